@@ -1,0 +1,342 @@
+//! # Plugging your own robot into marsupial
+//!
+//! This is the starting point for a new platform. It shows the three things you write:
+//!
+//! 1. **A profile** (here inline; normally `profiles/<robot>.toml`) describing the drive,
+//!    cameras, body, dock and loop timing. `marsupial check` validates it.
+//! 2. **The hardware traits** from [`marsupial::robot`]: a [`Camera`], a [`Drive`], and
+//!    optionally [`WheelEncoders`], a [`DockSensor`], a tether reel, arm, lights …
+//!    Here they talk to a tiny toy world (a red beacon on a floor); on your robot they
+//!    talk to your drivers.
+//! 3. **Behaviors**: a perceptual schema (find the red beacon), a motor schema (steer at
+//!    it), paired with an activation condition, under a priority arbiter with a
+//!    "docked" check on top.
+//!
+//! Then [`run`] drives the reactive loop on threads: one per camera, one for the slow
+//! sensors, one for the actuators, the loop itself at the profile's rate. It stops the
+//! robot if the camera goes stale and exits when the behavior reports an outcome.
+//!
+//! Run it with `cargo run --example custom_robot`.
+
+use marsupial::arbiter::runtime::{RuntimeConfig, RuntimeEvent, StopHandle, run};
+use marsupial::arbiter::{Priority, ReactiveLoop};
+use marsupial::geometry::{Pose2, Twist, integrate_twist};
+use marsupial::perception::RgbImage;
+use marsupial::profile::Profile;
+use marsupial::robot::{Camera, DockSensor, Drive, HardwareError, Robot, WheelEncoders, WheelTravel};
+use marsupial::schemas::{
+    Behavior, DriveCommand, Feedback, Inputs, MotorOutput, MotorSchema, Outcome, Percept, PerceptualSchema,
+    SchemaBehavior, Step,
+};
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// 1. The profile. Every field is checked; try misspelling one.
+const PROFILE: &str = r#"
+name = "toy"
+description = "A differential-drive toy that docks at a red beacon"
+
+[drive]
+kind = "differential"
+track_m = 0.30
+max_speed_mps = 0.25
+max_turn_rate_dps = 60.0
+
+[body]
+length_m = 0.35
+width_m = 0.30
+height_m = 0.20
+
+[[cameras]]
+name = "front"
+model = "pinhole"
+width_px = 160
+height_px = 120
+hfov_deg = 60.0
+fps = 30.0
+
+[dock]
+entrance_width_m = 0.40
+depth_m = 0.10
+approach_radius_m = 3.0
+approach_half_angle_deg = 90.0
+
+[fiducial.markers]
+count = 1
+side_m = 0.10
+color = "red"
+
+[behavior]
+approach = "none"
+coordination = "priority"
+max_retries = 0
+search_timeout_s = 20.0
+phase_timeout_s = 20.0
+
+[loop]
+rate_hz = 20.0
+camera_stale_s = 0.3
+
+[success]
+lateral_tolerance_m = 0.1
+heading_tolerance_deg = 20.0
+timeout_s = 30.0
+"#;
+
+// ---------------------------------------------------------------------------------------
+// 2. Hardware. A toy world stands in for your drivers: the robot on a floor, a beacon.
+// ---------------------------------------------------------------------------------------
+
+const BEACON: (f64, f64) = (2.0, 0.6);
+
+struct World {
+    pose: Pose2,
+    twist: Twist,
+    travel: WheelTravel,
+    last: Instant,
+}
+
+impl World {
+    /// Moves the robot along its current twist up to the present.
+    fn advance(&mut self) {
+        let now = Instant::now();
+        let dt = (now - self.last).as_secs_f64();
+        self.last = now;
+        self.pose = integrate_twist(&self.pose, &self.twist, dt);
+        let half = self.twist.omega * 0.30 / 2.0;
+        self.travel.left += (self.twist.v - half) * dt;
+        self.travel.right += (self.twist.v + half) * dt;
+    }
+}
+
+type Shared = Arc<Mutex<World>>;
+
+/// Renders the beacon as a red bar on a grey floor, pin-hole, 60° field of view.
+struct ToyCamera(Shared);
+impl Camera for ToyCamera {
+    fn resolution(&self) -> (usize, usize) {
+        (160, 120)
+    }
+    fn capture(&mut self, frame: &mut RgbImage) -> Result<(), HardwareError> {
+        std::thread::sleep(Duration::from_millis(33)); // a 30 fps sensor
+        let pose = {
+            let mut w = self.0.lock().map_err(|_| HardwareError::Fault {
+                device: "world".into(),
+                detail: "poisoned".into(),
+            })?;
+            w.advance();
+            w.pose
+        };
+        frame.fill([90, 90, 90]);
+        let (lx, ly) = pose.to_local(BEACON.0, BEACON.1);
+        if lx > 0.05 {
+            let f = 80.0 / (30f64.to_radians()).tan();
+            let u = 80.0 - f * ly / lx;
+            let half_w = (f * 0.05 / lx).max(1.0);
+            let half_h = (f * 0.3 / lx).min(60.0);
+            for x in (u - half_w).max(0.0) as usize..(u + half_w).clamp(0.0, 160.0) as usize {
+                for y in (60.0 - half_h) as usize..(60.0 + half_h) as usize {
+                    frame.put(x, y, [220, 30, 30]);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Applies twists to the toy world (your motor controller goes here).
+struct ToyDrive(Shared);
+impl Drive for ToyDrive {
+    fn apply(&mut self, command: &DriveCommand) -> Result<(), HardwareError> {
+        let mut w = self.0.lock().map_err(|_| HardwareError::Fault {
+            device: "world".into(),
+            detail: "poisoned".into(),
+        })?;
+        w.advance();
+        w.twist = command.to_twist();
+        Ok(())
+    }
+}
+
+struct ToyEncoders(Shared);
+impl WheelEncoders for ToyEncoders {
+    fn read(&mut self) -> Result<WheelTravel, HardwareError> {
+        let mut w = self.0.lock().map_err(|_| HardwareError::NotReady)?;
+        w.advance();
+        Ok(w.travel)
+    }
+}
+
+/// Closes when the robot's front is within 20 cm of the beacon.
+struct ToyDockSwitch(Shared);
+impl DockSensor for ToyDockSwitch {
+    fn in_contact(&mut self) -> Result<bool, HardwareError> {
+        let w = self.0.lock().map_err(|_| HardwareError::NotReady)?;
+        Ok((w.pose.x - BEACON.0).hypot(w.pose.y - BEACON.1) < 0.35)
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// 3. Behaviors.
+// ---------------------------------------------------------------------------------------
+
+/// Percept: where the red beacon is in the image.
+#[derive(Debug, Clone, Copy)]
+struct Beacon {
+    stamp: f64,
+    found: bool,
+    /// Column offset from the image centre, px (positive right).
+    offset_px: f64,
+    /// Red pixel count (grows as we approach).
+    pixels: usize,
+}
+
+impl Percept for Beacon {
+    fn stamp(&self) -> f64 {
+        self.stamp
+    }
+    fn found(&self) -> bool {
+        self.found
+    }
+}
+
+/// Perceptual schema: count red pixels and average their column.
+struct FindRed;
+impl PerceptualSchema for FindRed {
+    type Percept = Beacon;
+    fn perceive(&mut self, inputs: &Inputs<'_>) -> Beacon {
+        let Some(cam) = inputs.camera(0) else {
+            return Beacon {
+                stamp: inputs.now,
+                found: false,
+                offset_px: 0.0,
+                pixels: 0,
+            };
+        };
+        let (mut sum_x, mut n) = (0usize, 0usize);
+        for (i, px) in cam.image.as_bytes().chunks_exact(3).enumerate() {
+            if px[0] > 150 && px[1] < 80 && px[2] < 80 {
+                sum_x += i % cam.image.width();
+                n += 1;
+            }
+        }
+        let offset_px = if n > 0 {
+            sum_x as f64 / n as f64 - cam.image.width() as f64 / 2.0
+        } else {
+            0.0
+        };
+        Beacon {
+            stamp: cam.stamp,
+            found: n > 10,
+            offset_px,
+            pixels: n,
+        }
+    }
+}
+
+/// Motor schema: turn toward the beacon, slow down as it grows.
+struct SteerAtBeacon;
+impl MotorSchema for SteerAtBeacon {
+    type Percept = Beacon;
+    fn act(&self, b: &Beacon) -> MotorOutput {
+        let v = (0.2 - b.pixels as f64 * 2e-5).clamp(0.05, 0.2);
+        MotorOutput::twist(v, -0.012 * b.offset_px)
+    }
+}
+
+/// Turns in place while nothing is seen.
+struct Search;
+impl Behavior for Search {
+    fn name(&self) -> &str {
+        "search"
+    }
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+        Some(Step::running(
+            MotorOutput::drive(DriveCommand::Turn { omega: 0.6 }),
+            Feedback::new("search", inputs.now),
+        ))
+    }
+}
+
+/// Top priority: report `Docked` once the dock switch closes.
+struct DockedCheck;
+impl Behavior for DockedCheck {
+    fn name(&self) -> &str {
+        "docked"
+    }
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+        inputs.docked_contact().then(|| {
+            Step::done(
+                Outcome::Docked,
+                MotorOutput::stop(),
+                Feedback::new("docked", inputs.now),
+            )
+        })
+    }
+}
+
+fn main() {
+    let profile = match Profile::parse(PROFILE, Path::new("custom_robot.toml")) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("{e}");
+            std::process::exit(1);
+        }
+    };
+
+    // Start facing away from the beacon so the search behavior has work to do.
+    let world: Shared = Arc::new(Mutex::new(World {
+        pose: Pose2::new(0.0, 0.0, -2.0),
+        twist: Twist::ZERO,
+        travel: WheelTravel::default(),
+        last: Instant::now(),
+    }));
+    let mut robot = Robot::new(
+        vec![Box::new(ToyCamera(world.clone()))],
+        Box::new(ToyDrive(world.clone())),
+    );
+    robot.encoders = Some(Box::new(ToyEncoders(world.clone())));
+    robot.dock_sensor = Some(Box::new(ToyDockSwitch(world.clone())));
+
+    let approach = SchemaBehavior::new("approach", FindRed, SteerAtBeacon, |b: &Beacon| b.found);
+    let root = Priority::new(
+        "root",
+        vec![Box::new(DockedCheck), Box::new(approach), Box::new(Search)],
+    );
+    let mut lp = ReactiveLoop::new(Box::new(root), profile.loop_config());
+
+    let config = RuntimeConfig {
+        max_duration: Some(Duration::from_secs_f64(profile.success.timeout_s)),
+        ..RuntimeConfig::default()
+    };
+    println!(
+        "running the toy robot at {} Hz (up to {} s)…",
+        profile.loop_.rate_hz, profile.success.timeout_s
+    );
+    let report = run(&mut robot, &mut lp, &config, &StopHandle::new());
+
+    for e in &report.events {
+        match e {
+            RuntimeEvent::SafeStop { t, reason } => println!("  {t:6.2} s  safe stop: {reason}"),
+            RuntimeEvent::Resumed { t } => println!("  {t:6.2} s  resumed"),
+            RuntimeEvent::Finished { t, outcome } => println!("  {t:6.2} s  finished: {outcome:?}"),
+            RuntimeEvent::HardwareError { t, device, error } => println!("  {t:6.2} s  {device}: {error}"),
+        }
+    }
+    let pose = world.lock().map(|w| w.pose).unwrap_or_default();
+    println!(
+        "{} ticks in {:.1} s ({} overruns, slowest tick {:.3} ms); final pose ({:.2}, {:.2}, {:.0}°); outcome {:?}",
+        report.ticks,
+        report.elapsed_s,
+        report.overruns,
+        report.max_tick_s * 1e3,
+        pose.x,
+        pose.y,
+        pose.theta.to_degrees(),
+        report.outcome
+    );
+    if report.outcome != Some(Outcome::Docked) {
+        std::process::exit(2);
+    }
+}

@@ -1,0 +1,22 @@
+//! Coordination and the reactive loop.
+//!
+//! Three strategies, each itself a [`Behavior`](crate::schemas::Behavior) so they nest:
+//! [`Priority`] (subsumption), [`VectorSum`] (Arkin's gain-weighted sum) and
+//! [`Sequencer`] (a state machine with latched states). Each records its per-tick
+//! [`Decision`] and emits it through `tracing` (target `marsupial::arbiter`).
+//! [`ReactiveLoop`] is the pure tick; [`runtime::run`] is the threaded wrapper.
+
+pub mod decision;
+pub mod priority;
+pub mod reactive_loop;
+pub mod runtime;
+pub mod sequencer;
+pub mod vector_sum;
+
+pub use decision::{Candidate, Decision, Strategy};
+pub use priority::Priority;
+pub use reactive_loop::{
+    InputKind, LoopConfig, LoopStatus, ReactiveLoop, Staleness, StopReason, TickOutput, safe_stop_command,
+};
+pub use sequencer::{Next, Selector, Sequencer};
+pub use vector_sum::VectorSum;

@@ -1,0 +1,374 @@
+//! The reactive loop's pure tick: (loop state, timestamped inputs) → (loop state, command).
+//!
+//! [`ReactiveLoop::tick`] reads no clock, spawns nothing and draws no random number: the
+//! same sequence of [`Inputs`] yields the same sequence of commands, bit for bit. Before
+//! the behaviors run it checks the inputs the profile declares required; if one is
+//! missing, stale, the wrong size or not finite, the loop commands a safe stop, reports
+//! why in [`LoopStatus::SafeStop`], and resumes on the first tick whose inputs are good.
+
+use crate::kinematics::{DriveLimits, DriveModel};
+use crate::schemas::{
+    Auxiliary, Behavior, DriveCommand, Feedback, Inputs, MotorOutput, Outcome, Status, TetherCommand,
+};
+use serde::Serialize;
+use std::fmt;
+
+/// Which input a stop reason is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InputKind {
+    /// Camera with this index (profile order).
+    Camera(usize),
+    /// Odometry.
+    Odometry,
+    /// Tether sensor.
+    Tether,
+    /// The loop clock itself.
+    Clock,
+}
+
+impl fmt::Display for InputKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            InputKind::Camera(i) => write!(f, "camera {i}"),
+            InputKind::Odometry => f.write_str("odometry"),
+            InputKind::Tether => f.write_str("tether"),
+            InputKind::Clock => f.write_str("clock"),
+        }
+    }
+}
+
+/// Why the loop commanded a safe stop.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "reason", rename_all = "snake_case")]
+pub enum StopReason {
+    /// A required input has not arrived yet.
+    Missing {
+        /// The input.
+        input: InputKind,
+    },
+    /// A required input is older than its staleness limit.
+    Stale {
+        /// The input.
+        input: InputKind,
+        /// Its age, s.
+        age_s: f64,
+        /// The limit, s.
+        limit_s: f64,
+    },
+    /// A frame does not have the size the profile declares.
+    BadFrameSize {
+        /// The camera.
+        camera: usize,
+        /// Expected (width, height).
+        expected: (usize, usize),
+        /// Received (width, height).
+        got: (usize, usize),
+    },
+    /// An input holds NaN or infinity.
+    NonFinite {
+        /// The input.
+        input: InputKind,
+    },
+    /// The loop time is not finite or went backwards.
+    BadClock {
+        /// Previous tick time.
+        previous: f64,
+        /// This tick's time.
+        now: f64,
+    },
+    /// The behaviors proposed a command with NaN or infinity.
+    NonFiniteCommand,
+}
+
+impl fmt::Display for StopReason {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            StopReason::Missing { input } => write!(f, "{input}: no data yet"),
+            StopReason::Stale { input, age_s, limit_s } => {
+                write!(f, "{input}: last data {age_s:.3} s old (limit {limit_s:.3} s)")
+            }
+            StopReason::BadFrameSize { camera, expected, got } => write!(
+                f,
+                "camera {camera}: frame is {}×{}, profile says {}×{}",
+                got.0, got.1, expected.0, expected.1
+            ),
+            StopReason::NonFinite { input } => write!(f, "{input}: value is not finite"),
+            StopReason::BadClock { previous, now } => write!(f, "loop clock went from {previous} to {now}"),
+            StopReason::NonFiniteCommand => f.write_str("behaviors proposed a non-finite command"),
+        }
+    }
+}
+
+/// Staleness limits (s) of the required inputs; `None` means the input is optional.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Staleness {
+    /// Limit for every camera.
+    pub camera: Option<f64>,
+    /// Limit for odometry.
+    pub odometry: Option<f64>,
+    /// Limit for the tether sensor.
+    pub tether: Option<f64>,
+}
+
+/// Static configuration of a loop (built from a profile by
+/// [`crate::profile::Profile::loop_config`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoopConfig {
+    /// Tick rate, Hz (used by the threaded runtime and the simulator).
+    pub rate_hz: f64,
+    /// Required inputs and their staleness limits.
+    pub staleness: Staleness,
+    /// Expected frame size per camera (profile order).
+    pub frame_sizes: Vec<(usize, usize)>,
+    /// The base's kinematics, for command realisation.
+    pub drive: DriveModel,
+    /// The base's limits.
+    pub limits: DriveLimits,
+}
+
+/// The loop's status after a tick.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum LoopStatus {
+    /// A behavior is running.
+    Running {
+        /// Its feedback.
+        feedback: Feedback,
+    },
+    /// No behavior was released this tick; the base is stopped.
+    Idle,
+    /// Inputs are bad; the base is stopped until they recover.
+    SafeStop {
+        /// Why.
+        reason: StopReason,
+    },
+    /// The root behavior finished; the base stays stopped.
+    Finished {
+        /// How it ended.
+        outcome: Outcome,
+    },
+}
+
+/// What a tick returns.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TickOutput {
+    /// The command to send to the actuators (already realised for the drive).
+    pub command: MotorOutput,
+    /// The loop's status.
+    pub status: LoopStatus,
+}
+
+/// The reactive loop: a root behavior (usually an arbiter) plus input checks.
+pub struct ReactiveLoop {
+    root: Box<dyn Behavior>,
+    config: LoopConfig,
+    last_now: Option<f64>,
+    finished: Option<Outcome>,
+    stopped: Option<StopReason>,
+    ticks: u64,
+    safe_stop_ticks: u64,
+}
+
+/// True when an input of age `age` (s) is within `limit`; NaN ages are never fresh.
+fn is_fresh(age: f64, limit: f64) -> bool {
+    age.is_finite() && age <= limit
+}
+
+/// The command every safe stop sends: base stopped, reel stopped (not free-wheeling),
+/// other auxiliaries held.
+pub fn safe_stop_command() -> MotorOutput {
+    MotorOutput {
+        drive: DriveCommand::Stop,
+        aux: Auxiliary {
+            tether: Some(TetherCommand {
+                reel_rate: 0.0,
+                free_wheel: false,
+            }),
+            ..Auxiliary::default()
+        },
+    }
+}
+
+impl ReactiveLoop {
+    /// Builds a loop around `root`.
+    pub fn new(root: Box<dyn Behavior>, config: LoopConfig) -> Self {
+        Self {
+            root,
+            config,
+            last_now: None,
+            finished: None,
+            stopped: None,
+            ticks: 0,
+            safe_stop_ticks: 0,
+        }
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &LoopConfig {
+        &self.config
+    }
+
+    /// Ticks so far.
+    pub fn ticks(&self) -> u64 {
+        self.ticks
+    }
+
+    /// Ticks spent in safe stop so far.
+    pub fn safe_stop_ticks(&self) -> u64 {
+        self.safe_stop_ticks
+    }
+
+    /// The outcome, once the root behavior has finished.
+    pub fn outcome(&self) -> Option<Outcome> {
+        self.finished
+    }
+
+    /// The root behavior.
+    pub fn root_mut(&mut self) -> &mut dyn Behavior {
+        self.root.as_mut()
+    }
+
+    fn check_inputs(&self, inputs: &Inputs<'_>) -> Option<StopReason> {
+        let now = inputs.now;
+        let previous = self.last_now.unwrap_or(f64::NEG_INFINITY);
+        if !now.is_finite() || now < previous {
+            return Some(StopReason::BadClock { previous, now });
+        }
+        for (i, &expected) in self.config.frame_sizes.iter().enumerate() {
+            match inputs.camera(i) {
+                None => {
+                    if self.config.staleness.camera.is_some() {
+                        return Some(StopReason::Missing {
+                            input: InputKind::Camera(i),
+                        });
+                    }
+                }
+                Some(c) => {
+                    let got = (c.image.width(), c.image.height());
+                    if got != expected {
+                        return Some(StopReason::BadFrameSize {
+                            camera: i,
+                            expected,
+                            got,
+                        });
+                    }
+                    if let Some(limit) = self.config.staleness.camera {
+                        let age = now - c.stamp;
+                        if !is_fresh(age, limit) {
+                            return Some(StopReason::Stale {
+                                input: InputKind::Camera(i),
+                                age_s: age,
+                                limit_s: limit,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        if let Some(o) = inputs.odometry
+            && !(o.value.pose.is_finite() && o.value.twist.is_finite() && o.stamp.is_finite())
+        {
+            return Some(StopReason::NonFinite {
+                input: InputKind::Odometry,
+            });
+        }
+        if let Some(t) = inputs.tether
+            && !(t.value.length.is_finite() && t.value.tension.is_finite() && t.stamp.is_finite())
+        {
+            return Some(StopReason::NonFinite {
+                input: InputKind::Tether,
+            });
+        }
+        let checks = [
+            (
+                InputKind::Odometry,
+                self.config.staleness.odometry,
+                inputs.odometry.map(|o| o.stamp),
+            ),
+            (
+                InputKind::Tether,
+                self.config.staleness.tether,
+                inputs.tether.map(|t| t.stamp),
+            ),
+        ];
+        for (input, limit, stamp) in checks {
+            if let Some(limit) = limit {
+                match stamp {
+                    None => return Some(StopReason::Missing { input }),
+                    Some(s) if !is_fresh(now - s, limit) => {
+                        return Some(StopReason::Stale {
+                            input,
+                            age_s: now - s,
+                            limit_s: limit,
+                        });
+                    }
+                    _ => {}
+                }
+            }
+        }
+        None
+    }
+
+    fn enter_stop(&mut self, reason: StopReason, now: f64) -> TickOutput {
+        if self.stopped.is_none() {
+            tracing::warn!(target: "marsupial::loop", now, %reason, "safe stop");
+        }
+        self.stopped = Some(reason);
+        self.safe_stop_ticks += 1;
+        TickOutput {
+            command: safe_stop_command(),
+            status: LoopStatus::SafeStop { reason },
+        }
+    }
+
+    /// Runs one tick.
+    pub fn tick(&mut self, inputs: &Inputs<'_>) -> TickOutput {
+        self.ticks += 1;
+        if let Some(outcome) = self.finished {
+            return TickOutput {
+                command: MotorOutput::stop(),
+                status: LoopStatus::Finished { outcome },
+            };
+        }
+        if let Some(reason) = self.check_inputs(inputs) {
+            return self.enter_stop(reason, inputs.now);
+        }
+        self.last_now = Some(inputs.now);
+        if let Some(reason) = self.stopped.take() {
+            tracing::info!(target: "marsupial::loop", now = inputs.now, %reason, "inputs recovered, resuming");
+        }
+        let Some(step) = self.root.tick(inputs) else {
+            return TickOutput {
+                command: MotorOutput::stop(),
+                status: LoopStatus::Idle,
+            };
+        };
+        if !step.output.is_finite() {
+            return self.enter_stop(StopReason::NonFiniteCommand, inputs.now);
+        }
+        let drive = self.config.drive.realise(&step.output.drive, &self.config.limits);
+        match step.status {
+            Status::Running => TickOutput {
+                command: MotorOutput {
+                    drive,
+                    aux: step.output.aux,
+                },
+                status: LoopStatus::Running {
+                    feedback: step.feedback,
+                },
+            },
+            Status::Done(outcome) => {
+                tracing::info!(target: "marsupial::loop", now = inputs.now, ?outcome, "behavior finished");
+                self.finished = Some(outcome);
+                TickOutput {
+                    command: MotorOutput {
+                        drive: DriveCommand::Stop,
+                        aux: step.output.aux,
+                    },
+                    status: LoopStatus::Finished { outcome },
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,104 @@
+//! Weighted vector summation (Arkin's motor-schema coordination).
+
+use super::decision::{Decision, Strategy};
+use crate::geometry::Twist;
+use crate::schemas::{Behavior, DriveCommand, Feedback, Inputs, MotionVector, MotorOutput, Status, Step};
+
+/// Sums the active children's drive outputs, each scaled by its gain.
+///
+/// `Vector` outputs are summed as vectors (then clipped to `max_speed` and turned into a
+/// twist by the heading controller with gain `k_theta`); every other drive command is
+/// summed as a twist. Auxiliary commands merge in list order (earlier children win).
+/// The first child to report `Done` ends the sum with that outcome. With no active child
+/// the arbiter is inactive.
+pub struct VectorSum {
+    name: String,
+    children: Vec<(f64, Box<dyn Behavior>)>,
+    max_speed: f64,
+    k_theta: f64,
+    decision: Decision,
+}
+
+impl VectorSum {
+    /// Builds the arbiter from `(gain, behavior)` pairs.
+    pub fn new(name: impl Into<String>, children: Vec<(f64, Box<dyn Behavior>)>, max_speed: f64, k_theta: f64) -> Self {
+        Self {
+            name: name.into(),
+            decision: Decision::new(Strategy::VectorSum),
+            children,
+            max_speed,
+            k_theta,
+        }
+    }
+
+    /// The last tick's decision.
+    pub fn decision(&self) -> &Decision {
+        &self.decision
+    }
+}
+
+impl Behavior for VectorSum {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+        self.decision.clear();
+        let mut vec_sum = MotionVector::ZERO;
+        let mut any_vec = false;
+        let mut tw = Twist::ZERO;
+        let mut aux = crate::schemas::Auxiliary::default();
+        let mut feedback: Option<Feedback> = None;
+        let mut status = Status::Running;
+        let mut any = false;
+        for (i, (gain, child)) in self.children.iter_mut().enumerate() {
+            let gain = *gain;
+            let step = child.tick(inputs);
+            self.decision.push(i, step.as_ref());
+            let Some(step) = step else { continue };
+            any = true;
+            match step.output.drive {
+                DriveCommand::Vector(v) => {
+                    vec_sum = vec_sum + v.scale(gain);
+                    any_vec = true;
+                }
+                other => {
+                    let t = other.to_twist();
+                    tw.v += gain * t.v;
+                    tw.omega += gain * t.omega;
+                }
+            }
+            aux = aux.or(step.output.aux);
+            feedback.get_or_insert(step.feedback);
+            if status == Status::Running && matches!(step.status, Status::Done(_)) {
+                status = step.status;
+            }
+        }
+        if !any {
+            self.decision
+                .trace(&self.name, &|i| self.children[i].1.name().to_string());
+            return None;
+        }
+        if any_vec {
+            let t = vec_sum.clip(self.max_speed).to_twist(self.k_theta);
+            tw.v += t.v;
+            tw.omega += t.omega;
+        }
+        let output = MotorOutput {
+            drive: DriveCommand::Twist(tw),
+            aux,
+        };
+        self.decision.output = Some(output);
+        let children = &self.children;
+        self.decision.trace(&self.name, &|i| children[i].1.name().to_string());
+        Some(Step {
+            output,
+            feedback: feedback.unwrap_or(Feedback::new("sum", 0.0)),
+            status,
+        })
+    }
+
+    fn reset(&mut self) {
+        self.children.iter_mut().for_each(|(_, c)| c.reset());
+    }
+}

@@ -1,0 +1,32 @@
+//! `marsupial check FILE...`: validate profiles (and scenarios) without running anything.
+
+use crate::config::ConfigError;
+use crate::profile::Profile;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Validates one file, choosing its kind from its contents.
+///
+/// # Errors
+/// The file's [`ConfigError`].
+pub fn check_file(path: &Path) -> Result<(), ConfigError> {
+    Profile::load(path).map(|_| ())
+}
+
+/// Checks every file, printing `ok FILE` to `out` for each valid one and the error to
+/// `err` for each invalid one. Returns the number of invalid files.
+pub fn run(files: &[PathBuf], out: &mut dyn Write, err: &mut dyn Write) -> usize {
+    let mut bad = 0;
+    for f in files {
+        match check_file(f) {
+            Ok(()) => {
+                let _ = writeln!(out, "ok {}", f.display());
+            }
+            Err(e) => {
+                bad += 1;
+                let _ = writeln!(err, "error: {e}");
+            }
+        }
+    }
+    bad
+}

@@ -1,0 +1,4 @@
+//! The `marsupial` command-line tool's subcommands, as library functions so they can be
+//! tested without spawning a process.
+
+pub mod check;

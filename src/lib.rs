@@ -1,0 +1,50 @@
+//! # marsupial
+//!
+//! Reactive, behavior-based robots that dock by vision.
+//!
+//! * [`perception`]: pure image functions over borrowed views and reusable buffers.
+//! * [`schemas`]: perceptual schemas (sensor data → [`schemas::Percept`]), motor schemas
+//!   (percept → [`schemas::MotorOutput`]) and [`schemas::Behavior`]s pairing them.
+//! * [`arbiter`]: coordination ([`arbiter::Priority`], [`arbiter::VectorSum`],
+//!   [`arbiter::Sequencer`]) and the [`arbiter::ReactiveLoop`], whose tick is a pure
+//!   function of its state and timestamped inputs; [`arbiter::runtime`] runs it on
+//!   threads against a [`robot::Robot`].
+//! * [`kinematics`]: differential, skid-steer (effective track), turn-or-drive and
+//!   double-Ackermann models, command realisation and odometry.
+//! * [`profile`]: one TOML file per platform, validated with precise errors.
+//!
+//! ## How the parts fit
+//!
+//! ```
+//! use marsupial::arbiter::{Priority, ReactiveLoop};
+//! use marsupial::profile::Profile;
+//! use marsupial::schemas::{Behavior, Feedback, Inputs, MotorOutput, Step};
+//!
+//! /// A behavior that always drives forward slowly.
+//! struct Creep;
+//! impl Behavior for Creep {
+//!     fn name(&self) -> &str { "creep" }
+//!     fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+//!         Some(Step::running(MotorOutput::twist(0.05, 0.0), Feedback::new("creep", inputs.now)))
+//!     }
+//! }
+//!
+//! let profile = Profile::load("profiles/axel.toml".as_ref()).unwrap();
+//! let mut config = profile.loop_config();
+//! config.staleness = Default::default(); // no sensors in this doc example
+//! let root = Priority::new("root", vec![Box::new(Creep)]);
+//! let mut lp = ReactiveLoop::new(Box::new(root), config);
+//! let out = lp.tick(&Inputs::empty(0.0));
+//! assert!(out.command.drive.to_twist().v > 0.0);
+//! ```
+#![deny(missing_docs)]
+
+pub mod arbiter;
+pub mod cli;
+pub mod config;
+pub mod geometry;
+pub mod kinematics;
+pub mod perception;
+pub mod profile;
+pub mod robot;
+pub mod schemas;

@@ -1,0 +1,204 @@
+//! Owned RGB frames and borrowed views: the currency between cameras and perception.
+//!
+//! Pixels are packed `R, G, B` bytes in row-major order. Cameras write into an
+//! [`RgbImage`] the caller owns (so steady-state capture does not allocate); perception
+//! functions read an [`RgbView`].
+
+use thiserror::Error;
+
+/// Errors from constructing images or views with inconsistent sizes.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum ImageError {
+    /// Width or height is zero.
+    #[error("image is empty ({width}×{height}): expected width and height ≥ 1")]
+    Empty {
+        /// Width in pixels.
+        width: usize,
+        /// Height in pixels.
+        height: usize,
+    },
+    /// The byte buffer does not match `width × height × 3`.
+    #[error("RGB buffer holds {got} bytes but {width}×{height}×3 = {expected} were expected")]
+    BufferSize {
+        /// Width in pixels.
+        width: usize,
+        /// Height in pixels.
+        height: usize,
+        /// Bytes expected.
+        expected: usize,
+        /// Bytes found.
+        got: usize,
+    },
+}
+
+/// An owned, packed RGB8 image.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct RgbImage {
+    width: usize,
+    height: usize,
+    data: Vec<u8>,
+}
+
+impl RgbImage {
+    /// A black image of the given size. Zero sizes are allowed (an unfilled buffer).
+    pub fn new(width: usize, height: usize) -> Self {
+        Self {
+            width,
+            height,
+            data: vec![0; width * height * 3],
+        }
+    }
+
+    /// Wraps an existing packed RGB buffer.
+    ///
+    /// # Errors
+    /// [`ImageError::BufferSize`] when `data.len() != width*height*3`.
+    pub fn from_raw(width: usize, height: usize, data: Vec<u8>) -> Result<Self, ImageError> {
+        let expected = width * height * 3;
+        if data.len() != expected {
+            return Err(ImageError::BufferSize {
+                width,
+                height,
+                expected,
+                got: data.len(),
+            });
+        }
+        Ok(Self { width, height, data })
+    }
+
+    /// Resizes the buffer to `width × height`, reusing its allocation when it is big enough.
+    /// Contents are unspecified afterwards.
+    pub fn resize(&mut self, width: usize, height: usize) {
+        self.width = width;
+        self.height = height;
+        self.data.resize(width * height * 3, 0);
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The packed bytes.
+    pub fn as_bytes(&self) -> &[u8] {
+        &self.data
+    }
+
+    /// The packed bytes, mutable.
+    pub fn as_bytes_mut(&mut self) -> &mut [u8] {
+        &mut self.data
+    }
+
+    /// Sets pixel (x, y); out-of-range coordinates are ignored.
+    pub fn put(&mut self, x: usize, y: usize, rgb: [u8; 3]) {
+        if x < self.width && y < self.height {
+            let i = (y * self.width + x) * 3;
+            self.data[i..i + 3].copy_from_slice(&rgb);
+        }
+    }
+
+    /// Fills every pixel with one colour.
+    pub fn fill(&mut self, rgb: [u8; 3]) {
+        for px in self.data.chunks_exact_mut(3) {
+            px.copy_from_slice(&rgb);
+        }
+    }
+
+    /// A borrowed view of the whole image.
+    pub fn view(&self) -> RgbView<'_> {
+        RgbView {
+            width: self.width,
+            height: self.height,
+            data: &self.data,
+        }
+    }
+}
+
+/// A borrowed, packed RGB8 image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RgbView<'a> {
+    width: usize,
+    height: usize,
+    data: &'a [u8],
+}
+
+impl<'a> RgbView<'a> {
+    /// Wraps a packed RGB buffer.
+    ///
+    /// # Errors
+    /// [`ImageError::BufferSize`] when the length is not `width*height*3`.
+    pub fn new(width: usize, height: usize, data: &'a [u8]) -> Result<Self, ImageError> {
+        let expected = width * height * 3;
+        if data.len() != expected {
+            return Err(ImageError::BufferSize {
+                width,
+                height,
+                expected,
+                got: data.len(),
+            });
+        }
+        Ok(Self { width, height, data })
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// True when the view holds no pixel.
+    pub fn is_empty(&self) -> bool {
+        self.width == 0 || self.height == 0
+    }
+
+    /// The packed bytes.
+    pub fn as_bytes(&self) -> &'a [u8] {
+        self.data
+    }
+
+    /// Pixel (x, y), or `None` outside the image.
+    pub fn get(&self, x: usize, y: usize) -> Option<[u8; 3]> {
+        if x < self.width && y < self.height {
+            let i = (y * self.width + x) * 3;
+            Some([self.data[i], self.data[i + 1], self.data[i + 2]])
+        } else {
+            None
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_are_checked() {
+        assert!(matches!(
+            RgbImage::from_raw(2, 2, vec![0; 11]),
+            Err(ImageError::BufferSize {
+                expected: 12,
+                got: 11,
+                ..
+            })
+        ));
+        assert!(RgbView::new(1, 1, &[1, 2, 3]).is_ok());
+    }
+
+    #[test]
+    fn put_and_get() {
+        let mut im = RgbImage::new(3, 2);
+        im.put(2, 1, [9, 8, 7]);
+        im.put(5, 5, [1, 1, 1]); // ignored
+        assert_eq!(im.view().get(2, 1), Some([9, 8, 7]));
+        assert_eq!(im.view().get(3, 1), None);
+    }
+}

@@ -1,0 +1,268 @@
+//! `[behavior]` and `[loop]`: which behaviors run, their gains, and loop timing.
+
+use crate::config::Validator;
+use serde::{Deserialize, Serialize};
+
+/// The approach behavior a profile selects.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ApproachKind {
+    /// Bujold's pixel-ratio steering (seed 004 §V).
+    RatioSteering,
+    /// Arkin & Murphy potential-field docking on a relative pose.
+    PotentialField,
+    /// RAPOSA's seven-state vision servo (seed 001 §II).
+    SevenState,
+    /// Axel's region planner with two-arc manoeuvres (seed 000).
+    TwoArc,
+    /// No docking behavior (state estimation only, e.g. AutoKrawler).
+    None,
+}
+
+/// How the behaviors are coordinated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Coordination {
+    /// Subsumption.
+    Priority,
+    /// Weighted vector sum.
+    VectorSum,
+    /// State machine.
+    Sequencer,
+}
+
+/// Gains of the ratio-steering motor schema.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RatioSteeringGains {
+    /// Half-width of the dead band around a ratio of 1 (no turn inside it).
+    pub dead_band: f64,
+    /// Fraction of the needed turn actually commanded (< 1 understeers).
+    pub understeer: f64,
+    /// Turn-in-place rate, degrees per second.
+    pub turn_rate_dps: f64,
+    /// Straight-drive speed far from the dock, m/s.
+    pub drive_speed_mps: f64,
+    /// Summed pixel count at which the robot is at (or beside) the dock.
+    pub dock_total_px: u32,
+    /// Largest horizontal offset of the pair from the image centre to back in, px.
+    pub centre_tolerance_px: f64,
+}
+
+/// Gains of the potential-field docking schema (ALGORITHMS §1.3).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PotentialFieldGains {
+    /// Half-width of the approach sector where attraction dominates, degrees.
+    pub approach_sector_deg: f64,
+    /// Attraction weight in the coercive zone (tangential weight is 1 there).
+    pub coercive_attraction: f64,
+    /// Overall gain (m/s at full field).
+    pub gain: f64,
+    /// Heading-controller gain turning the field vector into a twist, 1/s.
+    pub k_theta: f64,
+}
+
+/// Gains and thresholds of RAPOSA's seven-state servo (seed 001 §II.D–E).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SevenStateGains {
+    /// State 1 near law v = K_lin·√(A_ref/A), m/s.
+    pub k_lin: f64,
+    /// ω = −K_ang·x_dev, rad/s per pixel.
+    pub k_ang: f64,
+    /// Arm = −K_arm·y_dev, rad per pixel.
+    pub k_arm: f64,
+    /// Constant speed beyond about 1 m, m/s.
+    pub far_speed_mps: f64,
+    /// Region II above this angle α, degrees (paper: 15).
+    pub angle_threshold_deg: f64,
+    /// Region II above this distance, m (paper: 0.34).
+    pub distance_threshold_m: f64,
+    /// Tracking ball radius around the previous ellipse, px (paper: 20).
+    pub tracking_ball_px: f64,
+    /// State 6 starts when the ellipse is at this distance, m (paper: 0.3).
+    pub final_distance_m: f64,
+    /// State 6 speed, m/s.
+    pub final_speed_mps: f64,
+    /// State 6 duration, s.
+    pub final_time_s: f64,
+}
+
+/// Gains of Axel's two-arc docking (seed 000).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TwoArcGains {
+    /// Heading tolerance before reeling in, degrees (paper: ±5).
+    pub heading_tolerance_deg: f64,
+    /// Radius of the mating region, m.
+    pub mating_radius_m: f64,
+    /// Radius of the alignment region, m.
+    pub alignment_radius_m: f64,
+    /// Tether reeled in during mating, m (paper: about 0.25).
+    pub reel_in_m: f64,
+    /// Speed along arcs, m/s.
+    pub arc_speed_mps: f64,
+}
+
+/// The `[behavior]` table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BehaviorSpec {
+    /// Approach behavior.
+    pub approach: ApproachKind,
+    /// Coordination strategy.
+    pub coordination: Coordination,
+    /// Retries after a failed attempt near the dock.
+    pub max_retries: u32,
+    /// Longest search rotation before giving up, s.
+    pub search_timeout_s: f64,
+    /// Longest any single phase may last, s.
+    pub phase_timeout_s: f64,
+    /// Ratio-steering gains (required when `approach = "ratio_steering"`).
+    #[serde(default)]
+    pub ratio_steering: Option<RatioSteeringGains>,
+    /// Potential-field gains (required when `approach = "potential_field"`).
+    #[serde(default)]
+    pub potential_field: Option<PotentialFieldGains>,
+    /// Seven-state gains (required when `approach = "seven_state"`).
+    #[serde(default)]
+    pub seven_state: Option<SevenStateGains>,
+    /// Two-arc gains (required when `approach = "two_arc"`).
+    #[serde(default)]
+    pub two_arc: Option<TwoArcGains>,
+}
+
+/// The `[loop]` table.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoopSpec {
+    /// Tick rate, Hz.
+    pub rate_hz: f64,
+    /// Cameras are required; a frame older than this stops the robot, s.
+    #[serde(default)]
+    pub camera_stale_s: Option<f64>,
+    /// Odometry is required; older than this stops the robot, s.
+    #[serde(default)]
+    pub odometry_stale_s: Option<f64>,
+    /// Tether sensing is required; older than this stops the robot, s.
+    #[serde(default)]
+    pub tether_stale_s: Option<f64>,
+}
+
+pub(crate) fn validate_behavior(b: &BehaviorSpec, v: &mut Validator<'_>) {
+    v.positive("behavior.search_timeout_s", b.search_timeout_s);
+    v.positive("behavior.phase_timeout_s", b.phase_timeout_s);
+    let missing = |v: &mut Validator<'_>, table: &str| {
+        v.problem(
+            "behavior.approach",
+            format!("approach needs a [behavior.{table}] table"),
+        );
+    };
+    match b.approach {
+        ApproachKind::RatioSteering => match &b.ratio_steering {
+            None => missing(v, "ratio_steering"),
+            Some(g) => {
+                v.range("behavior.ratio_steering.dead_band", g.dead_band, 0.0, 1.0);
+                v.range("behavior.ratio_steering.understeer", g.understeer, 0.0, 1.0);
+                v.positive("behavior.ratio_steering.turn_rate_dps", g.turn_rate_dps);
+                v.positive("behavior.ratio_steering.drive_speed_mps", g.drive_speed_mps);
+                v.require(g.dock_total_px > 0, "behavior.ratio_steering.dock_total_px", || {
+                    "expected a count ≥ 1".into()
+                });
+                v.positive("behavior.ratio_steering.centre_tolerance_px", g.centre_tolerance_px);
+            }
+        },
+        ApproachKind::PotentialField => match &b.potential_field {
+            None => missing(v, "potential_field"),
+            Some(g) => {
+                v.range(
+                    "behavior.potential_field.approach_sector_deg",
+                    g.approach_sector_deg,
+                    0.0,
+                    90.0,
+                );
+                v.range(
+                    "behavior.potential_field.coercive_attraction",
+                    g.coercive_attraction,
+                    0.0,
+                    1.0,
+                );
+                v.positive("behavior.potential_field.gain", g.gain);
+                v.positive("behavior.potential_field.k_theta", g.k_theta);
+            }
+        },
+        ApproachKind::SevenState => match &b.seven_state {
+            None => missing(v, "seven_state"),
+            Some(g) => {
+                v.positive("behavior.seven_state.k_lin", g.k_lin);
+                v.positive("behavior.seven_state.k_ang", g.k_ang);
+                v.non_negative("behavior.seven_state.k_arm", g.k_arm);
+                v.positive("behavior.seven_state.far_speed_mps", g.far_speed_mps);
+                v.range(
+                    "behavior.seven_state.angle_threshold_deg",
+                    g.angle_threshold_deg,
+                    0.0,
+                    90.0,
+                );
+                v.positive("behavior.seven_state.distance_threshold_m", g.distance_threshold_m);
+                v.positive("behavior.seven_state.tracking_ball_px", g.tracking_ball_px);
+                v.positive("behavior.seven_state.final_distance_m", g.final_distance_m);
+                v.positive("behavior.seven_state.final_speed_mps", g.final_speed_mps);
+                v.positive("behavior.seven_state.final_time_s", g.final_time_s);
+            }
+        },
+        ApproachKind::TwoArc => match &b.two_arc {
+            None => missing(v, "two_arc"),
+            Some(g) => {
+                v.range(
+                    "behavior.two_arc.heading_tolerance_deg",
+                    g.heading_tolerance_deg,
+                    0.0,
+                    90.0,
+                );
+                v.positive("behavior.two_arc.mating_radius_m", g.mating_radius_m);
+                v.positive("behavior.two_arc.alignment_radius_m", g.alignment_radius_m);
+                v.require(
+                    g.alignment_radius_m > g.mating_radius_m,
+                    "behavior.two_arc.alignment_radius_m",
+                    || {
+                        format!(
+                            "expected the alignment region ({} m) to be larger than the mating region ({} m)",
+                            g.alignment_radius_m, g.mating_radius_m
+                        )
+                    },
+                );
+                v.positive("behavior.two_arc.reel_in_m", g.reel_in_m);
+                v.positive("behavior.two_arc.arc_speed_mps", g.arc_speed_mps);
+            }
+        },
+        ApproachKind::None => {}
+    }
+}
+
+pub(crate) fn validate_loop(l: &LoopSpec, v: &mut Validator<'_>) {
+    v.require(
+        l.rate_hz.is_finite() && l.rate_hz > 0.0 && l.rate_hz <= 1000.0,
+        "loop.rate_hz",
+        || format!("expected a rate in (0, 1000] Hz, got {}", l.rate_hz),
+    );
+    for (path, s) in [
+        ("loop.camera_stale_s", l.camera_stale_s),
+        ("loop.odometry_stale_s", l.odometry_stale_s),
+        ("loop.tether_stale_s", l.tether_stale_s),
+    ] {
+        if let Some(s) = s {
+            v.positive(path, s);
+            if s.is_finite() && s > 0.0 && l.rate_hz > 0.0 && s < 1.0 / l.rate_hz {
+                v.problem(
+                    path,
+                    format!(
+                        "expected a limit of at least one tick (1/rate_hz = {:.4} s), got {s}",
+                        1.0 / l.rate_hz
+                    ),
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,130 @@
+//! Robot profiles: one TOML file describes one platform.
+//!
+//! A profile holds the drive (kinematics and limits), the cameras (model, resolution,
+//! field of view or intrinsics, mounting), the body, dock and fiducial geometry, the
+//! behavior selection with its gains, loop timing, and success tolerances. Unknown fields
+//! are rejected and every value is range-checked; see [`crate::config`] for the errors.
+//!
+//! ```
+//! let p = marsupial::profile::Profile::load("profiles/bujold.toml".as_ref()).unwrap();
+//! assert_eq!(p.cameras[0].width_px, 256);
+//! ```
+
+pub mod behavior;
+pub mod camera;
+pub mod drive;
+pub mod fiducial;
+pub mod geometry;
+
+pub use behavior::{
+    ApproachKind, BehaviorSpec, Coordination, LoopSpec, PotentialFieldGains, RatioSteeringGains, SevenStateGains,
+    TwoArcGains,
+};
+pub use camera::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount};
+pub use drive::{DriveKind, DriveSpec};
+pub use fiducial::{CirclePlacement, CirclesSpec, FiducialSpec, MarkersSpec, NamedColor, PyramidSpec, TwoBlockSpec};
+pub use geometry::{BodySpec, DockSpec, SuccessSpec, TetherSpec};
+
+use crate::arbiter::{LoopConfig, Staleness};
+use crate::config::{self, ConfigError, Validate, Validator};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// A platform profile.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Profile {
+    /// Short name (`"bujold"`).
+    pub name: String,
+    /// One-line description.
+    #[serde(default)]
+    pub description: String,
+    /// Base kinematics and limits.
+    pub drive: DriveSpec,
+    /// Footprint.
+    pub body: BodySpec,
+    /// Cameras, in the order the robot interface delivers them.
+    pub cameras: Vec<CameraSpec>,
+    /// Dock geometry (absent for profiles that do not dock).
+    #[serde(default)]
+    pub dock: Option<DockSpec>,
+    /// Visual target.
+    pub fiducial: FiducialSpec,
+    /// Tether (absent for untethered robots).
+    #[serde(default)]
+    pub tether: Option<TetherSpec>,
+    /// Behavior selection and gains.
+    pub behavior: BehaviorSpec,
+    /// Loop timing.
+    #[serde(rename = "loop")]
+    pub loop_: LoopSpec,
+    /// Success tolerances.
+    pub success: SuccessSpec,
+}
+
+impl Validate for Profile {
+    fn validate(&self, v: &mut Validator<'_>) {
+        v.require(!self.name.trim().is_empty(), "name", || {
+            "expected a non-empty profile name".into()
+        });
+        self.drive.validate(v);
+        geometry::validate_body(&self.body, v);
+        v.require(!self.cameras.is_empty(), "cameras", || {
+            "expected at least one [[cameras]] entry".into()
+        });
+        for (i, c) in self.cameras.iter().enumerate() {
+            c.validate_at(v, &format!("cameras[{i}]"));
+        }
+        if let Some(d) = &self.dock {
+            geometry::validate_dock(d, &self.body, v);
+        } else if self.behavior.approach != ApproachKind::None {
+            v.problem("behavior.approach", "a docking approach needs a [dock] table");
+        }
+        fiducial::validate_fiducial(&self.fiducial, v);
+        if let Some(t) = &self.tether {
+            geometry::validate_tether(t, v);
+        }
+        behavior::validate_behavior(&self.behavior, v);
+        behavior::validate_loop(&self.loop_, v);
+        geometry::validate_success(&self.success, v);
+        if self.loop_.tether_stale_s.is_some() && self.tether.is_none() {
+            v.problem(
+                "loop.tether_stale_s",
+                "tether sensing is required but the profile has no [tether] table",
+            );
+        }
+    }
+}
+
+impl Profile {
+    /// Loads and validates a profile file.
+    ///
+    /// # Errors
+    /// [`ConfigError`] naming the file, field path, line and expectation.
+    pub fn load(path: &Path) -> Result<Self, ConfigError> {
+        config::load(path)
+    }
+
+    /// Parses and validates profile text; `file` is used in messages.
+    ///
+    /// # Errors
+    /// As [`Profile::load`].
+    pub fn parse(src: &str, file: &Path) -> Result<Self, ConfigError> {
+        config::parse_str(src, file)
+    }
+
+    /// The reactive loop's configuration for this platform.
+    pub fn loop_config(&self) -> LoopConfig {
+        LoopConfig {
+            rate_hz: self.loop_.rate_hz,
+            staleness: Staleness {
+                camera: self.loop_.camera_stale_s,
+                odometry: self.loop_.odometry_stale_s,
+                tether: self.loop_.tether_stale_s,
+            },
+            frame_sizes: self.cameras.iter().map(|c| (c.width_px, c.height_px)).collect(),
+            drive: self.drive.model(),
+            limits: self.drive.limits(),
+        }
+    }
+}

@@ -1,0 +1,243 @@
+//! Behaviors: a perceptual and a motor schema paired with an activation condition, plus
+//! the feedback and typed outcome every behavior reports (after Nav2's docking server).
+
+use super::inputs::Inputs;
+use super::motor_output::MotorOutput;
+use super::percept::Percept;
+use super::traits::{MotorSchema, PerceptualSchema};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// Why a behavior gave up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FailureReason {
+    /// The target was never seen (search exhausted).
+    TargetNeverDetected,
+    /// The target was seen, then lost for longer than allowed.
+    TargetLost,
+    /// The controller could not bring the robot within tolerance.
+    FailedToControl,
+    /// The robot is stuck or in unplanned contact (e.g. on the dock entrance edge).
+    StuckContact,
+    /// A phase or the whole behavior ran out of time.
+    Timeout,
+    /// Every allowed retry was used.
+    RetriesExhausted,
+}
+
+impl FailureReason {
+    /// Every reason, in a fixed order (for tables and counters).
+    pub const ALL: [FailureReason; 6] = [
+        FailureReason::TargetNeverDetected,
+        FailureReason::TargetLost,
+        FailureReason::FailedToControl,
+        FailureReason::StuckContact,
+        FailureReason::Timeout,
+        FailureReason::RetriesExhausted,
+    ];
+
+    /// Snake-case name, as used in JSON output.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            FailureReason::TargetNeverDetected => "target_never_detected",
+            FailureReason::TargetLost => "target_lost",
+            FailureReason::FailedToControl => "failed_to_control",
+            FailureReason::StuckContact => "stuck_contact",
+            FailureReason::Timeout => "timeout",
+            FailureReason::RetriesExhausted => "retries_exhausted",
+        }
+    }
+}
+
+impl fmt::Display for FailureReason {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// How a behavior ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    /// Docked (the behavior's success criterion held).
+    Docked,
+    /// A non-docking behavior (undock, imprint, search) reached its goal.
+    Completed,
+    /// Gave up.
+    Failed(FailureReason),
+}
+
+impl Outcome {
+    /// True for `Docked` and `Completed`.
+    pub fn is_success(&self) -> bool {
+        !matches!(self, Outcome::Failed(_))
+    }
+}
+
+/// Progress report of a running behavior.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Feedback {
+    /// Current phase name (e.g. `"search"`, `"approach"`, `"state_7"`).
+    pub phase: &'static str,
+    /// Seconds since the behavior started.
+    pub elapsed: f64,
+    /// Retries used so far.
+    pub retries: u32,
+}
+
+impl Feedback {
+    /// Feedback for a phase with no retries.
+    pub fn new(phase: &'static str, elapsed: f64) -> Self {
+        Self {
+            phase,
+            elapsed,
+            retries: 0,
+        }
+    }
+}
+
+/// Whether a behavior is still running.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Status {
+    /// Keep ticking.
+    Running,
+    /// Finished; the output of this tick is its last.
+    Done(Outcome),
+}
+
+/// What an active behavior proposes for one tick.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Step {
+    /// The proposed motor output.
+    pub output: MotorOutput,
+    /// Progress report.
+    pub feedback: Feedback,
+    /// Running or done.
+    pub status: Status,
+}
+
+impl Step {
+    /// A running step.
+    pub fn running(output: MotorOutput, feedback: Feedback) -> Self {
+        Self {
+            output,
+            feedback,
+            status: Status::Running,
+        }
+    }
+
+    /// A final step: stops the base (every exit path commands zero velocity) and reports
+    /// the outcome. Auxiliary commands in `aux_output` are kept.
+    pub fn done(outcome: Outcome, aux_output: MotorOutput, feedback: Feedback) -> Self {
+        Self {
+            output: MotorOutput::stop().with_aux(aux_output.aux),
+            feedback,
+            status: Status::Done(outcome),
+        }
+    }
+}
+
+/// A behavior: ticked by the arbiter; returns `None` when its activation condition does
+/// not hold this tick (it is not "released"), or a [`Step`] with its proposal.
+///
+/// Implementations must be deterministic functions of their state and the inputs.
+pub trait Behavior: Send {
+    /// A short name for logs and decisions.
+    fn name(&self) -> &str;
+    /// Runs one tick.
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step>;
+    /// Returns to the initial state (called by sequencers when a state is entered).
+    fn reset(&mut self) {}
+}
+
+impl<B: Behavior + ?Sized> Behavior for Box<B> {
+    fn name(&self) -> &str {
+        (**self).name()
+    }
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+        (**self).tick(inputs)
+    }
+    fn reset(&mut self) {
+        (**self).reset()
+    }
+}
+
+/// The basic schema-theoretic behavior: perceive, test the releaser on the percept, act.
+///
+/// It never ends by itself (status is always `Running`); wrap it in a sequencer or write a
+/// dedicated behavior when an outcome is needed.
+pub struct SchemaBehavior<P, M, C> {
+    name: String,
+    perceptual: P,
+    motor: M,
+    releaser: C,
+    started: Option<f64>,
+}
+
+impl<P, M, C> SchemaBehavior<P, M, C>
+where
+    P: PerceptualSchema,
+    M: MotorSchema<Percept = P::Percept>,
+    C: Fn(&P::Percept) -> bool + Send,
+{
+    /// Pairs `perceptual` and `motor`; the behavior is active when `releaser(percept)`.
+    pub fn new(name: impl Into<String>, perceptual: P, motor: M, releaser: C) -> Self {
+        Self {
+            name: name.into(),
+            perceptual,
+            motor,
+            releaser,
+            started: None,
+        }
+    }
+
+    /// The perceptual schema (to inspect or retune it).
+    pub fn perceptual_mut(&mut self) -> &mut P {
+        &mut self.perceptual
+    }
+}
+
+impl<P, M, C> Behavior for SchemaBehavior<P, M, C>
+where
+    P: PerceptualSchema,
+    M: MotorSchema<Percept = P::Percept>,
+    C: Fn(&P::Percept) -> bool + Send,
+{
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+        let percept = self.perceptual.perceive(inputs);
+        if !(self.releaser)(&percept) {
+            return None;
+        }
+        let started = *self.started.get_or_insert(inputs.now);
+        let output = self.motor.act(&percept);
+        Some(Step::running(output, Feedback::new("active", inputs.now - started)))
+    }
+
+    fn reset(&mut self) {
+        self.started = None;
+        self.perceptual.reset();
+    }
+}
+
+/// A percept that is just "found or not" at a time: handy for releasers and tests.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Presence {
+    /// Capture time.
+    pub stamp: f64,
+    /// Found flag.
+    pub found: bool,
+}
+
+impl Percept for Presence {
+    fn stamp(&self) -> f64 {
+        self.stamp
+    }
+    fn found(&self) -> bool {
+        self.found
+    }
+}

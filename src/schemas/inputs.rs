@@ -1,0 +1,76 @@
+//! The timestamped sensor snapshot one loop tick consumes.
+
+use super::percept::Stamped;
+use crate::geometry::{Pose2, Twist};
+use crate::perception::RgbView;
+use serde::{Deserialize, Serialize};
+
+/// One camera frame handed to a tick.
+#[derive(Debug, Clone, Copy)]
+pub struct CameraInput<'a> {
+    /// Capture time, seconds on the loop clock.
+    pub stamp: f64,
+    /// The pixels.
+    pub image: RgbView<'a>,
+}
+
+/// An odometry estimate: pose in the odometry frame plus the current body twist.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct OdometryReading {
+    /// Pose in the odometry frame (origin where odometry was last reset).
+    pub pose: Pose2,
+    /// Body twist estimated from the wheels.
+    pub twist: Twist,
+}
+
+/// A tether reading.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct TetherReading {
+    /// Tether paid out, metres.
+    pub length: f64,
+    /// Tension, newtons (0 when slack).
+    pub tension: f64,
+}
+
+/// Everything one tick of the reactive loop sees.
+///
+/// `now` is the loop clock, supplied by the caller (the threaded runtime's monotonic
+/// clock, or the simulator's step counter); nothing downstream reads a clock itself.
+/// `cameras` is indexed like the profile's `[[cameras]]` list; a `None` entry means no
+/// frame has arrived from that camera yet.
+#[derive(Debug, Clone, Copy)]
+pub struct Inputs<'a> {
+    /// Loop time, seconds.
+    pub now: f64,
+    /// Latest frame per camera.
+    pub cameras: &'a [Option<CameraInput<'a>>],
+    /// Latest odometry estimate.
+    pub odometry: Option<Stamped<OdometryReading>>,
+    /// Latest tether reading.
+    pub tether: Option<Stamped<TetherReading>>,
+    /// Latest dock contact switch (pressure plates) reading.
+    pub dock_contact: Option<Stamped<bool>>,
+}
+
+impl<'a> Inputs<'a> {
+    /// A snapshot with no sensor data at time `now`.
+    pub fn empty(now: f64) -> Self {
+        Self {
+            now,
+            cameras: &[],
+            odometry: None,
+            tether: None,
+            dock_contact: None,
+        }
+    }
+
+    /// Camera `i`'s latest frame, if any.
+    pub fn camera(&self, i: usize) -> Option<&CameraInput<'a>> {
+        self.cameras.get(i).and_then(Option::as_ref)
+    }
+
+    /// True when the dock contact switch reads closed.
+    pub fn docked_contact(&self) -> bool {
+        self.dock_contact.is_some_and(|c| c.value)
+    }
+}

@@ -1,0 +1,20 @@
+//! Schema theory: percepts, perceptual and motor schemas, motor outputs, behaviors.
+//!
+//! A [`PerceptualSchema`] turns [`Inputs`] into a typed [`Percept`]; a [`MotorSchema`]
+//! turns the percept into a [`MotorOutput`]; a [`Behavior`] pairs them with an activation
+//! condition and reports [`Feedback`] and a typed [`Outcome`]. Motion vectors compose by
+//! Arkin's gain-weighted sum ([`MotionVector::weighted_sum`]).
+
+pub mod behavior;
+pub mod inputs;
+pub mod motor_output;
+pub mod percept;
+pub mod traits;
+pub mod vector;
+
+pub use behavior::{Behavior, FailureReason, Feedback, Outcome, Presence, SchemaBehavior, Status, Step};
+pub use inputs::{CameraInput, Inputs, OdometryReading, TetherReading};
+pub use motor_output::{Auxiliary, DriveCommand, Guides, MotorOutput, Posture, TetherCommand};
+pub use percept::{Percept, Stamped};
+pub use traits::{MotorSchema, PerceptualSchema};
+pub use vector::MotionVector;

@@ -1,0 +1,167 @@
+//! Motor outputs: what a motor schema proposes and the arbiter commands.
+
+use super::vector::MotionVector;
+use crate::geometry::Twist;
+use serde::{Deserialize, Serialize};
+
+/// How the base should move this tick.
+///
+/// `Turn` and `Straight` are the two halves of the restricted skid-steer command of
+/// Bujold's VGTv (turn in place OR drive straight, never both); a gradual turn alternates
+/// them. `Vector` is an Arkin-style desired velocity in the body frame, turned into a
+/// twist by a heading controller (see [`MotionVector::to_twist`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum DriveCommand {
+    /// Zero velocity.
+    #[default]
+    Stop,
+    /// Continuous body twist.
+    Twist(Twist),
+    /// Turn in place at `omega` rad/s (CCW positive).
+    Turn {
+        /// Yaw rate, rad/s.
+        omega: f64,
+    },
+    /// Drive straight at `v` m/s (negative reverses).
+    Straight {
+        /// Forward speed, m/s.
+        v: f64,
+    },
+    /// A desired body-frame velocity vector (m/s), Arkin style.
+    Vector(MotionVector),
+}
+
+impl DriveCommand {
+    /// The equivalent body twist. Vectors are converted with the default heading
+    /// controller ([`MotionVector::to_twist`] with `k_theta = 1.5`).
+    pub fn to_twist(&self) -> Twist {
+        match *self {
+            DriveCommand::Stop => Twist::ZERO,
+            DriveCommand::Twist(t) => t,
+            DriveCommand::Turn { omega } => Twist::new(0.0, omega),
+            DriveCommand::Straight { v } => Twist::new(v, 0.0),
+            DriveCommand::Vector(m) => m.to_twist(1.5),
+        }
+    }
+
+    /// True when every number in the command is finite.
+    pub fn is_finite(&self) -> bool {
+        match *self {
+            DriveCommand::Stop => true,
+            DriveCommand::Twist(t) => t.is_finite(),
+            DriveCommand::Turn { omega } => omega.is_finite(),
+            DriveCommand::Straight { v } => v.is_finite(),
+            DriveCommand::Vector(m) => m.x.is_finite() && m.y.is_finite(),
+        }
+    }
+
+    /// True when the command asks for no motion.
+    pub fn is_stop(&self) -> bool {
+        let t = self.to_twist();
+        t.v == 0.0 && t.omega == 0.0
+    }
+}
+
+/// Command for a tether reel.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TetherCommand {
+    /// Reel rate, m/s; positive reels the tether in, negative pays it out.
+    pub reel_rate: f64,
+    /// Put the wheels in free rotation so the tether can pull the rover (Axel's mating).
+    pub free_wheel: bool,
+}
+
+/// Position of docking guides (RAPOSA closes its guides at the end of state 6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Guides {
+    /// Guides open, ready to receive the target.
+    Open,
+    /// Guides closed on the target.
+    Closed,
+}
+
+/// Body posture for robots that change geometry (Bujold lowers herself to enter the pouch).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Posture {
+    /// Normal driving geometry.
+    Raised,
+    /// Lowest profile.
+    Lowered,
+}
+
+/// Auxiliary actuators; `None` means "this behavior has no opinion", so several outputs
+/// can be merged in priority order.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Auxiliary {
+    /// Tether reel command.
+    pub tether: Option<TetherCommand>,
+    /// Arm position, radians (RAPOSA's front arm; positive raises).
+    pub arm: Option<f64>,
+    /// Lights on or off.
+    pub lights: Option<bool>,
+    /// Dock guides.
+    pub guides: Option<Guides>,
+    /// Body posture.
+    pub posture: Option<Posture>,
+}
+
+impl Auxiliary {
+    /// Fills each field this one leaves open with `other`'s value (self has priority).
+    pub fn or(self, other: Auxiliary) -> Auxiliary {
+        Auxiliary {
+            tether: self.tether.or(other.tether),
+            arm: self.arm.or(other.arm),
+            lights: self.lights.or(other.lights),
+            guides: self.guides.or(other.guides),
+            posture: self.posture.or(other.posture),
+        }
+    }
+
+    /// True when every number in the command is finite.
+    pub fn is_finite(&self) -> bool {
+        self.tether.is_none_or(|t| t.reel_rate.is_finite()) && self.arm.is_none_or(f64::is_finite)
+    }
+}
+
+/// One motor schema's (or the arbiter's) output for one tick.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct MotorOutput {
+    /// Base motion.
+    pub drive: DriveCommand,
+    /// Auxiliary actuators.
+    pub aux: Auxiliary,
+}
+
+impl MotorOutput {
+    /// Stop the base; leave auxiliaries alone.
+    pub fn stop() -> Self {
+        Self::default()
+    }
+
+    /// A drive-only output.
+    pub fn drive(drive: DriveCommand) -> Self {
+        Self {
+            drive,
+            aux: Auxiliary::default(),
+        }
+    }
+
+    /// A twist-only output.
+    pub fn twist(v: f64, omega: f64) -> Self {
+        Self::drive(DriveCommand::Twist(Twist::new(v, omega)))
+    }
+
+    /// Replaces the auxiliary part.
+    pub fn with_aux(mut self, aux: Auxiliary) -> Self {
+        self.aux = aux;
+        self
+    }
+
+    /// True when every number is finite.
+    pub fn is_finite(&self) -> bool {
+        self.drive.is_finite() && self.aux.is_finite()
+    }
+}

@@ -1,0 +1,251 @@
+//! Coordination strategies: priority, vector summation and the sequencer with latching.
+
+use marsupial::arbiter::{Next, Priority, Sequencer, VectorSum};
+use marsupial::geometry::Twist;
+use marsupial::schemas::{
+    Auxiliary, Behavior, DriveCommand, FailureReason, Feedback, Inputs, MotionVector, MotorOutput, Outcome, Status,
+    Step,
+};
+
+/// A scripted behavior: active when `now` is in `[from, to)`, proposing `output`, and
+/// finishing with `outcome` after `done_after` ticks of activity.
+struct Scripted {
+    name: &'static str,
+    from: f64,
+    to: f64,
+    output: MotorOutput,
+    done_after: Option<(u32, Outcome)>,
+    ticks: u32,
+    resets: u32,
+}
+
+impl Scripted {
+    fn new(name: &'static str, from: f64, to: f64, output: MotorOutput) -> Self {
+        Self {
+            name,
+            from,
+            to,
+            output,
+            done_after: None,
+            ticks: 0,
+            resets: 0,
+        }
+    }
+    fn finishing(mut self, after: u32, outcome: Outcome) -> Self {
+        self.done_after = Some((after, outcome));
+        self
+    }
+}
+
+impl Behavior for Scripted {
+    fn name(&self) -> &str {
+        self.name
+    }
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+        if !(inputs.now >= self.from && inputs.now < self.to) {
+            return None;
+        }
+        self.ticks += 1;
+        let fb = Feedback::new("scripted", inputs.now);
+        match self.done_after {
+            Some((n, o)) if self.ticks >= n => Some(Step::done(o, self.output, fb)),
+            _ => Some(Step::running(self.output, fb)),
+        }
+    }
+    fn reset(&mut self) {
+        self.ticks = 0;
+        self.resets += 1;
+    }
+}
+
+#[test]
+fn priority_picks_first_active_and_ticks_everyone() {
+    let hi = Scripted::new("hi", 5.0, 10.0, MotorOutput::twist(0.0, 1.0));
+    let lo = Scripted::new("lo", 0.0, 100.0, MotorOutput::twist(0.1, 0.0));
+    let mut p = Priority::new("p", vec![Box::new(hi), Box::new(lo)]);
+    let s = p.tick(&Inputs::empty(1.0)).unwrap();
+    assert_eq!(s.output, MotorOutput::twist(0.1, 0.0));
+    assert_eq!(p.decision().winner, Some(1));
+    assert_eq!(p.decision().active().collect::<Vec<_>>(), vec![1]);
+    let s = p.tick(&Inputs::empty(6.0)).unwrap();
+    assert_eq!(s.output, MotorOutput::twist(0.0, 1.0));
+    assert_eq!(p.decision().winner, Some(0));
+    assert_eq!(p.decision().active().collect::<Vec<_>>(), vec![0, 1]);
+    // Both proposals are recorded even though only one won.
+    assert_eq!(p.decision().candidates[1].proposal, Some(MotorOutput::twist(0.1, 0.0)));
+    assert!(p.tick(&Inputs::empty(200.0)).is_none());
+    assert_eq!(p.decision().winner, None);
+}
+
+#[test]
+fn vector_sum_weights_and_merges() {
+    let a = Scripted::new(
+        "attract",
+        0.0,
+        10.0,
+        MotorOutput::drive(DriveCommand::Vector(MotionVector::new(1.0, 0.0))),
+    );
+    let mut b_out = MotorOutput::drive(DriveCommand::Vector(MotionVector::new(0.0, 1.0)));
+    b_out.aux = Auxiliary {
+        lights: Some(true),
+        ..Default::default()
+    };
+    let b = Scripted::new("tangent", 0.0, 5.0, b_out);
+    let c = Scripted::new("twist", 0.0, 10.0, MotorOutput::twist(0.0, 0.2));
+    let mut s = VectorSum::new(
+        "sum",
+        vec![(0.5, Box::new(a)), (0.5, Box::new(b)), (1.0, Box::new(c))],
+        10.0,
+        1.0,
+    );
+    let step = s.tick(&Inputs::empty(1.0)).unwrap();
+    let DriveCommand::Twist(t) = step.output.drive else {
+        panic!()
+    };
+    // Vector sum (0.5, 0.5): heading 45°, |V| = 0.707 → v = 0.5, ω = π/4; plus twist 0.2.
+    assert!((t.v - 0.5).abs() < 1e-12, "{t:?}");
+    assert!((t.omega - (std::f64::consts::FRAC_PI_4 + 0.2)).abs() < 1e-12, "{t:?}");
+    assert_eq!(step.output.aux.lights, Some(true));
+    let step = s.tick(&Inputs::empty(7.0)).unwrap();
+    let DriveCommand::Twist(t) = step.output.drive else {
+        panic!()
+    };
+    assert!((t.v - 0.5).abs() < 1e-12 && (t.omega - 0.2).abs() < 1e-12);
+    assert!(s.tick(&Inputs::empty(20.0)).is_none());
+}
+
+#[test]
+fn vector_sum_clips_to_max_speed() {
+    let a = Scripted::new(
+        "a",
+        0.0,
+        10.0,
+        MotorOutput::drive(DriveCommand::Vector(MotionVector::new(3.0, 0.0))),
+    );
+    let mut s = VectorSum::new("sum", vec![(1.0, Box::new(a))], 0.2, 1.0);
+    assert_eq!(
+        s.tick(&Inputs::empty(0.0)).unwrap().output.drive,
+        DriveCommand::Twist(Twist::new(0.2, 0.0))
+    );
+}
+
+#[test]
+fn sequencer_follows_transitions_and_finishes() {
+    let search = Scripted::new(
+        "search",
+        0.0,
+        1e9,
+        MotorOutput::drive(DriveCommand::Turn { omega: 0.3 }),
+    )
+    .finishing(3, Outcome::Completed);
+    let approach = Scripted::new(
+        "approach",
+        0.0,
+        1e9,
+        MotorOutput::drive(DriveCommand::Straight { v: 0.1 }),
+    )
+    .finishing(2, Outcome::Docked);
+    let mut seq = Sequencer::new("dock");
+    seq.state(Box::new(search), false);
+    seq.state(Box::new(approach), false);
+    let mut phases = Vec::new();
+    let mut t = 0.0;
+    let outcome = loop {
+        let s = seq.tick(&Inputs::empty(t)).unwrap();
+        phases.push(seq.current());
+        t += 0.1;
+        if let Status::Done(o) = s.status {
+            break o;
+        }
+        assert!(t < 10.0);
+    };
+    assert_eq!(outcome, Outcome::Docked);
+    // search runs 3 ticks (the third finishes it), approach 2 ticks.
+    assert_eq!(phases, vec![0, 0, 1, 1, 1]);
+    assert_eq!(seq.transition_count(), 1);
+}
+
+#[test]
+fn sequencer_failure_goes_to_recovery_state() {
+    let attempt = Scripted::new("attempt", 0.0, 1e9, MotorOutput::twist(0.1, 0.0))
+        .finishing(1, Outcome::Failed(FailureReason::FailedToControl));
+    let back_off = Scripted::new("back_off", 0.0, 1e9, MotorOutput::twist(-0.1, 0.0))
+        .finishing(1, Outcome::Failed(FailureReason::RetriesExhausted));
+    let mut seq = Sequencer::new("retry");
+    let a = seq.state(Box::new(attempt), false);
+    let b = seq.state(Box::new(back_off), false);
+    seq.transitions(a, Next::Goto(b + 1), Next::Goto(b));
+    let s = seq.tick(&Inputs::empty(0.0)).unwrap();
+    assert_eq!(s.status, Status::Running);
+    assert_eq!(s.output.drive, DriveCommand::Stop, "a finishing state stops the base");
+    assert_eq!(seq.current(), b);
+    let s = seq.tick(&Inputs::empty(0.1)).unwrap();
+    assert_eq!(s.status, Status::Done(Outcome::Failed(FailureReason::RetriesExhausted)));
+}
+
+#[test]
+fn latched_state_ignores_the_selector_until_done() {
+    let normal = Scripted::new("normal", 0.0, 1e9, MotorOutput::twist(0.1, 0.0));
+    let latched = Scripted::new("latched", 0.0, 1e9, MotorOutput::twist(0.0, 0.5)).finishing(4, Outcome::Completed);
+    let after = Scripted::new("after", 0.0, 1e9, MotorOutput::twist(0.2, 0.0));
+    // The selector wants "latched" at t ≥ 1 and "normal" at t ≥ 1.2.
+    let mut seq = Sequencer::new("s").with_selector(|inp: &Inputs<'_>, _cur: usize| {
+        if inp.now >= 1.2 {
+            Some(0)
+        } else if inp.now >= 1.0 {
+            Some(1)
+        } else {
+            None
+        }
+    });
+    seq.state(Box::new(normal), false);
+    let l = seq.state(Box::new(latched), true);
+    seq.state(Box::new(after), false);
+    seq.transitions(l, Next::Goto(2), Next::Finish);
+    let mut visited = Vec::new();
+    for k in 0..16 {
+        let t = 0.9 + 0.1 * k as f64;
+        seq.tick(&Inputs::empty(t)).unwrap();
+        visited.push(seq.current());
+    }
+    // 0.9: normal; 1.0..1.3: latched (4 ticks, selector ignored at 1.2 and 1.3), then the
+    // transition table moves to "after", and the selector takes over again (→ normal).
+    assert_eq!(&visited[..5], &[0, 1, 1, 1, 2]);
+    assert_eq!(visited[5], 0);
+}
+
+#[test]
+fn decisions_are_traced() {
+    use std::io::Write;
+    use std::sync::{Arc, Mutex};
+    #[derive(Clone, Default)]
+    struct Buf(Arc<Mutex<Vec<u8>>>);
+    impl Write for Buf {
+        fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+            self.0.lock().unwrap().extend_from_slice(b);
+            Ok(b.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+    let buf = Buf::default();
+    let b2 = buf.clone();
+    let subscriber = tracing_subscriber::fmt()
+        .with_max_level(tracing::Level::DEBUG)
+        .with_ansi(false)
+        .with_writer(move || b2.clone())
+        .finish();
+    tracing::subscriber::with_default(subscriber, || {
+        let hi = Scripted::new("avoid", 5.0, 10.0, MotorOutput::twist(0.0, 1.0));
+        let lo = Scripted::new("approach", 0.0, 100.0, MotorOutput::twist(0.1, 0.0));
+        let mut p = Priority::new("root", vec![Box::new(hi), Box::new(lo)]);
+        p.tick(&Inputs::empty(6.0));
+    });
+    let text = String::from_utf8(buf.0.lock().unwrap().clone()).unwrap();
+    assert!(text.contains("decision"), "{text}");
+    assert!(text.contains("arbiter=\"root\""), "{text}");
+    assert!(text.contains("active=[\"avoid\", \"approach\"]"), "{text}");
+    assert!(text.contains("winner=\"avoid\""), "{text}");
+    assert!(text.contains("approach=Twist"), "{text}");
+}

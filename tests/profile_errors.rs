@@ -1,0 +1,201 @@
+//! Every malformed profile fails with the file, field path, line and expectation, and
+//! never panics; the shipped profiles pass.
+
+use marsupial::config::ConfigError;
+use marsupial::profile::{DriveKind, Profile};
+use std::path::Path;
+use std::process::Command;
+
+/// (fixture, expected field path, expected line (None when the parser cannot give one),
+/// text the message must contain)
+const CASES: &[(&str, &str, Option<usize>, &str)] = &[
+    ("syntax_error.toml", "", Some(37), "TOML syntax error"),
+    (
+        "unknown_field.toml",
+        "drive.top_speed_mps",
+        Some(14),
+        "unknown field `top_speed_mps`",
+    ),
+    (
+        "wrong_type.toml",
+        "cameras[0].width_px",
+        Some(26),
+        "invalid type: string \"256\", expected usize",
+    ),
+    ("missing_field.toml", "", None, "missing field `success`"),
+    (
+        "negative_fov.toml",
+        "cameras[0].hfov_deg",
+        Some(28),
+        "expected a field of view in (0, 180) degrees, got -70",
+    ),
+    (
+        "dmin_gt_dmax.toml",
+        "drive.d_min_m",
+        Some(11),
+        "expected d_min_m ≤ d_max_m, got 0.4 > 0.3",
+    ),
+    (
+        "zero_resolution.toml",
+        "cameras[0].height_px",
+        Some(27),
+        "expected an integer ≥ 1, got 0",
+    ),
+    ("skid_without_bounds.toml", "drive", Some(8), "missing field `d_max_m`"),
+    (
+        "unknown_drive_kind.toml",
+        "drive.kind",
+        Some(9),
+        "unknown variant `hovercraft`",
+    ),
+    ("two_fiducials.toml", "fiducial", Some(44), "expected exactly one of"),
+    (
+        "approach_without_gains.toml",
+        "behavior.approach",
+        Some(52),
+        "needs a [behavior.ratio_steering] table",
+    ),
+    (
+        "bad_circle_rotation.toml",
+        "fiducial.circles.placements[2].rotation_deg",
+        Some(57),
+        "expected one of −45, 0, 45, 90, got 30",
+    ),
+    (
+        "stale_below_tick.toml",
+        "loop.camera_stale_s",
+        Some(68),
+        "at least one tick",
+    ),
+    (
+        "dock_narrower_than_body.toml",
+        "dock.entrance_width_m",
+        Some(38),
+        "at least as wide as the body",
+    ),
+    (
+        "pinhole_without_fov.toml",
+        "cameras[0]",
+        Some(23),
+        "needs `hfov_deg` or an `intrinsics` table",
+    ),
+    ("empty.toml", "", None, "missing field `name`"),
+];
+
+fn fixture(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/profiles")
+        .join(name)
+}
+
+#[test]
+fn shipped_profiles_are_valid() {
+    for (name, kind) in [
+        ("bujold", DriveKind::TurnOrDrive),
+        ("raposa", DriveKind::SkidSteer),
+        ("axel", DriveKind::Differential),
+        ("autokrawler", DriveKind::DoubleAckermann),
+    ] {
+        let p = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("profiles/{name}.toml")))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(p.name, name);
+        assert_eq!(p.drive.kind, kind);
+    }
+}
+
+#[test]
+fn every_malformed_profile_names_file_path_line_and_expectation() {
+    for &(file, path, line, text) in CASES {
+        let err = Profile::load(&fixture(file)).expect_err(file);
+        let ConfigError::Invalid { file: f, problems } = &err else {
+            panic!("{file}: expected Invalid, got {err:?}");
+        };
+        assert!(f.ends_with(file), "{file}: error names {}", f.display());
+        let p = problems
+            .iter()
+            .find(|p| p.message.contains(text))
+            .unwrap_or_else(|| panic!("{file}: no problem mentions {text:?}: {problems:?}"));
+        assert_eq!(p.path, path, "{file}");
+        assert_eq!(p.line, line, "{file}");
+        let shown = err.to_string();
+        assert!(shown.contains(file), "{file}: {shown}");
+        if let Some(l) = line {
+            assert!(shown.contains(&format!("{file}:{l}: ")), "{file}: {shown}");
+        }
+    }
+}
+
+#[test]
+fn unreadable_files_are_io_errors() {
+    let err = Profile::load(&fixture("binary.toml")).unwrap_err();
+    assert!(matches!(err, ConfigError::Io { .. }), "{err:?}");
+    assert!(err.to_string().contains("binary.toml"));
+    let err = Profile::load(&fixture("does-not-exist.toml")).unwrap_err();
+    assert!(err.to_string().contains("does-not-exist.toml: cannot read file"));
+}
+
+#[test]
+fn several_problems_are_reported_together() {
+    let src = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/bujold.toml")).unwrap();
+    let src = src
+        .replace("hfov_deg = 70.0", "hfov_deg = 190.0")
+        .replace("width_px = 256", "width_px = 0");
+    let err = Profile::parse(&src, Path::new("mem.toml")).unwrap_err();
+    let paths: Vec<_> = err.problems().iter().map(|p| p.path.as_str()).collect();
+    assert!(
+        paths.contains(&"cameras[0].hfov_deg") && paths.contains(&"cameras[0].width_px"),
+        "{paths:?}"
+    );
+}
+
+#[test]
+fn garbage_never_panics() {
+    // Truncations and byte flips of a real profile: every one must return, Ok or Err.
+    let src = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml")).unwrap();
+    let bytes = src.as_bytes();
+    for cut in (0..bytes.len()).step_by(37) {
+        if let Ok(s) = std::str::from_utf8(&bytes[..cut]) {
+            let _ = Profile::parse(s, Path::new("cut.toml"));
+        }
+    }
+    for i in (0..bytes.len()).step_by(11) {
+        let mut b = bytes.to_vec();
+        b[i] = b"=[]\"0.-x\n#"[i % 10];
+        if let Ok(s) = std::str::from_utf8(&b) {
+            let _ = Profile::parse(s, Path::new("flip.toml"));
+        }
+    }
+}
+
+#[test]
+fn cli_check_prints_ok_and_fails_on_bad_files() {
+    let exe = env!("CARGO_BIN_EXE_marsupial");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let profiles: Vec<_> = ["bujold", "raposa", "axel", "autokrawler"]
+        .iter()
+        .map(|n| root.join(format!("profiles/{n}.toml")))
+        .collect();
+    let out = Command::new(exe).arg("check").args(&profiles).output().unwrap();
+    assert!(out.status.success());
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(stdout.lines().filter(|l| l.starts_with("ok ")).count(), 4, "{stdout}");
+
+    let out = Command::new(exe)
+        .arg("check")
+        .arg(&profiles[0])
+        .arg(fixture("dmin_gt_dmax.toml"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("dmin_gt_dmax.toml:11: drive.d_min_m: expected d_min_m ≤ d_max_m"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"));
+
+    let out = Command::new(exe).arg("--help").output().unwrap();
+    assert!(String::from_utf8(out.stdout).unwrap().contains("check"));
+    let out = Command::new(exe).args(["check", "--help"]).output().unwrap();
+    assert!(String::from_utf8(out.stdout).unwrap().contains("FILE:LINE"));
+}
