@@ -2,7 +2,68 @@
 //!
 //! Everything here is a plain function or a struct that allocates its scratch space once
 //! and reuses it every frame; nothing reads a clock or a random source.
+//!
+//! * [`sct`] and [`hsv`]: colour spaces, exact per pixel and fast over whole frames.
+//! * [`segment`]: per-colour ranges into reusable [`Mask`]s (the SCT test is trig-free).
+//! * [`components`]: 8-connected labelling with per-component moments.
+//! * [`colour_model`]: imprinting, adaptation and the fallback chain of seed 004 Fig. 5.
+//! * [`two_block`]: Bujold's two-block fiducial detector and its perceptual schema.
 
+pub mod colour_model;
+pub mod components;
+pub mod fastmath;
+pub mod hsv;
 pub mod image;
+pub mod sct;
+pub mod segment;
+pub mod two_block;
 
+pub use colour_model::{AngleStats, ColorMode, ColorModel, ColorModelParams, Imprinter, StatsAccumulator};
+pub use components::{Component, Labeler, Run};
+pub use hsv::{Hsv, HsvPlanes, hsv_from_rgb};
 pub use image::{ImageError, RgbImage, RgbView};
+pub use sct::{Sct, SctPlanes, sct_from_rgb};
+pub use segment::{ColorRange, HsvRange, Mask, SctRange, Segmenter};
+pub use two_block::{Block, Pair, PairLimits, TwoBlockDetector, TwoBlockPercept, TwoBlockSchema};
+
+use thiserror::Error;
+
+/// Errors of the vision functions: inconsistent sizes, never pixel content.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum VisionError {
+    /// An output or scratch buffer does not match the input's size.
+    #[error("size mismatch: expected {expected:?}, got {got:?}")]
+    SizeMismatch {
+        /// Expected (width, height).
+        expected: (usize, usize),
+        /// Found (width, height).
+        got: (usize, usize),
+    },
+    /// Two lists that must pair up differ in length.
+    #[error("{what}: expected {expected}, got {got}")]
+    CountMismatch {
+        /// What was counted.
+        what: &'static str,
+        /// Expected count.
+        expected: usize,
+        /// Found count.
+        got: usize,
+    },
+    /// The frame has no pixels.
+    #[error("empty image")]
+    EmptyImage,
+    /// The profile lacks what a schema needs.
+    #[error("{what}")]
+    Profile {
+        /// What is missing.
+        what: String,
+    },
+}
+
+pub(crate) fn check_same_size(expected: (usize, usize), got: (usize, usize)) -> Result<(), VisionError> {
+    if expected == got {
+        Ok(())
+    } else {
+        Err(VisionError::SizeMismatch { expected, got })
+    }
+}

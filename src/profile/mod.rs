@@ -15,6 +15,7 @@ pub mod camera;
 pub mod drive;
 pub mod fiducial;
 pub mod geometry;
+pub mod perception;
 
 pub use behavior::{
     ApproachKind, BehaviorSpec, Coordination, LoopSpec, PotentialFieldGains, RatioSteeringGains, SevenStateGains,
@@ -24,6 +25,7 @@ pub use camera::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount};
 pub use drive::{DriveKind, DriveSpec};
 pub use fiducial::{CirclePlacement, CirclesSpec, FiducialSpec, MarkersSpec, NamedColor, PyramidSpec, TwoBlockSpec};
 pub use geometry::{BodySpec, DockSpec, SuccessSpec, TetherSpec};
+pub use perception::{ImprintSpec, PerceptionSpec, SegmentationMode};
 
 use crate::arbiter::{LoopConfig, Staleness};
 use crate::config::{self, ConfigError, Validate, Validator};
@@ -50,6 +52,10 @@ pub struct Profile {
     pub dock: Option<DockSpec>,
     /// Visual target.
     pub fiducial: FiducialSpec,
+    /// Colour perception settings (defaults: the paper's values, see
+    /// [`PerceptionSpec::default`]).
+    #[serde(default)]
+    pub perception: PerceptionSpec,
     /// Tether (absent for untethered robots).
     #[serde(default)]
     pub tether: Option<TetherSpec>,
@@ -81,6 +87,7 @@ impl Validate for Profile {
             v.problem("behavior.approach", "a docking approach needs a [dock] table");
         }
         fiducial::validate_fiducial(&self.fiducial, v);
+        perception::validate_perception(&self.perception, v);
         if let Some(t) = &self.tether {
             geometry::validate_tether(t, v);
         }

@@ -1,0 +1,506 @@
+//! Imprinting, adaptation and the parameter fallback chain (seed 004 §IV.C, Fig. 5).
+//!
+//! Colour statistics are the mean and standard deviation of the SCT angles A and B per
+//! colour. A colour's segmentation range is mean ± n·SD on each angle (n = 4: Chebyshev
+//! guarantees ≥ 93.75 % of any distribution per angle; with two angles the union bound
+//! guarantees 87.5 %). Three sets of statistics exist:
+//!
+//! * **table**: defaults from the fiducial's nominal paint colours;
+//! * **imprinted**: measured from a few well-aligned frames as the daughter leaves the dock;
+//! * **adapted**: measured every frame the fiducial is found, from the pixels segmented for
+//!   each block.
+//!
+//! While the fiducial is found, the adapted statistics drive the next frame. If it is not
+//! found for `timeout1` seconds, the model assumes adaptation drifted and reverts to the
+//! imprinted set; after `timeout2` seconds without a detection it assumes the imprint is
+//! bad too and reverts to the table. Every switch is logged (`tracing`, target
+//! `marsupial::perception`). In **static** mode (the paper's comparison) the imprinted
+//! statistics are used unchanged: no adaptation and no fallback.
+//!
+//! SDs are clamped to [floor, ceiling] so a flat-coloured patch cannot collapse its range
+//! to nothing and a noisy one cannot swallow the colour space (ALGORITHMS §2 pitfalls).
+
+use super::image::RgbView;
+use super::sct::Sct;
+use super::segment::SctRange;
+use serde::Serialize;
+use std::fmt;
+
+/// Mean and standard deviation of the SCT angles of one colour, radians.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AngleStats {
+    /// Mean of A.
+    pub mean_a: f64,
+    /// SD of A.
+    pub sd_a: f64,
+    /// Mean of B.
+    pub mean_b: f64,
+    /// SD of B.
+    pub sd_b: f64,
+    /// Pixels the statistics came from (0 for table defaults).
+    pub n: u64,
+}
+
+impl AngleStats {
+    /// Nominal statistics of a paint colour: its exact SCT angles with SD `sd` (rad).
+    pub fn nominal(rgb: [u8; 3], sd: f64) -> Self {
+        let s = Sct::from_rgb(rgb);
+        Self {
+            mean_a: s.a,
+            sd_a: sd,
+            mean_b: s.b,
+            sd_b: sd,
+            n: 0,
+        }
+    }
+
+    /// The segmentation range mean ± n·SD, with each SD clamped to [floor, ceiling].
+    pub fn range(&self, n_sd: f64, sd_floor: f64, sd_ceiling: f64, min_l: f64) -> SctRange {
+        let sa = self.sd_a.clamp(sd_floor, sd_ceiling) * n_sd;
+        let sb = self.sd_b.clamp(sd_floor, sd_ceiling) * n_sd;
+        SctRange {
+            a: [self.mean_a - sa, self.mean_a + sa],
+            b: [self.mean_b - sb, self.mean_b + sb],
+            min_l,
+        }
+    }
+
+    /// Blends toward `new` with rate `beta` in (0, 1] (1 replaces).
+    pub fn blend(&self, new: &AngleStats, beta: f64) -> AngleStats {
+        let mix = |a: f64, b: f64| a + beta * (b - a);
+        AngleStats {
+            mean_a: mix(self.mean_a, new.mean_a),
+            sd_a: mix(self.sd_a, new.sd_a),
+            mean_b: mix(self.mean_b, new.mean_b),
+            sd_b: mix(self.sd_b, new.sd_b),
+            n: new.n,
+        }
+    }
+}
+
+/// Streaming mean/variance of (A, B) pairs (Welford, in `f64`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StatsAccumulator {
+    n: u64,
+    mean_a: f64,
+    m2_a: f64,
+    mean_b: f64,
+    m2_b: f64,
+}
+
+impl StatsAccumulator {
+    /// Adds one sample (radians).
+    #[inline]
+    pub fn push(&mut self, a: f64, b: f64) {
+        self.n += 1;
+        let n = self.n as f64;
+        let da = a - self.mean_a;
+        self.mean_a += da / n;
+        self.m2_a += da * (a - self.mean_a);
+        let db = b - self.mean_b;
+        self.mean_b += db / n;
+        self.m2_b += db * (b - self.mean_b);
+    }
+
+    /// Samples so far.
+    pub fn count(&self) -> u64 {
+        self.n
+    }
+
+    /// The statistics (population SD), or `None` with fewer than 2 samples.
+    pub fn finish(&self) -> Option<AngleStats> {
+        (self.n >= 2).then(|| AngleStats {
+            mean_a: self.mean_a,
+            sd_a: (self.m2_a / self.n as f64).sqrt(),
+            mean_b: self.mean_b,
+            sd_b: (self.m2_b / self.n as f64).sqrt(),
+            n: self.n,
+        })
+    }
+}
+
+/// Which statistics drive segmentation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ColorMode {
+    /// Adapted from the last frames where the fiducial was found.
+    Adapted,
+    /// Imprinted on departure.
+    Imprinted,
+    /// Table defaults.
+    Table,
+}
+
+impl fmt::Display for ColorMode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            ColorMode::Adapted => "adapted",
+            ColorMode::Imprinted => "imprinted",
+            ColorMode::Table => "table",
+        })
+    }
+}
+
+/// Tuning of a [`ColorModel`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ColorModelParams {
+    /// Range half-width in SDs (paper: 4).
+    pub n_sd: f64,
+    /// Smallest SD used, rad.
+    pub sd_floor: f64,
+    /// Largest SD used, rad.
+    pub sd_ceiling: f64,
+    /// Brightness gate, L units (0–441.7).
+    pub min_l: f64,
+    /// Seconds without detection before adapted → imprinted.
+    pub timeout1: f64,
+    /// Seconds without detection before imprinted → table.
+    pub timeout2: f64,
+    /// Adapt (true) or keep the imprint static (false).
+    pub adaptive: bool,
+    /// Blend rate of adaptation in (0, 1]; 1 is the paper's (replace each frame).
+    pub adapt_rate: f64,
+}
+
+/// The per-colour statistics with the fallback chain. Two colours: index 0 is the block
+/// on the image's left, 1 the block on its right.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ColorModel {
+    params: ColorModelParams,
+    table: [AngleStats; 2],
+    imprinted: Option<[AngleStats; 2]>,
+    adapted: Option<[AngleStats; 2]>,
+    mode: ColorMode,
+    reference_time: Option<f64>,
+    switches: u32,
+}
+
+impl ColorModel {
+    /// Starts on the table defaults.
+    pub fn new(table: [AngleStats; 2], params: ColorModelParams) -> Self {
+        Self {
+            params,
+            table,
+            imprinted: None,
+            adapted: None,
+            mode: ColorMode::Table,
+            reference_time: None,
+            switches: 0,
+        }
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &ColorModelParams {
+        &self.params
+    }
+
+    /// Current mode.
+    pub fn mode(&self) -> ColorMode {
+        self.mode
+    }
+
+    /// Number of mode switches so far.
+    pub fn switches(&self) -> u32 {
+        self.switches
+    }
+
+    /// Imprinted statistics, if any.
+    pub fn imprinted(&self) -> Option<&[AngleStats; 2]> {
+        self.imprinted.as_ref()
+    }
+
+    /// Statistics in use.
+    pub fn current(&self) -> &[AngleStats; 2] {
+        match self.mode {
+            ColorMode::Adapted => self.adapted.as_ref().unwrap_or(&self.table),
+            ColorMode::Imprinted => self.imprinted.as_ref().unwrap_or(&self.table),
+            ColorMode::Table => &self.table,
+        }
+    }
+
+    /// Segmentation ranges for the next frame.
+    pub fn ranges(&self) -> [SctRange; 2] {
+        let p = &self.params;
+        self.current()
+            .map(|s| s.range(p.n_sd, p.sd_floor, p.sd_ceiling, p.min_l))
+    }
+
+    /// Installs imprinted statistics at time `now` and switches to them.
+    pub fn imprint(&mut self, stats: [AngleStats; 2], now: f64) {
+        self.imprinted = Some(stats);
+        self.adapted = None;
+        self.reference_time = Some(now);
+        self.switch(ColorMode::Imprinted, now, "imprinted");
+    }
+
+    /// Switches to adaptive or static segmentation.
+    pub fn set_adaptive(&mut self, adaptive: bool) {
+        self.params.adaptive = adaptive;
+    }
+
+    fn switch(&mut self, to: ColorMode, now: f64, why: &'static str) {
+        if to != self.mode {
+            tracing::info!(target: "marsupial::perception", from = %self.mode, to = %to, now, why, "colour statistics switched");
+            self.mode = to;
+            self.switches += 1;
+        }
+    }
+
+    /// Feeds one frame's result: `measured` holds the statistics of the accepted blocks'
+    /// pixels when the fiducial was found, `None` otherwise.
+    pub fn update(&mut self, now: f64, measured: Option<[AngleStats; 2]>) {
+        let reference = *self.reference_time.get_or_insert(now);
+        if let Some(m) = measured {
+            self.reference_time = Some(now);
+            if self.params.adaptive {
+                let beta = self.params.adapt_rate;
+                let base = *self.current();
+                self.adapted = Some([base[0].blend(&m[0], beta), base[1].blend(&m[1], beta)]);
+                self.switch(ColorMode::Adapted, now, "fiducial found");
+            }
+            return;
+        }
+        if !self.params.adaptive {
+            return;
+        }
+        let waited = now - reference;
+        if self.mode == ColorMode::Adapted && waited > self.params.timeout1 {
+            let to = if self.imprinted.is_some() {
+                ColorMode::Imprinted
+            } else {
+                ColorMode::Table
+            };
+            self.switch(to, now, "timeout 1: adaptation assumed at fault");
+        }
+        if self.mode == ColorMode::Imprinted && waited > self.params.timeout2 {
+            self.switch(ColorMode::Table, now, "timeout 2: imprint assumed at fault");
+        }
+    }
+}
+
+/// Collects imprint statistics from well-aligned frames: a block in the middle of each
+/// rectangle where the profile says the two coloured blocks appear.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Imprinter {
+    rects: [[f64; 4]; 2],
+    sample_frac: f64,
+    min_l: f64,
+    acc: [StatsAccumulator; 2],
+    frames: u32,
+}
+
+impl Imprinter {
+    /// `rects` are (x0, y0, x1, y1) as fractions of the image size for the left and right
+    /// block; the middle `sample_frac` of each (by side length) is sampled.
+    pub fn new(rects: [[f64; 4]; 2], sample_frac: f64, min_l: f64) -> Self {
+        Self {
+            rects,
+            sample_frac,
+            min_l,
+            acc: [StatsAccumulator::default(); 2],
+            frames: 0,
+        }
+    }
+
+    /// Pixel rectangle (x0, y0, x1, y1), end exclusive, sampled for block `i` in a
+    /// `w × h` image.
+    pub fn sample_rect(&self, i: usize, w: usize, h: usize) -> [usize; 4] {
+        let [x0, y0, x1, y1] = self.rects[i.min(1)];
+        let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+        let (hw, hh) = (
+            (x1 - x0).abs() * self.sample_frac / 2.0,
+            (y1 - y0).abs() * self.sample_frac / 2.0,
+        );
+        let px = |f: f64, n: usize| ((f * n as f64).round().max(0.0) as usize).min(n);
+        let (a, c) = (px(cx - hw, w), px(cx + hw, w));
+        let (b, d) = (px(cy - hh, h), px(cy + hh, h));
+        [a, b, c.max(a + 1).min(w), d.max(b + 1).min(h)]
+    }
+
+    /// Samples one frame.
+    pub fn add_frame(&mut self, view: &RgbView<'_>) {
+        let (w, h) = (view.width(), view.height());
+        if w == 0 || h == 0 {
+            return;
+        }
+        for i in 0..2 {
+            let [x0, y0, x1, y1] = self.sample_rect(i, w, h);
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    if let Some(px) = view.get(x, y) {
+                        let s = Sct::from_rgb(px);
+                        if s.l >= self.min_l {
+                            self.acc[i].push(s.a, s.b);
+                        }
+                    }
+                }
+            }
+        }
+        self.frames += 1;
+    }
+
+    /// The fractional rectangle of block `i` (0 left, 1 right).
+    pub fn rect(&self, i: usize) -> [f64; 4] {
+        self.rects[i.min(1)]
+    }
+
+    /// The sampled fraction of each rectangle.
+    pub fn sample_frac(&self) -> f64 {
+        self.sample_frac
+    }
+
+    /// Forgets everything sampled.
+    pub fn clear(&mut self) {
+        self.acc = [StatsAccumulator::default(); 2];
+        self.frames = 0;
+    }
+
+    /// Frames sampled so far.
+    pub fn frames(&self) -> u32 {
+        self.frames
+    }
+
+    /// The imprinted statistics, when both blocks gave at least 10 bright pixels.
+    pub fn finish(&self) -> Option<[AngleStats; 2]> {
+        if self.acc.iter().any(|a| a.count() < 10) {
+            return None;
+        }
+        Some([self.acc[0].finish()?, self.acc[1].finish()?])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn params(adaptive: bool) -> ColorModelParams {
+        ColorModelParams {
+            n_sd: 4.0,
+            sd_floor: 0.01,
+            sd_ceiling: 0.2,
+            min_l: 20.0,
+            timeout1: 2.0,
+            timeout2: 5.0,
+            adaptive,
+            adapt_rate: 1.0,
+        }
+    }
+
+    fn table() -> [AngleStats; 2] {
+        [
+            AngleStats::nominal([0, 255, 255], 0.1),
+            AngleStats::nominal([255, 0, 255], 0.1),
+        ]
+    }
+
+    fn stats(a: f64) -> AngleStats {
+        AngleStats {
+            mean_a: a,
+            sd_a: 0.02,
+            mean_b: 0.5,
+            sd_b: 0.02,
+            n: 100,
+        }
+    }
+
+    #[test]
+    fn welford_matches_two_pass() {
+        let xs = [0.1, 0.4, 0.35, 0.2, 0.9, 0.05];
+        let mut acc = StatsAccumulator::default();
+        for (i, x) in xs.iter().enumerate() {
+            acc.push(*x, i as f64);
+        }
+        let s = acc.finish().unwrap();
+        let m = xs.iter().sum::<f64>() / 6.0;
+        let sd = (xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / 6.0).sqrt();
+        assert!((s.mean_a - m).abs() < 1e-12 && (s.sd_a - sd).abs() < 1e-12);
+        assert!((s.mean_b - 2.5).abs() < 1e-12);
+        assert!(StatsAccumulator::default().finish().is_none());
+    }
+
+    #[test]
+    fn range_clamps_sd() {
+        let r = AngleStats {
+            mean_a: 1.0,
+            sd_a: 0.0,
+            mean_b: 0.5,
+            sd_b: 5.0,
+            n: 3,
+        }
+        .range(4.0, 0.01, 0.1, 30.0);
+        assert!((r.a[0] - 0.96).abs() < 1e-12 && (r.a[1] - 1.04).abs() < 1e-12);
+        assert!((r.b[0] - 0.1).abs() < 1e-12 && (r.b[1] - 0.9).abs() < 1e-12);
+        assert_eq!(r.min_l, 30.0);
+    }
+
+    #[test]
+    fn fallback_chain_timing() {
+        let mut m = ColorModel::new(table(), params(true));
+        assert_eq!(m.mode(), ColorMode::Table);
+        m.imprint([stats(0.7), stats(0.8)], 0.0);
+        assert_eq!(m.mode(), ColorMode::Imprinted);
+        m.update(1.0, Some([stats(0.71), stats(0.79)]));
+        assert_eq!(m.mode(), ColorMode::Adapted);
+        assert!((m.current()[0].mean_a - 0.71).abs() < 1e-12);
+        // Lost at t = 1: still adapted up to t = 3 (timeout 1 = 2 s) …
+        m.update(2.9, None);
+        assert_eq!(m.mode(), ColorMode::Adapted);
+        m.update(3.1, None);
+        assert_eq!(m.mode(), ColorMode::Imprinted);
+        assert!((m.current()[0].mean_a - 0.7).abs() < 1e-12);
+        // … imprinted up to t = 6 (timeout 2 = 5 s after the last detection) …
+        m.update(5.9, None);
+        assert_eq!(m.mode(), ColorMode::Imprinted);
+        m.update(6.1, None);
+        assert_eq!(m.mode(), ColorMode::Table);
+        // … and a new detection adapts again from the table's segmentation.
+        m.update(7.0, Some([stats(0.75), stats(0.85)]));
+        assert_eq!(m.mode(), ColorMode::Adapted);
+        assert_eq!(m.switches(), 5);
+    }
+
+    #[test]
+    fn without_imprint_adapted_falls_back_to_table() {
+        let mut m = ColorModel::new(table(), params(true));
+        m.update(0.0, Some([stats(0.7), stats(0.8)]));
+        assert_eq!(m.mode(), ColorMode::Adapted);
+        m.update(2.5, None);
+        assert_eq!(m.mode(), ColorMode::Table);
+    }
+
+    #[test]
+    fn static_mode_never_adapts_or_falls_back() {
+        let mut m = ColorModel::new(table(), params(false));
+        m.imprint([stats(0.7), stats(0.8)], 0.0);
+        m.update(1.0, Some([stats(0.2), stats(0.3)]));
+        assert_eq!(m.mode(), ColorMode::Imprinted);
+        assert!((m.current()[0].mean_a - 0.7).abs() < 1e-12);
+        m.update(100.0, None);
+        assert_eq!(m.mode(), ColorMode::Imprinted);
+    }
+
+    #[test]
+    fn imprinter_samples_the_middle_of_each_block() {
+        let mut im = crate::perception::RgbImage::new(40, 20);
+        im.fill([20, 20, 20]);
+        for y in 5..15 {
+            for x in 8..20 {
+                im.put(x, y, [0, 200, 220]);
+            }
+            for x in 20..32 {
+                im.put(x, y, [210, 10, 200]);
+            }
+        }
+        // Rectangles a bit larger than the blocks: sampling their middle half stays inside.
+        let mut imp = Imprinter::new([[0.15, 0.2, 0.5, 0.8], [0.5, 0.2, 0.85, 0.8]], 0.5, 20.0);
+        assert!(imp.finish().is_none());
+        imp.add_frame(&im.view());
+        imp.add_frame(&im.view());
+        let s = imp.finish().unwrap();
+        let cyan = Sct::from_rgb([0, 200, 220]);
+        let magenta = Sct::from_rgb([210, 10, 200]);
+        assert!((s[0].mean_a - cyan.a).abs() < 1e-9 && (s[0].mean_b - cyan.b).abs() < 1e-9 && s[0].sd_a < 1e-9);
+        assert!((s[1].mean_a - magenta.a).abs() < 1e-9 && (s[1].mean_b - magenta.b).abs() < 1e-9);
+        assert_eq!(imp.frames(), 2);
+    }
+}

@@ -1,0 +1,447 @@
+//! Bujold's two-block fiducial (seed 004 §IV.B): detector and perceptual schema.
+//!
+//! Per frame: segment both colours (SCT ranges from the [`ColorModel`]), label each mask,
+//! drop components under `min_component_px`, and test every (left-colour, right-colour)
+//! pair:
+//!
+//! * **order**: the left-colour block lies left of the right-colour block *in the image*.
+//!   "Left colour" means the colour that appears on the image's left for this camera
+//!   mounting (a 180°-rolled camera swaps the fiducial's sides), so a copy of the fiducial
+//!   turned upside down presents its colours in the wrong order and is rejected;
+//! * **gap**: the right block's leftmost pixel minus the left block's rightmost pixel is
+//!   within `gap_slack_px + max_gap_frac · h` of adjacency (h the blocks' mean height;
+//!   proportional so that roll, which tilts the shared edge, is tolerated at any range);
+//! * **alignment**: centroids within `max_vertical_frac · h` vertically.
+//!
+//! Among the surviving pairs the one whose pixel-count ratio is closest to 1 wins; ties go
+//! to the larger total, then to the lower component indices, so the choice is
+//! deterministic.
+
+use super::colour_model::{AngleStats, ColorMode, ColorModel, ColorModelParams, Imprinter, StatsAccumulator};
+use super::components::Labeler;
+use super::image::RgbView;
+use super::sct::Sct;
+use super::segment::{ColorRange, Mask, SctRange, Segmenter};
+use super::{VisionError, check_same_size};
+use crate::profile::{PerceptionSpec, Profile, SegmentationMode};
+use crate::schemas::{Inputs, Percept, PerceptualSchema};
+use serde::Serialize;
+
+/// Pairing limits (from the profile's `[perception]`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairLimits {
+    /// Smallest component considered, px.
+    pub min_component_px: u64,
+    /// Gap tolerance as a fraction of the mean block height.
+    pub max_gap_frac: f64,
+    /// Gap tolerance in pixels.
+    pub gap_slack_px: f64,
+    /// Vertical centroid tolerance as a fraction of the mean block height.
+    pub max_vertical_frac: f64,
+    /// Largest number of components per colour paired.
+    pub max_candidates: usize,
+}
+
+impl From<&PerceptionSpec> for PairLimits {
+    fn from(p: &PerceptionSpec) -> Self {
+        Self {
+            min_component_px: p.min_component_px as u64,
+            max_gap_frac: p.max_gap_frac,
+            gap_slack_px: p.gap_slack_px,
+            max_vertical_frac: p.max_vertical_frac,
+            max_candidates: p.max_candidates as usize,
+        }
+    }
+}
+
+/// One accepted block.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Block {
+    /// Component index in its colour's labelling.
+    pub component: u32,
+    /// Pixel count.
+    pub count: u64,
+    /// Centroid (x, y), px.
+    pub centroid: [f64; 2],
+    /// Bounding box (x_min, y_min, x_max, y_max), inclusive, px.
+    pub bbox: [u32; 4],
+}
+
+/// The accepted pair.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Pair {
+    /// Block on the image's left.
+    pub left: Block,
+    /// Block on the image's right.
+    pub right: Block,
+    /// min(count)/max(count), in (0, 1].
+    pub ratio: f64,
+}
+
+/// Segments, labels and pairs; owns all scratch buffers.
+#[derive(Debug, Clone)]
+pub struct TwoBlockDetector {
+    width: usize,
+    height: usize,
+    limits: PairLimits,
+    segmenter: Segmenter,
+    masks: [Mask; 2],
+    labelers: [Labeler; 2],
+    candidates: [Vec<u32>; 2],
+}
+
+impl TwoBlockDetector {
+    /// A detector for `width × height` frames; every buffer is allocated here.
+    pub fn new(width: usize, height: usize, limits: PairLimits) -> Self {
+        let max_cand = width * height / (limits.min_component_px.max(1) as usize) + 1;
+        Self {
+            width,
+            height,
+            limits,
+            segmenter: Segmenter::new(width),
+            masks: [Mask::new(width, height), Mask::new(width, height)],
+            labelers: [Labeler::new(width, height), Labeler::new(width, height)],
+            candidates: [Vec::with_capacity(max_cand), Vec::with_capacity(max_cand)],
+        }
+    }
+
+    /// (width, height) the detector is sized for.
+    pub fn size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// Re-sizes for another frame size (allocates; not for the per-frame path).
+    pub fn resize(&mut self, width: usize, height: usize) {
+        if (width, height) != (self.width, self.height) {
+            *self = Self::new(width, height, self.limits);
+        }
+    }
+
+    /// The pairing limits.
+    pub fn limits(&self) -> &PairLimits {
+        &self.limits
+    }
+
+    /// The masks of the last frame (left colour, right colour).
+    pub fn masks(&self) -> &[Mask; 2] {
+        &self.masks
+    }
+
+    /// The labeller of colour `i` (0 left, 1 right) after the last frame.
+    pub fn labeler(&self, i: usize) -> &Labeler {
+        &self.labelers[i.min(1)]
+    }
+
+    /// Finds the fiducial in `view` with `ranges` (left colour, right colour).
+    ///
+    /// # Errors
+    /// [`VisionError::EmptyImage`] for a frame with no pixel; [`VisionError::SizeMismatch`]
+    /// when the frame is not the detector's size.
+    pub fn detect(&mut self, view: &RgbView<'_>, ranges: &[SctRange; 2]) -> Result<Option<Pair>, VisionError> {
+        if view.is_empty() {
+            return Err(VisionError::EmptyImage);
+        }
+        check_same_size((self.width, self.height), (view.width(), view.height()))?;
+        let cr = [ColorRange::Sct(ranges[0]), ColorRange::Sct(ranges[1])];
+        self.segmenter.segment(view, &cr, &mut self.masks)?;
+        for c in 0..2 {
+            let comps = self.labelers[c].label(&self.masks[c])?;
+            let cand = &mut self.candidates[c];
+            cand.clear();
+            cand.extend(
+                comps
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, k)| k.count >= self.limits.min_component_px)
+                    .map(|(i, _)| i as u32),
+            );
+            if cand.len() > self.limits.max_candidates {
+                cand.sort_unstable_by(|&a, &b| comps[b as usize].count.cmp(&comps[a as usize].count).then(a.cmp(&b)));
+                cand.truncate(self.limits.max_candidates);
+                cand.sort_unstable();
+            }
+        }
+        let (lc, rc) = (self.labelers[0].components(), self.labelers[1].components());
+        let lim = self.limits;
+        let mut best: Option<(f64, u64, Pair)> = None;
+        for &li in &self.candidates[0] {
+            let l = &lc[li as usize];
+            let (lx, ly) = l.centroid();
+            for &ri in &self.candidates[1] {
+                let r = &rc[ri as usize];
+                let (rx, ry) = r.centroid();
+                if lx >= rx {
+                    continue;
+                }
+                let h = (l.height() + r.height()) as f64 / 2.0;
+                let gap = r.bbox[0] as f64 - l.bbox[2] as f64;
+                if (gap - 1.0).abs() > lim.gap_slack_px + lim.max_gap_frac * h {
+                    continue;
+                }
+                if (ly - ry).abs() > lim.max_vertical_frac * h {
+                    continue;
+                }
+                let ratio = l.count.min(r.count) as f64 / l.count.max(r.count) as f64;
+                let total = l.count + r.count;
+                let better = match &best {
+                    None => true,
+                    Some((br, bt, _)) => (1.0 - ratio) < (1.0 - br) || ((1.0 - ratio) == (1.0 - br) && total > *bt),
+                };
+                if better {
+                    let block = |i: u32, k: &super::components::Component, (x, y): (f64, f64)| Block {
+                        component: i,
+                        count: k.count,
+                        centroid: [x, y],
+                        bbox: k.bbox,
+                    };
+                    best = Some((
+                        ratio,
+                        total,
+                        Pair {
+                            left: block(li, l, (lx, ly)),
+                            right: block(ri, r, (rx, ry)),
+                            ratio,
+                        },
+                    ));
+                }
+            }
+        }
+        Ok(best.map(|(_, _, p)| p))
+    }
+
+    /// SCT statistics of the pixels of each accepted block (fast SCT path), for
+    /// adaptation. `view` must be the frame `pair` was detected in.
+    pub fn measure(&self, view: &RgbView<'_>, pair: &Pair) -> Option<[AngleStats; 2]> {
+        let mut acc = [StatsAccumulator::default(); 2];
+        let bytes = view.as_bytes();
+        let w = view.width();
+        for (c, block) in [pair.left, pair.right].iter().enumerate() {
+            for run in self.labelers[c].runs().iter().filter(|r| r.label == block.component) {
+                let row = run.y as usize * w;
+                for x in run.x0 as usize..run.x1 as usize {
+                    let i = (row + x) * 3;
+                    let Some(px) = bytes.get(i..i + 3) else { continue };
+                    let (_, a, b) = Sct::from_rgb_fast([px[0], px[1], px[2]]);
+                    acc[c].push(a as f64, b as f64);
+                }
+            }
+        }
+        Some([acc[0].finish()?, acc[1].finish()?])
+    }
+}
+
+/// What the two-block perceptual schema reports each frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TwoBlockPercept {
+    /// Capture time of the frame, s.
+    pub stamp: f64,
+    /// A valid pair was found.
+    pub found: bool,
+    /// Pixels of the image-left block.
+    pub left_px: u64,
+    /// Pixels of the image-right block.
+    pub right_px: u64,
+    /// left_px + right_px.
+    pub total_px: u64,
+    /// min/max of the two counts in [0, 1] (0 when not found).
+    pub ratio: f64,
+    /// Centroid of the image-left block (x, y), px.
+    pub left_centroid: [f64; 2],
+    /// Centroid of the image-right block (x, y), px.
+    pub right_centroid: [f64; 2],
+    /// Horizontal offset of the pair's midpoint from the image centre, px (positive:
+    /// right of centre in the image as delivered, i.e. after any 180° flip).
+    pub offset_px: f64,
+    /// Statistics that segmented this frame.
+    pub mode: ColorMode,
+    /// Frame size (width, height).
+    pub image_size: (usize, usize),
+}
+
+impl TwoBlockPercept {
+    /// A "not found" percept.
+    pub fn not_found(stamp: f64, mode: ColorMode, image_size: (usize, usize)) -> Self {
+        Self {
+            stamp,
+            found: false,
+            left_px: 0,
+            right_px: 0,
+            total_px: 0,
+            ratio: 0.0,
+            left_centroid: [0.0; 2],
+            right_centroid: [0.0; 2],
+            offset_px: 0.0,
+            mode,
+            image_size,
+        }
+    }
+}
+
+impl Percept for TwoBlockPercept {
+    fn stamp(&self) -> f64 {
+        self.stamp
+    }
+    fn found(&self) -> bool {
+        self.found
+    }
+}
+
+/// The close-dock perceptual schema: detector + colour model (+ imprinting).
+#[derive(Debug, Clone)]
+pub struct TwoBlockSchema {
+    camera: usize,
+    detector: TwoBlockDetector,
+    model: ColorModel,
+    imprinter: Imprinter,
+    imprint_frames: u32,
+    last_pair: Option<Pair>,
+}
+
+impl TwoBlockSchema {
+    /// Builds the schema for camera `camera` of `profile`, which needs a
+    /// `[fiducial.two_block]`. Table defaults come from the fiducial's paint colours, in
+    /// the order they appear in this camera's image.
+    ///
+    /// # Errors
+    /// [`VisionError::Profile`] when the profile has no two-block fiducial or no such camera.
+    pub fn from_profile(profile: &Profile, camera: usize) -> Result<Self, VisionError> {
+        let fid = profile.fiducial.two_block.ok_or_else(|| VisionError::Profile {
+            what: format!("profile `{}` has no [fiducial.two_block]", profile.name),
+        })?;
+        let cam = profile.cameras.get(camera).ok_or_else(|| VisionError::Profile {
+            what: format!("profile `{}` has no camera {camera}", profile.name),
+        })?;
+        let p = &profile.perception;
+        let (img_left, img_right) = if cam.mount.is_flipped() {
+            (fid.right_color, fid.left_color)
+        } else {
+            (fid.left_color, fid.right_color)
+        };
+        let table_sd = p.table_sd_deg.to_radians();
+        let table = [
+            AngleStats::nominal(img_left.rgb(), table_sd),
+            AngleStats::nominal(img_right.rgb(), table_sd),
+        ];
+        let params = ColorModelParams {
+            n_sd: p.n_sd,
+            sd_floor: p.sd_floor_deg.to_radians(),
+            sd_ceiling: p.sd_ceiling_deg.to_radians(),
+            min_l: p.min_brightness,
+            timeout1: p.timeout1_s,
+            timeout2: p.timeout2_s,
+            adaptive: p.mode == SegmentationMode::Adaptive,
+            adapt_rate: p.adapt_rate,
+        };
+        Ok(Self {
+            camera,
+            detector: TwoBlockDetector::new(cam.width_px, cam.height_px, PairLimits::from(p)),
+            model: ColorModel::new(table, params),
+            imprinter: Imprinter::new(
+                [p.imprint.left_rect, p.imprint.right_rect],
+                p.imprint.sample_frac,
+                p.min_brightness,
+            ),
+            imprint_frames: p.imprint.frames,
+            last_pair: None,
+        })
+    }
+
+    /// The colour model.
+    pub fn model(&self) -> &ColorModel {
+        &self.model
+    }
+
+    /// The colour model, mutable (e.g. to switch static/adaptive).
+    pub fn model_mut(&mut self) -> &mut ColorModel {
+        &mut self.model
+    }
+
+    /// The detector (masks and components of the last frame).
+    pub fn detector(&self) -> &TwoBlockDetector {
+        &self.detector
+    }
+
+    /// The detector, mutable (e.g. to resize for a differently sized image file).
+    pub fn detector_mut(&mut self) -> &mut TwoBlockDetector {
+        &mut self.detector
+    }
+
+    /// The pair accepted in the last frame.
+    pub fn last_pair(&self) -> Option<&Pair> {
+        self.last_pair.as_ref()
+    }
+
+    /// Frames the profile asks to imprint on.
+    pub fn imprint_frames_wanted(&self) -> u32 {
+        self.imprint_frames
+    }
+
+    /// Samples one well-aligned frame for imprinting.
+    pub fn imprint_frame(&mut self, view: &RgbView<'_>) {
+        self.imprinter.add_frame(view);
+    }
+
+    /// Installs the imprint gathered so far; false (and no change) when too few bright
+    /// pixels were sampled. Resets the imprinter for the next departure.
+    pub fn finish_imprint(&mut self, now: f64) -> bool {
+        let done = self.imprinter.finish();
+        self.imprinter.clear();
+        match done {
+            Some(stats) => {
+                self.model.imprint(stats, now);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Runs the schema on one frame taken at `stamp`: detect with the current ranges,
+    /// adapt, and report.
+    ///
+    /// # Errors
+    /// As [`TwoBlockDetector::detect`].
+    pub fn process(&mut self, view: &RgbView<'_>, stamp: f64) -> Result<TwoBlockPercept, VisionError> {
+        let mode = self.model.mode();
+        let ranges = self.model.ranges();
+        let size = (view.width(), view.height());
+        let pair = self.detector.detect(view, &ranges)?;
+        self.last_pair = pair;
+        let Some(pair) = pair else {
+            self.model.update(stamp, None);
+            return Ok(TwoBlockPercept::not_found(stamp, mode, size));
+        };
+        let measured = self.detector.measure(view, &pair);
+        self.model.update(stamp, measured);
+        let mid = (pair.left.centroid[0] + pair.right.centroid[0]) / 2.0;
+        Ok(TwoBlockPercept {
+            stamp,
+            found: true,
+            left_px: pair.left.count,
+            right_px: pair.right.count,
+            total_px: pair.left.count + pair.right.count,
+            ratio: pair.ratio,
+            left_centroid: pair.left.centroid,
+            right_centroid: pair.right.centroid,
+            offset_px: mid - size.0 as f64 / 2.0,
+            mode,
+            image_size: size,
+        })
+    }
+}
+
+impl PerceptualSchema for TwoBlockSchema {
+    type Percept = TwoBlockPercept;
+
+    fn perceive(&mut self, inputs: &Inputs<'_>) -> TwoBlockPercept {
+        let size = self.detector.size();
+        match inputs.camera(self.camera) {
+            Some(cam) => self
+                .process(&cam.image, cam.stamp)
+                .unwrap_or_else(|_| TwoBlockPercept::not_found(cam.stamp, self.model.mode(), size)),
+            None => {
+                self.model.update(inputs.now, None);
+                TwoBlockPercept::not_found(inputs.now, self.model.mode(), size)
+            }
+        }
+    }
+}

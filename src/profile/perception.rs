@@ -1,0 +1,157 @@
+//! `[perception]`: colour segmentation, imprinting/adaptation and fiducial pairing.
+
+use crate::config::Validator;
+use serde::{Deserialize, Serialize};
+
+/// Adaptive (imprint + adapt + fallback) or static (imprint only) segmentation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SegmentationMode {
+    /// Imprint, then adapt every frame; fall back on timeouts (seed 004 Fig. 5).
+    Adaptive,
+    /// Imprint, never adapt (the paper's comparison, Table II).
+    Static,
+}
+
+/// Where the two blocks appear in the image as the daughter leaves the dock.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ImprintSpec {
+    /// Image-left block: (x0, y0, x1, y1) as fractions of width and height.
+    pub left_rect: [f64; 4],
+    /// Image-right block, same convention.
+    pub right_rect: [f64; 4],
+    /// Fraction of each rectangle (per side, centred) that is sampled.
+    pub sample_frac: f64,
+    /// Frames averaged.
+    pub frames: u32,
+}
+
+/// The `[perception]` table. Every field is optional; missing ones take the defaults of
+/// [`PerceptionSpec::default`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PerceptionSpec {
+    /// Adaptive or static segmentation.
+    pub mode: SegmentationMode,
+    /// Components smaller than this are dropped, px (paper: 20).
+    pub min_component_px: u32,
+    /// Pixels darker than this L (0–441.7) are not classified.
+    pub min_brightness: f64,
+    /// Gap allowed between the blocks, as a fraction of their mean height (allows roll).
+    pub max_gap_frac: f64,
+    /// Extra gap allowed in pixels (for tiny, distant blocks).
+    pub gap_slack_px: f64,
+    /// Largest vertical offset of the block centroids, fraction of their mean height.
+    pub max_vertical_frac: f64,
+    /// Range half-width in SDs (paper: 4).
+    pub n_sd: f64,
+    /// Smallest SD used for a range, degrees.
+    pub sd_floor_deg: f64,
+    /// Largest SD used for a range, degrees.
+    pub sd_ceiling_deg: f64,
+    /// SD of the table defaults, degrees.
+    pub table_sd_deg: f64,
+    /// Adaptation blend rate in (0, 1]; 1 replaces the statistics every frame (paper).
+    pub adapt_rate: f64,
+    /// Adapted → imprinted after this long without a detection, s.
+    pub timeout1_s: f64,
+    /// Imprinted → table after this long without a detection, s.
+    pub timeout2_s: f64,
+    /// At most this many components per colour are paired (the largest), bounding time
+    /// in clutter.
+    pub max_candidates: u32,
+    /// Imprint geometry.
+    pub imprint: ImprintSpec,
+}
+
+impl Default for PerceptionSpec {
+    fn default() -> Self {
+        Self {
+            mode: SegmentationMode::Adaptive,
+            min_component_px: 20,
+            min_brightness: 30.0,
+            max_gap_frac: 0.5,
+            gap_slack_px: 3.0,
+            max_vertical_frac: 0.5,
+            n_sd: 4.0,
+            sd_floor_deg: 0.5,
+            sd_ceiling_deg: 10.0,
+            table_sd_deg: 6.0,
+            adapt_rate: 1.0,
+            timeout1_s: 2.0,
+            timeout2_s: 6.0,
+            max_candidates: 64,
+            imprint: ImprintSpec::default(),
+        }
+    }
+}
+
+impl Default for ImprintSpec {
+    fn default() -> Self {
+        Self {
+            left_rect: [0.38, 0.40, 0.50, 0.60],
+            right_rect: [0.50, 0.40, 0.62, 0.60],
+            sample_frac: 0.5,
+            frames: 5,
+        }
+    }
+}
+
+pub(crate) fn validate_perception(p: &PerceptionSpec, v: &mut Validator<'_>) {
+    v.require(p.min_component_px >= 1, "perception.min_component_px", || {
+        "expected a count ≥ 1".into()
+    });
+    v.range("perception.min_brightness", p.min_brightness, 0.0, 441.0);
+    v.non_negative("perception.max_gap_frac", p.max_gap_frac);
+    v.non_negative("perception.gap_slack_px", p.gap_slack_px);
+    v.positive("perception.max_vertical_frac", p.max_vertical_frac);
+    v.positive("perception.n_sd", p.n_sd);
+    v.positive("perception.sd_floor_deg", p.sd_floor_deg);
+    v.positive("perception.sd_ceiling_deg", p.sd_ceiling_deg);
+    if p.sd_floor_deg > p.sd_ceiling_deg {
+        v.problem(
+            "perception.sd_floor_deg",
+            format!(
+                "expected sd_floor_deg ≤ sd_ceiling_deg, got {} > {}",
+                p.sd_floor_deg, p.sd_ceiling_deg
+            ),
+        );
+    }
+    v.positive("perception.table_sd_deg", p.table_sd_deg);
+    v.require(
+        p.adapt_rate > 0.0 && p.adapt_rate <= 1.0,
+        "perception.adapt_rate",
+        || format!("expected a rate in (0, 1], got {}", p.adapt_rate),
+    );
+    v.positive("perception.timeout1_s", p.timeout1_s);
+    v.positive("perception.timeout2_s", p.timeout2_s);
+    if p.timeout1_s > 0.0 && p.timeout2_s <= p.timeout1_s {
+        v.problem(
+            "perception.timeout2_s",
+            format!(
+                "expected timeout2_s > timeout1_s, got {} ≤ {}",
+                p.timeout2_s, p.timeout1_s
+            ),
+        );
+    }
+    v.require(p.max_candidates >= 1, "perception.max_candidates", || {
+        "expected a count ≥ 1".into()
+    });
+    for (name, r) in [("left_rect", p.imprint.left_rect), ("right_rect", p.imprint.right_rect)] {
+        let path = format!("perception.imprint.{name}");
+        v.require(
+            r.iter().all(|x| (0.0..=1.0).contains(x)) && r[0] < r[2] && r[1] < r[3],
+            &path,
+            || format!("expected (x0, y0, x1, y1) fractions in [0, 1] with x0 < x1 and y0 < y1, got {r:?}"),
+        );
+    }
+    v.require(
+        p.imprint.sample_frac > 0.0 && p.imprint.sample_frac <= 1.0,
+        "perception.imprint.sample_frac",
+        || format!("expected a fraction in (0, 1], got {}", p.imprint.sample_frac),
+    );
+    v.require(p.imprint.frames >= 1, "perception.imprint.frames", || {
+        "expected a count ≥ 1".into()
+    });
+}

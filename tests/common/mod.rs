@@ -1,0 +1,61 @@
+//! Helpers shared by integration tests: drawing synthetic fiducials.
+#![allow(dead_code)]
+
+use marsupial::perception::{RgbImage, SctRange};
+
+pub const CYAN: [u8; 3] = [20, 190, 210];
+pub const MAGENTA: [u8; 3] = [200, 30, 190];
+pub const GREY: [u8; 3] = [110, 105, 100];
+
+/// Wide SCT ranges for the two test colours.
+pub fn ranges() -> [SctRange; 2] {
+    let d = |x: f64| x.to_radians();
+    [
+        SctRange {
+            a: [d(30.0), d(60.0)],
+            b: [d(70.0), d(90.0)],
+            min_l: 30.0,
+        },
+        SctRange {
+            a: [d(30.0), d(60.0)],
+            b: [d(0.0), d(20.0)],
+            min_l: 30.0,
+        },
+    ]
+}
+
+/// Fills the axis-aligned rectangle [x0, x1) × [y0, y1).
+pub fn rect(im: &mut RgbImage, x0: usize, y0: usize, x1: usize, y1: usize, c: [u8; 3]) {
+    for y in y0..y1 {
+        for x in x0..x1 {
+            im.put(x, y, c);
+        }
+    }
+}
+
+/// Two adjacent blocks, `left` then `right`, each `bw × bh`, top-left at (x, y).
+pub fn fiducial(im: &mut RgbImage, x: usize, y: usize, bw: usize, bh: usize, left: [u8; 3], right: [u8; 3]) {
+    rect(im, x, y, x + bw, y + bh, left);
+    rect(im, x + bw, y, x + 2 * bw, y + bh, right);
+}
+
+/// A fiducial rotated by `roll` radians about its centre `c`, `size` = (w, h) overall.
+pub fn rolled_fiducial(im: &mut RgbImage, c: (f64, f64), size: (f64, f64), roll: f64, left: [u8; 3], right: [u8; 3]) {
+    let ((cx, cy), (w, h)) = (c, size);
+    let (s, co) = roll.sin_cos();
+    for y in 0..im.height() {
+        for x in 0..im.width() {
+            let (dx, dy) = (x as f64 + 0.5 - cx, y as f64 + 0.5 - cy);
+            let (u, v) = (co * dx + s * dy, -s * dx + co * dy);
+            if u.abs() <= w / 2.0 && v.abs() <= h / 2.0 {
+                im.put(x, y, if u < 0.0 { left } else { right });
+            }
+        }
+    }
+}
+
+pub fn background(w: usize, h: usize) -> RgbImage {
+    let mut im = RgbImage::new(w, h);
+    im.fill(GREY);
+    im
+}
