@@ -78,28 +78,34 @@ impl AngleStats {
     }
 }
 
-/// Streaming mean/variance of (A, B) pairs (Welford, in `f64`).
+/// Streaming mean/variance of (A, B) pairs in `f64`, by shifted sums: samples are taken
+/// relative to the first one, which keeps E[x²] − E[x]² well conditioned (the naive form
+/// loses precision; ALGORITHMS §2) without a division per sample.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StatsAccumulator {
     n: u64,
-    mean_a: f64,
-    m2_a: f64,
-    mean_b: f64,
-    m2_b: f64,
+    ref_a: f64,
+    ref_b: f64,
+    sum_a: f64,
+    sum_aa: f64,
+    sum_b: f64,
+    sum_bb: f64,
 }
 
 impl StatsAccumulator {
     /// Adds one sample (radians).
     #[inline]
     pub fn push(&mut self, a: f64, b: f64) {
+        if self.n == 0 {
+            self.ref_a = a;
+            self.ref_b = b;
+        }
         self.n += 1;
-        let n = self.n as f64;
-        let da = a - self.mean_a;
-        self.mean_a += da / n;
-        self.m2_a += da * (a - self.mean_a);
-        let db = b - self.mean_b;
-        self.mean_b += db / n;
-        self.m2_b += db * (b - self.mean_b);
+        let (da, db) = (a - self.ref_a, b - self.ref_b);
+        self.sum_a += da;
+        self.sum_aa += da * da;
+        self.sum_b += db;
+        self.sum_bb += db * db;
     }
 
     /// Samples so far.
@@ -109,11 +115,16 @@ impl StatsAccumulator {
 
     /// The statistics (population SD), or `None` with fewer than 2 samples.
     pub fn finish(&self) -> Option<AngleStats> {
-        (self.n >= 2).then(|| AngleStats {
-            mean_a: self.mean_a,
-            sd_a: (self.m2_a / self.n as f64).sqrt(),
-            mean_b: self.mean_b,
-            sd_b: (self.m2_b / self.n as f64).sqrt(),
+        if self.n < 2 {
+            return None;
+        }
+        let n = self.n as f64;
+        let var = |s: f64, ss: f64| ((ss - s * s / n) / n).max(0.0);
+        Some(AngleStats {
+            mean_a: self.ref_a + self.sum_a / n,
+            sd_a: var(self.sum_a, self.sum_aa).sqrt(),
+            mean_b: self.ref_b + self.sum_b / n,
+            sd_b: var(self.sum_b, self.sum_bb).sqrt(),
             n: self.n,
         })
     }
@@ -404,7 +415,7 @@ mod tests {
     }
 
     #[test]
-    fn welford_matches_two_pass() {
+    fn shifted_sums_match_two_pass() {
         let xs = [0.1, 0.4, 0.35, 0.2, 0.9, 0.05];
         let mut acc = StatsAccumulator::default();
         for (i, x) in xs.iter().enumerate() {

@@ -59,3 +59,44 @@ pub fn background(w: usize, h: usize) -> RgbImage {
     im.fill(GREY);
     im
 }
+
+/// A deterministic, textured and noisy scene of `w × h` with a magenta|cyan fiducial as
+/// Bujold's upside-down camera sees it (magenta on the image's left), about `fid_frac` of
+/// the image wide, plus same-coloured clutter. `seed` varies the noise.
+pub fn scene(w: usize, h: usize, fid_frac: f64, seed: u64) -> RgbImage {
+    let mut im = RgbImage::new(w, h);
+    let mut s = seed.wrapping_mul(0x9E3779B97F4A7C15) | 1;
+    let mut noise = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s % 13) as i32 - 6
+    };
+    for y in 0..h {
+        for x in 0..w {
+            let t = ((x as f64 * 0.07).sin() * 25.0 + (y as f64 * 0.045).cos() * 20.0) as i32;
+            let base = [120 + t, 110 + t / 2, 95 - t / 3];
+            let px = base.map(|c| (c + noise()).clamp(0, 255) as u8);
+            im.put(x, y, px);
+        }
+    }
+    let bw = (w as f64 * fid_frac / 2.0) as usize;
+    let bh = bw * 11 / 9;
+    let (x0, y0) = (w / 2 - bw, h / 2 - bh / 2);
+    for y in y0..y0 + bh {
+        for x in x0..x0 + 2 * bw {
+            let c: [i32; 3] = if x < x0 + bw { [215, 35, 200] } else { [25, 200, 215] };
+            im.put(x, y, c.map(|v| (v + noise()).clamp(0, 255) as u8));
+        }
+    }
+    // Clutter: isolated blobs of both colours, too far apart to pair.
+    for k in 0..6 {
+        let (cx, cy) = (
+            (k * 97 + 13) % (w - 20),
+            if k % 2 == 0 { h / 8 } else { h * 7 / 8 - 10 },
+        );
+        let c = if k % 2 == 0 { [215, 35, 200] } else { [25, 200, 215] };
+        rect(&mut im, cx, cy, cx + 8 + k, cy + 9, c);
+    }
+    im
+}
