@@ -2,3 +2,5 @@
 //! tested without spawning a process.
 
 pub mod check;
+pub mod detect;
+pub mod image_io;

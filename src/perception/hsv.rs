@@ -124,6 +124,30 @@ mod tests {
     }
 
     #[test]
+    fn frame_error_is_bounded_over_the_cube() {
+        // Quantised planes are within half a step of the exact values: 1° of hue (with
+        // wrap-around), 0.5/255 of saturation and value.
+        let vals: Vec<u8> = (0..=255).step_by(7).collect();
+        let mut im = crate::perception::RgbImage::new(vals.len() * vals.len(), vals.len());
+        for (i, &r) in vals.iter().enumerate() {
+            for (j, &g) in vals.iter().enumerate() {
+                for (k, &b) in vals.iter().enumerate() {
+                    im.put(i * vals.len() + j, k, [r, g, b]);
+                }
+            }
+        }
+        let mut p = HsvPlanes::new(im.width(), im.height());
+        hsv_from_rgb(&im.view(), &mut p).unwrap();
+        for (n, px) in im.as_bytes().chunks_exact(3).enumerate() {
+            let e = Hsv::from_rgb([px[0], px[1], px[2]]);
+            let dh = (p.h[n] as f32 * 2.0 - e.h).abs();
+            assert!(dh.min(360.0 - dh) <= 1.0 + 1e-3, "{px:?}");
+            assert!((p.s[n] as f32 / 255.0 - e.s).abs() <= 0.5 / 255.0 + 1e-6);
+            assert!((p.v[n] as f32 / 255.0 - e.v).abs() <= 0.5 / 255.0 + 1e-6);
+        }
+    }
+
+    #[test]
     fn frame_quantisation() {
         let im = crate::perception::RgbImage::from_raw(3, 1, vec![255, 0, 1, 0, 0, 255, 10, 10, 10]).unwrap();
         let mut p = HsvPlanes::new(3, 1);

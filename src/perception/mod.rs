@@ -8,12 +8,14 @@
 //! * [`components`]: 8-connected labelling with per-component moments.
 //! * [`colour_model`]: imprinting, adaptation and the fallback chain of seed 004 Fig. 5.
 //! * [`two_block`]: Bujold's two-block fiducial detector and its perceptual schema.
+//! * [`overlay`]: drawing a detection over its frame.
 
 pub mod colour_model;
 pub mod components;
 pub mod fastmath;
 pub mod hsv;
 pub mod image;
+pub mod overlay;
 pub mod sct;
 pub mod segment;
 pub mod two_block;

@@ -1,0 +1,47 @@
+//! Drawing what the two-block detector saw, as in seed 004 Fig. 7: segmented pixels of
+//! each colour painted in, the accepted blocks bright and boxed.
+
+use super::image::{RgbImage, RgbView};
+use super::two_block::{Pair, TwoBlockDetector};
+
+/// Paint for the image-left colour's pixels (accepted block / other segmented pixels).
+pub const LEFT_PAINT: ([u8; 3], [u8; 3]) = ([0, 255, 0], [0, 110, 0]);
+/// Paint for the image-right colour's pixels (accepted block / other segmented pixels).
+pub const RIGHT_PAINT: ([u8; 3], [u8; 3]) = ([255, 255, 0], [120, 120, 0]);
+
+/// Copies `frame` into `out` and paints the detector's last segmentation over it: pixels
+/// of the accepted blocks in bright green (left) and yellow (right), other segmented
+/// pixels of the same colours dimmer, and a white box around the accepted pair.
+pub fn paint_overlay(frame: &RgbView<'_>, detector: &TwoBlockDetector, pair: Option<&Pair>, out: &mut RgbImage) {
+    let (w, h) = (frame.width(), frame.height());
+    out.resize(w, h);
+    out.as_bytes_mut().copy_from_slice(frame.as_bytes());
+    if detector.size() != (w, h) {
+        return;
+    }
+    for (c, paint) in [LEFT_PAINT, RIGHT_PAINT].iter().enumerate() {
+        let chosen = pair.map(|p| if c == 0 { p.left.component } else { p.right.component });
+        for run in detector.labeler(c).runs() {
+            let colour = if Some(run.label) == chosen { paint.0 } else { paint.1 };
+            for x in run.x0..run.x1 {
+                out.put(x as usize, run.y as usize, colour);
+            }
+        }
+    }
+    if let Some(p) = pair {
+        let x0 = p.left.bbox[0].min(p.right.bbox[0]) as usize;
+        let y0 = p.left.bbox[1].min(p.right.bbox[1]) as usize;
+        let x1 = p.left.bbox[2].max(p.right.bbox[2]) as usize;
+        let y1 = p.left.bbox[3].max(p.right.bbox[3]) as usize;
+        let (x0, y0) = (x0.saturating_sub(2), y0.saturating_sub(2));
+        let (x1, y1) = ((x1 + 2).min(w - 1), (y1 + 2).min(h - 1));
+        for x in x0..=x1 {
+            out.put(x, y0, [255, 255, 255]);
+            out.put(x, y1, [255, 255, 255]);
+        }
+        for y in y0..=y1 {
+            out.put(x0, y, [255, 255, 255]);
+            out.put(x1, y, [255, 255, 255]);
+        }
+    }
+}
