@@ -40,6 +40,7 @@
 #![deny(missing_docs)]
 
 pub mod arbiter;
+pub mod behaviors;
 pub mod cli;
 pub mod config;
 pub mod geometry;
@@ -48,3 +49,4 @@ pub mod perception;
 pub mod profile;
 pub mod robot;
 pub mod schemas;
+pub mod sim;

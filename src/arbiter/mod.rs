@@ -16,7 +16,7 @@ pub mod vector_sum;
 pub use decision::{Candidate, Decision, Strategy};
 pub use priority::Priority;
 pub use reactive_loop::{
-    InputKind, LoopConfig, LoopStatus, ReactiveLoop, Staleness, StopReason, TickOutput, safe_stop_command,
+    InputKind, LoopConfig, LoopCore, LoopStatus, ReactiveLoop, Staleness, StopReason, TickOutput, safe_stop_command,
 };
 pub use sequencer::{Next, Selector, Sequencer};
 pub use vector_sum::VectorSum;

@@ -162,6 +162,13 @@ pub struct TickOutput {
 /// The reactive loop: a root behavior (usually an arbiter) plus input checks.
 pub struct ReactiveLoop {
     root: Box<dyn Behavior>,
+    core: LoopCore,
+}
+
+/// The loop's own state (input checks, safe-stop and finish bookkeeping) without a root
+/// behavior, for callers that own the behavior themselves (the simulator ticks an agent
+/// through several phases with a fresh `LoopCore` each).
+pub struct LoopCore {
     config: LoopConfig,
     last_now: Option<f64>,
     finished: Option<Outcome>,
@@ -195,6 +202,45 @@ impl ReactiveLoop {
     pub fn new(root: Box<dyn Behavior>, config: LoopConfig) -> Self {
         Self {
             root,
+            core: LoopCore::new(config),
+        }
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &LoopConfig {
+        &self.core.config
+    }
+
+    /// Ticks so far.
+    pub fn ticks(&self) -> u64 {
+        self.core.ticks
+    }
+
+    /// Ticks spent in safe stop so far.
+    pub fn safe_stop_ticks(&self) -> u64 {
+        self.core.safe_stop_ticks
+    }
+
+    /// The outcome, once the root behavior has finished.
+    pub fn outcome(&self) -> Option<Outcome> {
+        self.core.finished
+    }
+
+    /// The root behavior.
+    pub fn root_mut(&mut self) -> &mut dyn Behavior {
+        self.root.as_mut()
+    }
+
+    /// Runs one tick.
+    pub fn tick(&mut self, inputs: &Inputs<'_>) -> TickOutput {
+        self.core.tick(self.root.as_mut(), inputs)
+    }
+}
+
+impl LoopCore {
+    /// Fresh loop state.
+    pub fn new(config: LoopConfig) -> Self {
+        Self {
             config,
             last_now: None,
             finished: None,
@@ -222,11 +268,6 @@ impl ReactiveLoop {
     /// The outcome, once the root behavior has finished.
     pub fn outcome(&self) -> Option<Outcome> {
         self.finished
-    }
-
-    /// The root behavior.
-    pub fn root_mut(&mut self) -> &mut dyn Behavior {
-        self.root.as_mut()
     }
 
     fn check_inputs(&self, inputs: &Inputs<'_>) -> Option<StopReason> {
@@ -322,8 +363,8 @@ impl ReactiveLoop {
         }
     }
 
-    /// Runs one tick.
-    pub fn tick(&mut self, inputs: &Inputs<'_>) -> TickOutput {
+    /// Runs one tick of `root`.
+    pub fn tick(&mut self, root: &mut dyn Behavior, inputs: &Inputs<'_>) -> TickOutput {
         self.ticks += 1;
         if let Some(outcome) = self.finished {
             return TickOutput {
@@ -338,7 +379,7 @@ impl ReactiveLoop {
         if let Some(reason) = self.stopped.take() {
             tracing::info!(target: "marsupial::loop", now = inputs.now, %reason, "inputs recovered, resuming");
         }
-        let Some(step) = self.root.tick(inputs) else {
+        let Some(step) = root.tick(inputs) else {
             return TickOutput {
                 command: MotorOutput::stop(),
                 status: LoopStatus::Idle,

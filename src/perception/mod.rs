@@ -3,6 +3,7 @@
 //! Everything here is a plain function or a struct that allocates its scratch space once
 //! and reuses it every frame; nothing reads a clock or a random source.
 //!
+//! * [`camera_model`]: pin-hole and omnidirectional projection, camera mounting.
 //! * [`sct`] and [`hsv`]: colour spaces, exact per pixel and fast over whole frames.
 //! * [`segment`]: per-colour ranges into reusable [`Mask`]s (the SCT test is trig-free).
 //! * [`components`]: 8-connected labelling with per-component moments.
@@ -10,6 +11,7 @@
 //! * [`two_block`]: Bujold's two-block fiducial detector and its perceptual schema.
 //! * [`overlay`]: drawing a detection over its frame.
 
+pub mod camera_model;
 pub mod colour_model;
 pub mod components;
 pub mod fastmath;

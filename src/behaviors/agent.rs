@@ -1,0 +1,46 @@
+//! The agent abstraction and its construction from a profile.
+
+use crate::profile::{ApproachKind, Profile};
+use crate::schemas::Behavior;
+use thiserror::Error;
+
+/// A robot's behaviors for one docking experiment.
+pub trait Agent: Behavior {
+    /// Switches to the departure phase (leave the dock, imprint on the way). Returns false
+    /// when the agent has none, in which case it stays ready to dock.
+    fn begin_departure(&mut self) -> bool;
+    /// Switches to the docking phase; the robot may have been moved since departure.
+    fn begin_docking(&mut self);
+}
+
+/// Why no agent could be built for a profile.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum BuildError {
+    /// The profile's approach has no behavior implementation.
+    #[error("profile `{profile}`: approach `{approach:?}` has no docking behavior in this build")]
+    NoBehavior {
+        /// The profile.
+        profile: String,
+        /// Its approach.
+        approach: ApproachKind,
+    },
+    /// The profile lacks something the behavior needs.
+    #[error("profile `{profile}`: {what}")]
+    Profile {
+        /// The profile.
+        profile: String,
+        /// What is missing.
+        what: String,
+    },
+}
+
+/// Builds the agent a profile selects.
+///
+/// # Errors
+/// [`BuildError`] when the profile's approach has no implementation or lacks what it needs.
+pub fn agent_for(profile: &Profile) -> Result<Box<dyn Agent>, BuildError> {
+    Err(BuildError::NoBehavior {
+        profile: profile.name.clone(),
+        approach: profile.behavior.approach,
+    })
+}

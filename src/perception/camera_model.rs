@@ -1,0 +1,273 @@
+//! Camera projection models and mounting poses.
+//!
+//! Camera frame: +x right in the image, +y down, +z forward along the optical axis.
+//! Pixel coordinates: (u, v) = (column, row), with pixel centres at integer + 0.5.
+//!
+//! * [`Pinhole`]: focal lengths, principal point and Brown radial distortion (k1, k2).
+//! * [`Fisheye`]: Scaramuzza's unified omnidirectional model (OCamCalib): a pixel maps to
+//!   the ray (x, y, −f(ρ)) with f(ρ) = a0 + a1·ρ + a2·ρ² + … (a0 < 0 in OCamCalib's frame,
+//!   whose optical axis is −z; here it is flipped to +z), after an affine correction
+//!   [[c, d], [e, 1]] about the distortion centre. Projection inverts f numerically via a
+//!   monotonic table of the ray's off-axis angle.
+
+use crate::profile::{CameraModelKind, CameraSpec, Mount};
+use nalgebra::{Matrix3, Rotation3, Vector3};
+
+/// Pin-hole model with radial distortion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pinhole {
+    /// Focal length x, px.
+    pub fx: f64,
+    /// Focal length y, px.
+    pub fy: f64,
+    /// Principal point x, px.
+    pub cx: f64,
+    /// Principal point y, px.
+    pub cy: f64,
+    /// Radial k1.
+    pub k1: f64,
+    /// Radial k2.
+    pub k2: f64,
+}
+
+impl Pinhole {
+    /// Pixel of a camera-frame point, or `None` behind the camera.
+    pub fn project(&self, p: &Vector3<f64>) -> Option<[f64; 2]> {
+        if p.z <= 1e-9 {
+            return None;
+        }
+        let (x, y) = (p.x / p.z, p.y / p.z);
+        let r2 = x * x + y * y;
+        let d = 1.0 + self.k1 * r2 + self.k2 * r2 * r2;
+        Some([self.fx * x * d + self.cx, self.fy * y * d + self.cy])
+    }
+
+    /// Unit ray through pixel (u, v) (undistorted by fixed-point iteration).
+    pub fn ray(&self, u: f64, v: f64) -> Vector3<f64> {
+        let (xd, yd) = ((u - self.cx) / self.fx, (v - self.cy) / self.fy);
+        let (mut x, mut y) = (xd, yd);
+        if self.k1 != 0.0 || self.k2 != 0.0 {
+            for _ in 0..20 {
+                let r2 = x * x + y * y;
+                let d = 1.0 + self.k1 * r2 + self.k2 * r2 * r2;
+                x = xd / d;
+                y = yd / d;
+            }
+        }
+        Vector3::new(x, y, 1.0).normalize()
+    }
+}
+
+/// Scaramuzza omnidirectional model (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fisheye {
+    /// f(ρ) coefficients a0, a1, a2 …
+    pub poly: Vec<f64>,
+    /// Distortion centre (u, v), px.
+    pub center: [f64; 2],
+    /// Affine (c, d, e).
+    pub affine: [f64; 3],
+    /// Table of ρ against the off-axis angle θ, for projection.
+    inverse: Vec<(f64, f64)>,
+}
+
+impl Fisheye {
+    /// Builds the model; the inverse table covers ρ from 0 to `max_rho` px.
+    pub fn new(poly: Vec<f64>, center: [f64; 2], affine: [f64; 3], max_rho: f64) -> Self {
+        let mut f = Self {
+            poly,
+            center,
+            affine,
+            inverse: Vec::new(),
+        };
+        let n = 2048;
+        let mut last = -1.0;
+        for i in 0..=n {
+            let rho = max_rho * i as f64 / n as f64;
+            let theta = rho.atan2(-f.f(rho));
+            if theta <= last {
+                break; // the polynomial stops being monotonic: beyond the valid field of view
+            }
+            last = theta;
+            f.inverse.push((theta, rho));
+        }
+        f
+    }
+
+    fn f(&self, rho: f64) -> f64 {
+        self.poly.iter().rev().fold(0.0, |acc, a| acc * rho + a)
+    }
+
+    /// Largest off-axis angle the model covers, rad.
+    pub fn max_angle(&self) -> f64 {
+        self.inverse.last().map_or(0.0, |t| t.0)
+    }
+
+    /// Unit ray through pixel (u, v).
+    pub fn ray(&self, u: f64, v: f64) -> Vector3<f64> {
+        let [c, d, e] = self.affine;
+        let (du, dv) = (u - self.center[0], v - self.center[1]);
+        let inv = 1.0 / (c - d * e);
+        let (x, y) = (inv * (du - d * dv), inv * (-e * du + c * dv));
+        let rho = x.hypot(y);
+        Vector3::new(x, y, -self.f(rho)).normalize()
+    }
+
+    /// Pixel of a camera-frame point, or `None` outside the modelled field of view.
+    pub fn project(&self, p: &Vector3<f64>) -> Option<[f64; 2]> {
+        let n = p.x.hypot(p.y);
+        let theta = n.atan2(p.z);
+        let table = &self.inverse;
+        if table.len() < 2 || theta > self.max_angle() {
+            return None;
+        }
+        let i = table.partition_point(|t| t.0 < theta).clamp(1, table.len() - 1);
+        let ((t0, r0), (t1, r1)) = (table[i - 1], table[i]);
+        let rho = r0 + (r1 - r0) * (theta - t0) / (t1 - t0);
+        let (x, y) = if n > 1e-12 {
+            (p.x / n * rho, p.y / n * rho)
+        } else {
+            (0.0, 0.0)
+        };
+        let [c, d, e] = self.affine;
+        Some([c * x + d * y + self.center[0], e * x + y + self.center[1]])
+    }
+}
+
+/// A camera model.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CameraModel {
+    /// Pin-hole.
+    Pinhole(Pinhole),
+    /// Omnidirectional.
+    Fisheye(Fisheye),
+}
+
+impl CameraModel {
+    /// The model a profile's camera describes.
+    pub fn from_spec(spec: &CameraSpec) -> Self {
+        match spec.model {
+            CameraModelKind::Pinhole => {
+                let k = spec.pinhole_intrinsics().unwrap_or(crate::profile::Intrinsics {
+                    fx: spec.width_px as f64,
+                    fy: spec.width_px as f64,
+                    cx: spec.width_px as f64 / 2.0,
+                    cy: spec.height_px as f64 / 2.0,
+                    k1: 0.0,
+                    k2: 0.0,
+                });
+                CameraModel::Pinhole(Pinhole {
+                    fx: k.fx,
+                    fy: k.fy,
+                    cx: k.cx,
+                    cy: k.cy,
+                    k1: k.k1,
+                    k2: k.k2,
+                })
+            }
+            CameraModelKind::Fisheye => {
+                let fe = spec.fisheye.clone().unwrap_or(crate::profile::FisheyeSpec {
+                    poly: vec![-(spec.width_px as f64) / 2.0],
+                    center_px: [spec.width_px as f64 / 2.0, spec.height_px as f64 / 2.0],
+                    affine: [1.0, 0.0, 0.0],
+                });
+                let max_rho = (spec.width_px as f64).hypot(spec.height_px as f64);
+                CameraModel::Fisheye(Fisheye::new(fe.poly, fe.center_px, fe.affine, max_rho))
+            }
+        }
+    }
+
+    /// Pixel of a camera-frame point.
+    pub fn project(&self, p: &Vector3<f64>) -> Option<[f64; 2]> {
+        match self {
+            CameraModel::Pinhole(m) => m.project(p),
+            CameraModel::Fisheye(m) => m.project(p),
+        }
+    }
+
+    /// Unit ray through a pixel position.
+    pub fn ray(&self, u: f64, v: f64) -> Vector3<f64> {
+        match self {
+            CameraModel::Pinhole(m) => m.ray(u, v),
+            CameraModel::Fisheye(m) => m.ray(u, v),
+        }
+    }
+}
+
+/// Rotation taking camera-frame vectors to the body frame, for a mount.
+///
+/// With yaw = pitch = roll = 0 the camera looks along body +x with image right = body −y
+/// and image down = body −z. Then: yaw about body +z, pitch about the body's (yawed) +y
+/// (positive looks down), roll about the optical axis (180° turns the image upside down).
+pub fn body_from_camera(mount: &Mount) -> Matrix3<f64> {
+    let r0 = Matrix3::new(0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, -1.0, 0.0);
+    let yaw = Rotation3::from_axis_angle(&Vector3::z_axis(), mount.yaw_deg.to_radians());
+    let pitch = Rotation3::from_axis_angle(&Vector3::y_axis(), mount.pitch_deg.to_radians());
+    let roll = Rotation3::from_axis_angle(&Vector3::z_axis(), mount.roll_deg.to_radians());
+    yaw.matrix() * pitch.matrix() * r0 * roll.matrix()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pinhole_round_trip_with_distortion() {
+        let m = Pinhole {
+            fx: 300.0,
+            fy: 310.0,
+            cx: 160.0,
+            cy: 120.0,
+            k1: -0.2,
+            k2: 0.05,
+        };
+        for (u, v) in [(160.0, 120.0), (10.0, 5.0), (300.0, 230.0)] {
+            let r = m.ray(u, v);
+            let p = m.project(&(r * 3.0)).unwrap();
+            assert!((p[0] - u).abs() < 1e-6 && (p[1] - v).abs() < 1e-6, "{p:?}");
+        }
+        assert!(m.project(&Vector3::new(0.0, 0.0, -1.0)).is_none());
+    }
+
+    #[test]
+    fn fisheye_round_trip() {
+        let m = Fisheye::new(
+            vec![-175.0, 0.0, 1.6e-3, -1.2e-6, 2.5e-9],
+            [320.0, 240.0],
+            [1.0, 0.0, 0.0],
+            800.0,
+        );
+        assert!(m.max_angle() > 1.5, "{}", m.max_angle());
+        for (u, v) in [(320.0, 240.0), (100.0, 50.0), (600.0, 400.0), (330.0, 260.0)] {
+            let r = m.ray(u, v);
+            let p = m.project(&r).unwrap();
+            assert!((p[0] - u).abs() < 0.05 && (p[1] - v).abs() < 0.05, "({u},{v}) → {p:?}");
+        }
+        let axis = m.ray(320.0, 240.0);
+        assert!((axis - Vector3::z()).norm() < 1e-12);
+    }
+
+    #[test]
+    fn mounts() {
+        let fwd = body_from_camera(&Mount::default());
+        assert!((fwd * Vector3::z() - Vector3::x()).norm() < 1e-12);
+        assert!(
+            (fwd * Vector3::x() + Vector3::y()).norm() < 1e-12,
+            "image right is body −y"
+        );
+        let back = body_from_camera(&Mount {
+            yaw_deg: 180.0,
+            roll_deg: 180.0,
+            ..Default::default()
+        });
+        assert!((back * Vector3::z() + Vector3::x()).norm() < 1e-12, "looks backwards");
+        // Rolled 180°: image right is body −y again when looking backwards, image down is up.
+        assert!((back * Vector3::x() + Vector3::y()).norm() < 1e-12);
+        assert!((back * Vector3::y() - Vector3::z()).norm() < 1e-12);
+        let down = body_from_camera(&Mount {
+            pitch_deg: 30.0,
+            ..Default::default()
+        });
+        assert!((down * Vector3::z()).z < -0.49);
+    }
+}

@@ -1,0 +1,529 @@
+//! Trial campaigns: every run of a scenario, in parallel, streamed to `runs.jsonl`.
+//!
+//! Runs are independent and seeded from (scenario seed, run index), so a run's record does
+//! not depend on which worker ran it or when. Records are written in run order (a small
+//! reorder buffer holds early finishers), so the same scenario and seed give the same
+//! `runs.jsonl` byte for byte whatever `--jobs` is; `--resume` skips runs already in the
+//! file. Runs that differ only in segmentation mode share a `pair_seed`: same lighting
+//! instant, same placement error and the same imprint, as in the paper's paired protocol.
+
+use super::SimError;
+use super::engine::{PhaseEnd, Sim};
+use super::lighting::LightingRun;
+use super::motion::Motion;
+use super::rng::Rng;
+use super::scenario::{Loaded, RunSpec, Scenario};
+use super::world::{self, World};
+use crate::behaviors::{Agent, BuildError};
+use crate::geometry::Pose2;
+use crate::perception::RgbImage;
+use crate::profile::{Profile, SegmentationMode};
+use crate::schemas::Outcome;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Builds a fresh agent for a (per-run) profile.
+pub type AgentFactory = dyn Fn(&Profile) -> Result<Box<dyn Agent>, BuildError> + Sync;
+
+/// The record of one run (one line of `runs.jsonl`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunRecord {
+    /// Run index in the campaign.
+    pub index: usize,
+    /// Start label.
+    pub start: String,
+    /// Lighting programme.
+    pub lighting: String,
+    /// Segmentation mode.
+    pub segmentation: String,
+    /// Terrain.
+    pub terrain: String,
+    /// Trial number.
+    pub trial: u32,
+    /// Run seed.
+    pub seed: u64,
+    /// Start distance from the entrance, m.
+    pub distance_m: f64,
+    /// Start angle off the dock axis, degrees.
+    pub angle_deg: f64,
+    /// Docked (the simulator's ground truth: contact with the plates).
+    pub success: bool,
+    /// `docked`, or the failure reason.
+    pub outcome: String,
+    /// Time from placement to docking or failure, s.
+    pub time_s: f64,
+    /// Distance driven, m.
+    pub path_m: f64,
+    /// Effective velocity: start distance / time, cm/s (successful runs).
+    pub v_eff_cmps: f64,
+    /// Drive-command changes per metre driven.
+    pub commands_per_m: f64,
+    /// Lateral error at the entrance, m (when the robot reached it).
+    pub entrance_lateral_m: Option<f64>,
+    /// Heading error at the entrance, degrees.
+    pub entrance_heading_deg: Option<f64>,
+    /// Ticks in safe stop.
+    pub safe_stops: u64,
+    /// Departure imprinted successfully (when the agent has a departure).
+    pub imprinted: Option<bool>,
+    /// True path, [x, y] in mm every 0.5 s.
+    pub track: Vec<[i32; 2]>,
+}
+
+/// Options for [`run_campaign`].
+#[derive(Debug, Clone, Default)]
+pub struct CampaignOptions {
+    /// Output folder (runs.jsonl, summary.json, plots, per-run files).
+    pub out: Option<PathBuf>,
+    /// Worker threads (0: all cores).
+    pub jobs: usize,
+    /// Skip runs already in `out/runs.jsonl`.
+    pub resume: bool,
+    /// Show a progress bar on stderr.
+    pub progress: bool,
+    /// Write each run's trajectory CSV (and frames, when the scenario asks).
+    pub per_run_files: bool,
+}
+
+/// Everything shared by the runs of a campaign.
+pub struct Prepared {
+    /// Scenario and profile.
+    pub loaded: Loaded,
+    /// The built world.
+    pub world: World,
+    /// Every run.
+    pub runs: Vec<RunSpec>,
+}
+
+/// Loads backdrops and builds the world for a loaded scenario.
+///
+/// # Errors
+/// [`SimError`] when a backdrop cannot be read or the world cannot be built.
+pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
+    let dir = loaded.file.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let backdrops: Vec<Arc<RgbImage>> = loaded
+        .scenario
+        .backgrounds
+        .iter()
+        .map(|b| crate::cli::image_io::load_rgb(&dir.join(b)).map(Arc::new))
+        .collect::<Result<_, _>>()?;
+    let world = world::build(&loaded.profile, &loaded.scenario.clutter, &backdrops)?;
+    let runs = loaded.scenario.runs(&loaded.profile);
+    Ok(Prepared { loaded, world, runs })
+}
+
+fn seg_name(m: SegmentationMode) -> &'static str {
+    match m {
+        SegmentationMode::Adaptive => "adaptive",
+        SegmentationMode::Static => "static",
+    }
+}
+
+fn terrain_name(t: super::motion::Terrain) -> String {
+    serde_json::to_value(t)
+        .ok()
+        .and_then(|v| v.as_str().map(String::from))
+        .unwrap_or_default()
+}
+
+/// Runs one run of a prepared campaign. `frames` (folder, every N) records camera frames.
+///
+/// # Errors
+/// [`SimError::Unsupported`] when no agent can be built.
+pub fn run_one(
+    p: &Prepared,
+    spec: &RunSpec,
+    make_agent: &AgentFactory,
+    frames: Option<(&Path, u32)>,
+) -> Result<RunRecord, SimError> {
+    let sc: &Scenario = &p.loaded.scenario;
+    let mut profile = p.loaded.profile.clone();
+    profile.perception.mode = spec.segmentation;
+    let mut agent = make_agent(&profile).map_err(|e| SimError::Unsupported(e.to_string()))?;
+    let mut pair = Rng::new(spec.pair_seed);
+    let lighting = sc.lighting_named(&spec.lighting);
+    let run_light = LightingRun::new(lighting.clone(), &mut pair, sc.timeout_s + 120.0);
+    let sensor = sc.sensor_params(&lighting);
+    let motion = Motion::new(
+        profile.drive.model(),
+        profile.drive.limits(),
+        sc.slip(spec.terrain),
+        sc.motion.latency_s,
+        sc.motion.accel_mps2,
+        sc.motion.yaw_accel_dps2.to_radians(),
+    );
+    let mut sim = Sim::new(
+        &profile,
+        &p.world,
+        run_light.clone(),
+        sensor,
+        motion,
+        sc.dt_s,
+        spec.seed,
+    );
+    // Departure: undock and imprint (paired runs share it through `pair`).
+    let mut imprinted = None;
+    if sc.imprint.enabled && agent.begin_departure() {
+        let dep_light = match &sc.imprint.lighting {
+            Some(name) => {
+                let l = sc.lighting_named(name);
+                (
+                    LightingRun::new(l.clone(), &mut Rng::new(spec.pair_seed ^ 0xD0), 120.0),
+                    sc.sensor_params(&l),
+                )
+            }
+            None => (run_light.clone(), sensor),
+        };
+        sim.set_lighting(dep_light.0, dep_light.1);
+        let inside = Pose2::new(-p.world.dock.depth + profile.body.length_m / 2.0, 0.0, 0.0);
+        let open = p.world.dock.open;
+        sim.place(
+            if open {
+                Pose2::new(profile.body.length_m / 2.0 + 0.02, 0.0, 0.0)
+            } else {
+                inside
+            },
+            !open,
+        );
+        let end = sim.run_phase(agent.as_mut(), 90.0, None);
+        imprinted = Some(matches!(end, PhaseEnd::Finished(Outcome::Completed)));
+        let mut light = run_light;
+        light.advance_session(sc.imprint.sleep_s);
+        sim.set_lighting(light, sensor);
+    }
+    // Placement with the proctor's error.
+    let s = &spec.start;
+    let jx = pair.normal() * sc.starts.position_jitter_m;
+    let jy = pair.normal() * sc.starts.position_jitter_m;
+    let jt = pair.normal() * sc.starts.heading_jitter_deg.to_radians();
+    sim.place(Pose2::new(s.pose.x + jx, s.pose.y + jy, s.pose.theta + jt), false);
+    agent.begin_docking();
+    let end = match frames {
+        Some((dir, every)) if every > 0 => {
+            let mut hook = |n: u64, _t: f64, fr: &[RgbImage]| {
+                if n.is_multiple_of(every as u64) {
+                    for (i, f) in fr.iter().enumerate() {
+                        let _ = crate::cli::image_io::save_png(&dir.join(format!("frame-{n:05}-cam{i}.png")), f);
+                    }
+                }
+            };
+            sim.run_phase(agent.as_mut(), sc.timeout_s, Some(&mut hook))
+        }
+        _ => sim.run_phase(agent.as_mut(), sc.timeout_s, None),
+    };
+    let success = sim.docked();
+    let outcome = match end {
+        PhaseEnd::Docked => "docked".to_string(),
+        PhaseEnd::Finished(Outcome::Docked) if success => "docked".to_string(),
+        PhaseEnd::Finished(Outcome::Docked | Outcome::Completed) => "false_dock".to_string(),
+        PhaseEnd::Finished(Outcome::Failed(r)) => r.as_str().to_string(),
+        PhaseEnd::Stuck { .. } => "stuck_contact".to_string(),
+        PhaseEnd::Timeout => "timeout".to_string(),
+    };
+    let time_s = sim.time();
+    let path_m = sim.path_m;
+    Ok(RunRecord {
+        index: spec.index,
+        start: s.label.clone(),
+        lighting: spec.lighting.clone(),
+        segmentation: seg_name(spec.segmentation).into(),
+        terrain: terrain_name(spec.terrain),
+        trial: spec.trial,
+        seed: spec.seed,
+        distance_m: s.distance,
+        angle_deg: s.angle_deg,
+        success,
+        outcome,
+        time_s,
+        path_m,
+        v_eff_cmps: if success && time_s > 0.0 {
+            s.distance / time_s * 100.0
+        } else {
+            0.0
+        },
+        commands_per_m: if path_m > 0.01 {
+            sim.drive_changes as f64 / path_m
+        } else {
+            0.0
+        },
+        entrance_lateral_m: sim.entrance.map(|e| e.0),
+        entrance_heading_deg: sim.entrance.map(|e| e.1.to_degrees()),
+        safe_stops: sim.safe_stops,
+        imprinted,
+        track: sim
+            .track
+            .iter()
+            .map(|t| [(t[1] * 1000.0).round() as i32, (t[2] * 1000.0).round() as i32])
+            .collect(),
+    })
+}
+
+/// Summary of a set of runs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GroupSummary {
+    /// Start label (`*` for all).
+    pub start: String,
+    /// Lighting (`*` for all).
+    pub lighting: String,
+    /// Segmentation (`*` for all).
+    pub segmentation: String,
+    /// Terrain (`*` for all).
+    pub terrain: String,
+    /// Runs.
+    pub runs: usize,
+    /// Successful runs.
+    pub successes: usize,
+    /// successes / runs.
+    pub success_rate: f64,
+    /// Mean time to dock of the successful runs, s.
+    pub mean_time_s: Option<f64>,
+    /// SD of that time, s.
+    pub sd_time_s: Option<f64>,
+    /// Mean effective velocity of the successful runs, cm/s.
+    pub v_eff_cmps: Option<f64>,
+    /// Mean drive-command changes per metre.
+    pub commands_per_m: f64,
+    /// Failures by reason.
+    pub failures: BTreeMap<String, usize>,
+}
+
+/// `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Scenario name.
+    pub scenario: String,
+    /// All runs together.
+    pub overall: GroupSummary,
+    /// One entry per combination of the axes (start, lighting, segmentation, terrain).
+    pub groups: Vec<GroupSummary>,
+}
+
+/// Summarises records with the given labels.
+pub fn summarise(records: &[&RunRecord], labels: [&str; 4]) -> GroupSummary {
+    let ok: Vec<&&RunRecord> = records.iter().filter(|r| r.success).collect();
+    let mean = |f: &dyn Fn(&RunRecord) -> f64| {
+        (!ok.is_empty()).then(|| ok.iter().map(|r| f(r)).sum::<f64>() / ok.len() as f64)
+    };
+    let mean_time = mean(&|r| r.time_s);
+    let sd_time = mean_time.map(|m| (ok.iter().map(|r| (r.time_s - m).powi(2)).sum::<f64>() / ok.len() as f64).sqrt());
+    let mut failures = BTreeMap::new();
+    for r in records.iter().filter(|r| !r.success) {
+        *failures.entry(r.outcome.clone()).or_insert(0) += 1;
+    }
+    GroupSummary {
+        start: labels[0].into(),
+        lighting: labels[1].into(),
+        segmentation: labels[2].into(),
+        terrain: labels[3].into(),
+        runs: records.len(),
+        successes: ok.len(),
+        success_rate: if records.is_empty() {
+            0.0
+        } else {
+            ok.len() as f64 / records.len() as f64
+        },
+        mean_time_s: mean_time,
+        sd_time_s: sd_time,
+        v_eff_cmps: mean(&|r| r.v_eff_cmps),
+        commands_per_m: if records.is_empty() {
+            0.0
+        } else {
+            records.iter().map(|r| r.commands_per_m).sum::<f64>() / records.len() as f64
+        },
+        failures,
+    }
+}
+
+/// The summary of a campaign's records (in campaign order).
+pub fn summary(name: &str, records: &[RunRecord]) -> Summary {
+    let all: Vec<&RunRecord> = records.iter().collect();
+    let mut keys: Vec<(usize, [String; 4])> = Vec::new();
+    for r in records {
+        let k = [
+            r.start.clone(),
+            r.lighting.clone(),
+            r.segmentation.clone(),
+            r.terrain.clone(),
+        ];
+        if !keys.iter().any(|(_, kk)| *kk == k) {
+            keys.push((r.index, k));
+        }
+    }
+    let groups = keys
+        .iter()
+        .map(|(_, k)| {
+            let rs: Vec<&RunRecord> = records
+                .iter()
+                .filter(|r| r.start == k[0] && r.lighting == k[1] && r.segmentation == k[2] && r.terrain == k[3])
+                .collect();
+            summarise(&rs, [&k[0], &k[1], &k[2], &k[3]])
+        })
+        .collect();
+    Summary {
+        scenario: name.into(),
+        overall: summarise(&all, ["*", "*", "*", "*"]),
+        groups,
+    }
+}
+
+/// Reads the records of an earlier (possibly interrupted) campaign.
+pub fn read_runs(path: &Path) -> Vec<RunRecord> {
+    std::fs::read_to_string(path)
+        .map(|s| s.lines().filter_map(|l| serde_json::from_str(l).ok()).collect())
+        .unwrap_or_default()
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> SimError + '_ {
+    move |source| SimError::Io {
+        path: path.display().to_string(),
+        source,
+    }
+}
+
+/// Runs every run of `p` and returns the records in campaign order plus the summary.
+///
+/// # Errors
+/// [`SimError`] when output cannot be written or no agent can be built.
+pub fn run_campaign(
+    p: &Prepared,
+    make_agent: &AgentFactory,
+    opts: &CampaignOptions,
+) -> Result<(Vec<RunRecord>, Summary), SimError> {
+    // Fail early if the profile has no behavior.
+    make_agent(&p.loaded.profile).map_err(|e| SimError::Unsupported(e.to_string()))?;
+    let mut done: BTreeMap<usize, RunRecord> = BTreeMap::new();
+    let mut jsonl = None;
+    if let Some(dir) = &opts.out {
+        std::fs::create_dir_all(dir).map_err(io(dir))?;
+        let path = dir.join("runs.jsonl");
+        if opts.resume {
+            for r in read_runs(&path) {
+                done.insert(r.index, r);
+            }
+            // Rewrite the file with only complete, ordered lines.
+            let mut f = std::fs::File::create(&path).map_err(io(&path))?;
+            for r in done.values() {
+                writeln!(f, "{}", serde_json::to_string(r).unwrap_or_default()).map_err(io(&path))?;
+            }
+        } else {
+            std::fs::File::create(&path).map_err(io(&path))?;
+        }
+        jsonl = Some(
+            std::fs::OpenOptions::new()
+                .append(true)
+                .open(&path)
+                .map_err(io(&path))?,
+        );
+    }
+    let pending: Vec<&RunSpec> = p.runs.iter().filter(|r| !done.contains_key(&r.index)).collect();
+    let jobs = if opts.jobs == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        opts.jobs
+    };
+    let bar = opts.progress.then(|| {
+        let b = indicatif::ProgressBar::new(p.runs.len() as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {elapsed_precise} (eta {eta})  {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b.set_position(done.len() as u64);
+        b
+    });
+    let next = AtomicUsize::new(0);
+    let (tx, rx) = crossbeam::channel::unbounded::<Result<RunRecord, SimError>>();
+    let mut error = None;
+    std::thread::scope(|s| {
+        for _ in 0..jobs.min(pending.len().max(1)) {
+            let tx = tx.clone();
+            let (next, pending) = (&next, &pending);
+            s.spawn(move || {
+                loop {
+                    let k = next.fetch_add(1, Ordering::SeqCst);
+                    let Some(spec) = pending.get(k) else { break };
+                    let frames_dir = opts
+                        .out
+                        .as_ref()
+                        .filter(|_| opts.per_run_files)
+                        .map(|d| d.join(format!("run-{:04}", spec.index)));
+                    if let Some(d) = &frames_dir {
+                        let _ = std::fs::create_dir_all(d);
+                    }
+                    let every = p.loaded.scenario.record.frames_every;
+                    let rec = run_one(p, spec, make_agent, frames_dir.as_deref().map(|d| (d, every)));
+                    if let (Ok(r), Some(d)) = (&rec, &frames_dir) {
+                        let _ = write_track_csv(&d.join("trajectory.csv"), r);
+                    }
+                    if tx.send(rec).is_err() {
+                        break;
+                    }
+                }
+            });
+        }
+        drop(tx);
+        // Write in campaign order.
+        let mut buffer: BTreeMap<usize, RunRecord> = BTreeMap::new();
+        let mut cursor = 0usize;
+        for rec in rx.iter() {
+            match rec {
+                Ok(r) => {
+                    if let Some(b) = &bar {
+                        b.inc(1);
+                        b.set_message(format!("last: start {} {}", r.start, r.outcome));
+                    }
+                    buffer.insert(r.index, r);
+                }
+                Err(e) => {
+                    error.get_or_insert(e);
+                    next.store(usize::MAX / 2, Ordering::SeqCst);
+                }
+            }
+            while cursor < p.runs.len() {
+                let idx = p.runs[cursor].index;
+                if done.contains_key(&idx) {
+                    cursor += 1;
+                    continue;
+                }
+                let Some(r) = buffer.remove(&idx) else { break };
+                if let Some(f) = jsonl.as_mut() {
+                    let _ = writeln!(f, "{}", serde_json::to_string(&r).unwrap_or_default());
+                    let _ = f.flush();
+                }
+                done.insert(idx, r);
+                cursor += 1;
+            }
+        }
+    });
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    if let Some(e) = error {
+        return Err(e);
+    }
+    let records: Vec<RunRecord> = done.into_values().collect();
+    let summary = summary(&p.loaded.scenario.name, &records);
+    if let Some(dir) = &opts.out {
+        let path = dir.join("summary.json");
+        std::fs::write(&path, serde_json::to_string_pretty(&summary).unwrap_or_default()).map_err(io(&path))?;
+        super::plot::write_plots(dir, &p.world, &p.loaded.profile, &records).map_err(io(dir))?;
+    }
+    Ok((records, summary))
+}
+
+/// Writes a run's track as CSV (t, x, y).
+pub fn write_track_csv(path: &Path, r: &RunRecord) -> std::io::Result<()> {
+    let mut s = String::from("t_s,x_m,y_m\n");
+    for (i, p) in r.track.iter().enumerate() {
+        s.push_str(&format!(
+            "{:.1},{:.3},{:.3}\n",
+            i as f64 * 0.5,
+            p[0] as f64 / 1000.0,
+            p[1] as f64 / 1000.0
+        ));
+    }
+    std::fs::write(path, s)
+}

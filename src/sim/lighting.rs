@@ -1,0 +1,597 @@
+//! Lighting programmes: time-varying illumination from a scenario.
+//!
+//! Irradiance on a surface = ambient (sky or room) + sun·max(0, n·s) + coloured flashers,
+//! all tinted by the illuminant; target surfaces can carry shadow bands (static, like the
+//! sonar's shadow of seed 004 Fig. 10b, or moving) and the robot's own shadow; glossy
+//! targets show a specular highlight of the key light (glare). Clouds switch the sun off
+//! and on at random (seeded) instants. Presets `lab`, `flashers`, `noon`, `dusk`, `clouds`
+//! and `dawn` reproduce DESIGN §2.1's conditions; every number can be set by hand.
+
+use super::rng::Rng;
+use super::scene::Tag;
+use crate::config::Validator;
+
+use nalgebra::{Point3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Named lighting conditions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LightingPreset {
+    /// Uniform fluorescent lab light.
+    Lab,
+    /// Lab light plus two rotating orange emergency lights 1.5 m from the fiducial, 0.5 m
+    /// either side (seed 004 §VI.B).
+    Flashers,
+    /// Outdoors at noon: high sun, hard shadow band, glare.
+    Noon,
+    /// Outdoors 90 min before sunset until dark: low warm sun, falling light.
+    Dusk,
+    /// Outdoors with sudden random cloud cover.
+    Clouds,
+    /// Outdoors at dawn: low, cool, rising light.
+    Dawn,
+}
+
+/// Illuminant colours (relative RGB).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Illuminant {
+    /// Neutral daylight.
+    Daylight,
+    /// Warm evening light.
+    Dusk,
+    /// Incandescent.
+    Tungsten,
+    /// Fluorescent (slightly green).
+    Fluorescent,
+    /// Cool morning light.
+    Dawn,
+}
+
+impl Illuminant {
+    /// Relative RGB irradiance.
+    pub fn rgb(&self) -> [f32; 3] {
+        match self {
+            Illuminant::Daylight => [1.0, 1.0, 1.0],
+            Illuminant::Dusk => [1.0, 0.72, 0.48],
+            Illuminant::Tungsten => [1.0, 0.68, 0.38],
+            Illuminant::Fluorescent => [0.95, 1.0, 0.92],
+            Illuminant::Dawn => [0.85, 0.9, 1.0],
+        }
+    }
+}
+
+/// A rotating beacon.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlasherSpec {
+    /// Position (world), m.
+    pub x_m: f64,
+    /// Position (world), m.
+    pub y_m: f64,
+    /// Height, m.
+    pub z_m: f64,
+    /// Rotation period, s.
+    pub period_s: f64,
+    /// Peak irradiance at 1 m, relative to the ambient.
+    pub power: f64,
+    /// Colour (sRGB).
+    pub rgb: [u8; 3],
+}
+
+/// A shadow band over the target surfaces.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShadowSpec {
+    /// Fraction of light removed inside the shadow (0–1).
+    pub strength: f64,
+    /// Direction of the shadow edge's normal in the target plane, degrees (0: the shadow
+    /// covers the target's +u side).
+    pub angle_deg: f64,
+    /// Edge position at rest, m from the target centre.
+    pub offset_m: f64,
+    /// Amplitude of the edge's motion, m (0: static).
+    pub amplitude_m: f64,
+    /// Period of the motion, s.
+    pub period_s: f64,
+    /// Penumbra width, m.
+    pub softness_m: f64,
+}
+
+/// Random cloud cover.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CloudSpec {
+    /// Mean time between sudden changes, s.
+    pub mean_interval_s: f64,
+    /// Fraction of the sun a cloud removes (0–1).
+    pub depth: f64,
+}
+
+/// A lighting programme. A preset fills in everything; any field given overrides it.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightingSpec {
+    /// Base preset (default `lab`).
+    #[serde(default)]
+    pub preset: Option<LightingPreset>,
+    /// Overall light multiplier.
+    #[serde(default)]
+    pub intensity: Option<f64>,
+    /// Illuminant colour.
+    #[serde(default)]
+    pub illuminant: Option<Illuminant>,
+    /// Ambient (sky or room) level.
+    #[serde(default)]
+    pub ambient: Option<f64>,
+    /// Sun level (0 indoors).
+    #[serde(default)]
+    pub sun: Option<f64>,
+    /// Sun elevation, degrees.
+    #[serde(default)]
+    pub sun_elevation_deg: Option<f64>,
+    /// Sun azimuth, degrees (0 = along +x, behind an approaching robot).
+    #[serde(default)]
+    pub sun_azimuth_deg: Option<f64>,
+    /// Specular glare strength on glossy targets.
+    #[serde(default)]
+    pub glare: Option<f64>,
+    /// Relative light change per hour of session time (dusk < 0, dawn > 0).
+    #[serde(default)]
+    pub change_per_hour: Option<f64>,
+    /// Each run starts at a random time in [0, session_s) of the session (the paper's
+    /// outdoor sessions lasted two hours at noon and 90 minutes at dusk).
+    #[serde(default)]
+    pub session_s: Option<f64>,
+    /// Rotating beacons.
+    #[serde(default)]
+    pub flashers: Option<Vec<FlasherSpec>>,
+    /// Shadow bands on the target.
+    #[serde(default)]
+    pub shadows: Option<Vec<ShadowSpec>>,
+    /// Cloud cover.
+    #[serde(default)]
+    pub clouds: Option<CloudSpec>,
+    /// The robot's own shadow falls on the target (outdoor presets).
+    #[serde(default)]
+    pub self_shadow: Option<bool>,
+}
+
+/// The resolved programme (preset + overrides).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lighting {
+    /// Overall multiplier.
+    pub intensity: f64,
+    /// Illuminant.
+    pub illuminant: Illuminant,
+    /// Ambient level.
+    pub ambient: f64,
+    /// Sun level.
+    pub sun: f64,
+    /// Unit vector toward the sun.
+    pub sun_dir: Vector3<f64>,
+    /// Glare strength.
+    pub glare: f64,
+    /// Relative change per hour.
+    pub change_per_hour: f64,
+    /// Session length, s.
+    pub session_s: f64,
+    /// Beacons.
+    pub flashers: Vec<FlasherSpec>,
+    /// Shadow bands.
+    pub shadows: Vec<ShadowSpec>,
+    /// Clouds.
+    pub clouds: Option<CloudSpec>,
+    /// Robot self-shadow.
+    pub self_shadow: bool,
+}
+
+impl LightingSpec {
+    /// Resolves the preset and overrides.
+    pub fn resolve(&self) -> Lighting {
+        let preset = self.preset.unwrap_or(LightingPreset::Lab);
+        let mut l = match preset {
+            LightingPreset::Lab | LightingPreset::Flashers => Lighting {
+                intensity: 1.0,
+                illuminant: Illuminant::Fluorescent,
+                ambient: 1.0,
+                sun: 0.0,
+                sun_dir: sun_vector(70.0, 0.0),
+                glare: 0.15,
+                change_per_hour: 0.0,
+                session_s: 0.0,
+                flashers: Vec::new(),
+                shadows: Vec::new(),
+                clouds: None,
+                self_shadow: false,
+            },
+            LightingPreset::Noon => Lighting {
+                intensity: 3.0,
+                illuminant: Illuminant::Daylight,
+                ambient: 0.35,
+                sun: 1.0,
+                sun_dir: sun_vector(65.0, 20.0),
+                glare: 1.2,
+                change_per_hour: 0.0,
+                session_s: 7200.0,
+                flashers: Vec::new(),
+                shadows: vec![ShadowSpec {
+                    strength: 0.7,
+                    angle_deg: 90.0,
+                    offset_m: 0.02,
+                    amplitude_m: 0.03,
+                    period_s: 90.0,
+                    softness_m: 0.01,
+                }],
+                clouds: None,
+                self_shadow: true,
+            },
+            LightingPreset::Dusk => Lighting {
+                intensity: 0.5,
+                illuminant: Illuminant::Dusk,
+                ambient: 0.45,
+                sun: 0.6,
+                sun_dir: sun_vector(6.0, -30.0),
+                glare: 0.8,
+                change_per_hour: -0.55,
+                session_s: 5400.0,
+                flashers: Vec::new(),
+                shadows: vec![ShadowSpec {
+                    strength: 0.6,
+                    angle_deg: 0.0,
+                    offset_m: 0.03,
+                    amplitude_m: 0.04,
+                    period_s: 120.0,
+                    softness_m: 0.02,
+                }],
+                clouds: None,
+                self_shadow: true,
+            },
+            LightingPreset::Clouds => Lighting {
+                intensity: 2.5,
+                illuminant: Illuminant::Daylight,
+                ambient: 0.35,
+                sun: 1.0,
+                sun_dir: sun_vector(50.0, 10.0),
+                glare: 0.8,
+                change_per_hour: 0.0,
+                session_s: 7200.0,
+                flashers: Vec::new(),
+                shadows: Vec::new(),
+                clouds: Some(CloudSpec {
+                    mean_interval_s: 15.0,
+                    depth: 0.85,
+                }),
+                self_shadow: true,
+            },
+            LightingPreset::Dawn => Lighting {
+                intensity: 0.4,
+                illuminant: Illuminant::Dawn,
+                ambient: 0.5,
+                sun: 0.5,
+                sun_dir: sun_vector(4.0, 160.0),
+                glare: 0.5,
+                change_per_hour: 0.8,
+                session_s: 0.0,
+                flashers: Vec::new(),
+                shadows: Vec::new(),
+                clouds: None,
+                self_shadow: true,
+            },
+        };
+        if preset == LightingPreset::Flashers {
+            l.flashers = [-0.5, 0.5]
+                .iter()
+                .map(|&y| FlasherSpec {
+                    x_m: 1.5,
+                    y_m: y,
+                    z_m: 0.6,
+                    period_s: 1.2,
+                    power: 2.5,
+                    rgb: [255, 120, 0],
+                })
+                .collect();
+        }
+        if let Some(v) = self.intensity {
+            l.intensity = v;
+        }
+        if let Some(v) = self.illuminant {
+            l.illuminant = v;
+        }
+        if let Some(v) = self.ambient {
+            l.ambient = v;
+        }
+        if let Some(v) = self.sun {
+            l.sun = v;
+        }
+        if self.sun_elevation_deg.is_some() || self.sun_azimuth_deg.is_some() {
+            let (e, a) = sun_angles(&l.sun_dir);
+            l.sun_dir = sun_vector(self.sun_elevation_deg.unwrap_or(e), self.sun_azimuth_deg.unwrap_or(a));
+        }
+        if let Some(v) = self.glare {
+            l.glare = v;
+        }
+        if let Some(v) = self.change_per_hour {
+            l.change_per_hour = v;
+        }
+        if let Some(v) = self.session_s {
+            l.session_s = v;
+        }
+        if let Some(v) = &self.flashers {
+            l.flashers = v.clone();
+        }
+        if let Some(v) = &self.shadows {
+            l.shadows = v.clone();
+        }
+        if let Some(v) = self.clouds {
+            l.clouds = Some(v);
+        }
+        if let Some(v) = self.self_shadow {
+            l.self_shadow = v;
+        }
+        l
+    }
+
+    pub(crate) fn validate_at(&self, base: &str, v: &mut Validator<'_>) {
+        let p = |f: &str| format!("{base}.{f}");
+        for (f, x) in [
+            ("intensity", self.intensity),
+            ("ambient", self.ambient),
+            ("sun", self.sun),
+            ("glare", self.glare),
+        ] {
+            if let Some(x) = x {
+                v.non_negative(&p(f), x);
+            }
+        }
+        if let Some(x) = self.intensity {
+            v.require(x > 0.0, &p("intensity"), || {
+                format!("expected a positive intensity, got {x}")
+            });
+        }
+        if let Some(e) = self.sun_elevation_deg {
+            v.range(&p("sun_elevation_deg"), e, -10.0, 90.0);
+        }
+        if let Some(s) = self.session_s {
+            v.non_negative(&p("session_s"), s);
+        }
+        if let Some(c) = self.change_per_hour {
+            v.range(&p("change_per_hour"), c, -0.99, 10.0);
+        }
+        for (i, f) in self.flashers.iter().flatten().enumerate() {
+            v.positive(&p(&format!("flashers[{i}].period_s")), f.period_s);
+            v.non_negative(&p(&format!("flashers[{i}].power")), f.power);
+        }
+        for (i, s) in self.shadows.iter().flatten().enumerate() {
+            v.range(&p(&format!("shadows[{i}].strength")), s.strength, 0.0, 1.0);
+            v.non_negative(&p(&format!("shadows[{i}].softness_m")), s.softness_m);
+            v.positive(&p(&format!("shadows[{i}].period_s")), s.period_s);
+        }
+        if let Some(c) = self.clouds {
+            v.positive(&p("clouds.mean_interval_s"), c.mean_interval_s);
+            v.range(&p("clouds.depth"), c.depth, 0.0, 1.0);
+        }
+    }
+}
+
+fn sun_vector(elev_deg: f64, az_deg: f64) -> Vector3<f64> {
+    let (e, a) = (elev_deg.to_radians(), az_deg.to_radians());
+    Vector3::new(e.cos() * a.cos(), e.cos() * a.sin(), e.sin())
+}
+
+fn sun_angles(v: &Vector3<f64>) -> (f64, f64) {
+    (v.z.asin().to_degrees(), v.y.atan2(v.x).to_degrees())
+}
+
+/// A shadow band evaluated at one instant, in a target's local coordinates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowBand {
+    /// Edge normal (cos, sin) in (a, b).
+    pub cos: f32,
+    /// See `cos`.
+    pub sin: f32,
+    /// Edge offset, m.
+    pub offset: f32,
+    /// Penumbra, m.
+    pub softness: f32,
+    /// Light removed.
+    pub strength: f32,
+}
+
+/// One run's lighting: the programme plus its seeded randomness (start time in the
+/// session, cloud switching instants).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightingRun {
+    lighting: Lighting,
+    start_s: f64,
+    cloud_switches: Vec<f64>,
+}
+
+impl LightingRun {
+    /// Instantiates `lighting` for one run; `horizon_s` bounds the cloud schedule.
+    pub fn new(lighting: Lighting, rng: &mut Rng, horizon_s: f64) -> Self {
+        let start_s = rng.uniform() * lighting.session_s;
+        let mut cloud_switches = Vec::new();
+        if let Some(c) = lighting.clouds {
+            let mut t = 0.0;
+            while t < horizon_s {
+                t += -c.mean_interval_s * (1.0 - rng.uniform()).ln();
+                cloud_switches.push(t);
+            }
+        }
+        Self {
+            lighting,
+            start_s,
+            cloud_switches,
+        }
+    }
+
+    /// Delays the session clock by `s` seconds (e.g. hours asleep between imprint and dock).
+    pub fn advance_session(&mut self, s: f64) {
+        self.start_s += s;
+    }
+
+    /// The resolved programme.
+    pub fn lighting(&self) -> &Lighting {
+        &self.lighting
+    }
+
+    /// The state at run time `t` (s).
+    pub fn at(&self, t: f64) -> LightState {
+        let l = &self.lighting;
+        let hours = (self.start_s + t) / 3600.0;
+        let level = (l.intensity * (1.0 + l.change_per_hour * hours)).max(0.02 * l.intensity);
+        let clouded = self.cloud_switches.iter().take_while(|&&s| s <= t).count() % 2 == 1;
+        let sun = l.sun
+            * if clouded {
+                1.0 - l.clouds.map_or(0.0, |c| c.depth)
+            } else {
+                1.0
+            };
+        let shadows = l
+            .shadows
+            .iter()
+            .map(|s| {
+                let off = s.offset_m + s.amplitude_m * (std::f64::consts::TAU * t / s.period_s).sin();
+                let a = s.angle_deg.to_radians();
+                ShadowBand {
+                    cos: a.cos() as f32,
+                    sin: a.sin() as f32,
+                    offset: off as f32,
+                    softness: s.softness_m as f32,
+                    strength: s.strength as f32,
+                }
+            })
+            .collect();
+        LightState {
+            illum: l.illuminant.rgb(),
+            level: level as f32,
+            ambient: l.ambient as f32,
+            sun: sun as f32,
+            sun_dir: l.sun_dir,
+            glare: (l.glare * sun.max(0.3)) as f32,
+            flashers: l
+                .flashers
+                .iter()
+                .map(|f| {
+                    let angle = std::f64::consts::TAU * t / f.period_s;
+                    (
+                        Point3::new(f.x_m, f.y_m, f.z_m),
+                        angle,
+                        f.power as f32,
+                        super::scene::albedo(f.rgb, 1.0),
+                    )
+                })
+                .collect(),
+            shadows,
+        }
+    }
+
+    /// True when the robot's own shadow should be cast on the target.
+    pub fn self_shadow(&self) -> bool {
+        self.lighting.self_shadow
+    }
+}
+
+/// Lighting at one instant, as the renderer uses it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightState {
+    illum: [f32; 3],
+    level: f32,
+    ambient: f32,
+    sun: f32,
+    sun_dir: Vector3<f64>,
+    glare: f32,
+    flashers: Vec<(Point3<f64>, f64, f32, [f32; 3])>,
+    shadows: Vec<ShadowBand>,
+}
+
+impl LightState {
+    /// Plain uniform light of `level` (for tests).
+    pub fn uniform(level: f32) -> Self {
+        Self {
+            illum: [1.0; 3],
+            level,
+            ambient: 1.0,
+            sun: 0.0,
+            sun_dir: Vector3::z(),
+            glare: 0.0,
+            flashers: Vec::new(),
+            shadows: Vec::new(),
+        }
+    }
+
+    /// Adds a shadow band on the targets for this instant (e.g. the robot's own shadow).
+    pub fn push_target_shadow(&mut self, band: ShadowBand) {
+        self.shadows.push(band);
+    }
+
+    /// Unit vector toward the sun and the sun's level (0 indoors or under cloud).
+    pub fn sun(&self) -> (Vector3<f64>, f32) {
+        (self.sun_dir, self.sun)
+    }
+
+    /// Irradiance (linear RGB) on a surface with world normal `n` at `at`.
+    pub fn irradiance_at(&self, n: &Vector3<f64>, at: &Point3<f64>, tag: Tag) -> [f32; 3] {
+        let direct = self.sun * (n.dot(&self.sun_dir).max(0.0) as f32);
+        let mut e = [0.0f32; 3];
+        for (c, v) in e.iter_mut().enumerate() {
+            *v = self.illum[c] * self.level * (self.ambient + direct);
+        }
+        if tag != Tag::Backdrop {
+            for (pos, angle, power, rgb) in &self.flashers {
+                let d = pos - at;
+                let dist = d.norm().max(0.2);
+                let dir = d / dist;
+                // Beam sweeping in the horizontal plane; the lit fraction is its lobe.
+                let beam = Vector3::new(angle.cos(), angle.sin(), 0.0);
+                let lobe = (-beam.dot(&dir)).max(0.0).powi(6) as f32;
+                let facing = n.dot(&dir).max(0.0) as f32;
+                for c in 0..3 {
+                    e[c] += power * lobe * facing * rgb[c] / (dist * dist) as f32;
+                }
+            }
+        }
+        e
+    }
+
+    /// Irradiance at no particular place (flashers ignored): ground and backdrops.
+    pub fn irradiance(&self, n: &Vector3<f64>, tag: Tag) -> [f32; 3] {
+        self.irradiance_at(
+            n,
+            &Point3::new(1e6, 1e6, 1e6),
+            if tag == Tag::Backdrop { tag } else { Tag::Backdrop },
+        )
+    }
+
+    /// Sky brightness multiplier.
+    pub fn sky_scale(&self) -> f32 {
+        self.level * (self.ambient + 0.5 * self.sun)
+    }
+
+    /// Direction (world) of the key light for highlights.
+    pub fn key_direction(&self) -> Vector3<f64> {
+        self.sun_dir
+    }
+
+    /// Colour of highlights.
+    pub fn key_colour(&self) -> [f32; 3] {
+        [0, 1, 2].map(|c| self.illum[c] * self.level * 4.0)
+    }
+
+    /// Glare multiplier.
+    pub fn glare_strength(&self) -> f32 {
+        self.glare
+    }
+
+    /// Shadow bands applying to primitives tagged `tag`.
+    pub fn shadows_for(&self, tag: Tag) -> &[ShadowBand] {
+        if tag == Tag::Target { &self.shadows } else { &[] }
+    }
+
+    /// Mean scene level (for tests).
+    pub fn level(&self) -> f32 {
+        self.level
+    }
+}

@@ -1,0 +1,40 @@
+//! The embedded simulator: rendered cameras, lighting, motion with slip, contact, tether,
+//! scenarios and trial campaigns.
+
+pub mod camera;
+pub mod lighting;
+pub mod render;
+pub mod rng;
+pub mod scene;
+pub mod world;
+
+use thiserror::Error;
+
+/// Simulator errors.
+#[derive(Debug, Error)]
+pub enum SimError {
+    /// The simulator cannot (yet) build what the profile describes.
+    #[error("not supported by the simulator: {0}")]
+    Unsupported(String),
+    /// A scenario file problem.
+    #[error(transparent)]
+    Config(#[from] crate::config::ConfigError),
+    /// An image (backdrop) could not be loaded.
+    #[error(transparent)]
+    Image(#[from] crate::cli::image_io::ImageFileError),
+    /// Output could not be written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The path.
+        path: String,
+        /// Why.
+        source: std::io::Error,
+    },
+}
+pub mod campaign;
+pub mod dock;
+pub mod engine;
+pub mod motion;
+pub mod plot;
+pub mod scenario;
+pub mod tether;

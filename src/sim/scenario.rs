@@ -1,0 +1,540 @@
+//! Scenario files: experiments as data.
+//!
+//! A scenario names a profile, the start poses (a built-in grid such as `paper16`, or an
+//! explicit list), trials per start, a seed, the axes that vary (lighting programmes,
+//! segmentation modes, terrains), sensor noise, motion, imprinting, clutter and backdrop
+//! photos. `marsupial check` validates it with the same errors as profiles. Paths are
+//! relative to the scenario file.
+
+use super::lighting::{Lighting, LightingPreset, LightingSpec};
+use super::motion::{SlipSpec, Terrain};
+use super::render::SensorParams;
+use super::world::ClutterSpec;
+use crate::config::{self, ConfigError, Validate, Validator};
+use crate::geometry::Pose2;
+use crate::profile::{Profile, SegmentationMode};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Built-in start grids.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Grid {
+    /// The 16 positions of seed 004 Fig. 8 (DESIGN §2.1): 0.33 m at −a, 0°, +a (a =
+    /// `corner_angle_deg`); 0.5 m at −30, 0, 30°; 1.33 m and 2 m at −60, −30, 0, 30, 60°.
+    Paper16,
+}
+
+/// One explicit start: polar (distance, angle from the dock axis) or Cartesian.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StartPoint {
+    /// Distance from the dock entrance, m.
+    #[serde(default)]
+    pub distance_m: Option<f64>,
+    /// Angle off the dock axis, degrees (positive toward +y).
+    #[serde(default)]
+    pub angle_deg: Option<f64>,
+    /// x, m.
+    #[serde(default)]
+    pub x_m: Option<f64>,
+    /// y, m.
+    #[serde(default)]
+    pub y_m: Option<f64>,
+    /// Heading, degrees; default: the camera faces the dock.
+    #[serde(default)]
+    pub heading_deg: Option<f64>,
+    /// Label in tables (default: its 1-based position in the list).
+    #[serde(default)]
+    pub label: Option<String>,
+}
+
+/// `[starts]`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StartsSpec {
+    /// A built-in grid.
+    #[serde(default)]
+    pub grid: Option<Grid>,
+    /// Use only these 1-based grid positions.
+    #[serde(default)]
+    pub select: Option<Vec<usize>>,
+    /// Angle of grid positions 1 and 3, degrees (the paper's is not recoverable).
+    #[serde(default = "default_corner")]
+    pub corner_angle_deg: f64,
+    /// Explicit starts (instead of, or after, the grid).
+    #[serde(default)]
+    pub points: Vec<StartPoint>,
+    /// SD of the placement error, m.
+    #[serde(default)]
+    pub position_jitter_m: f64,
+    /// SD of the heading placement error, degrees.
+    #[serde(default)]
+    pub heading_jitter_deg: f64,
+}
+
+fn default_corner() -> f64 {
+    70.0
+}
+
+/// `[axes]`: what varies across runs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxesSpec {
+    /// Lighting programmes: preset names or keys of `[lighting.NAME]`.
+    #[serde(default = "default_lighting")]
+    pub lighting: Vec<String>,
+    /// Segmentation modes.
+    #[serde(default = "default_segmentation")]
+    pub segmentation: Vec<SegmentationMode>,
+    /// Terrains.
+    #[serde(default = "default_terrain")]
+    pub terrain: Vec<Terrain>,
+}
+
+impl Default for AxesSpec {
+    fn default() -> Self {
+        Self {
+            lighting: default_lighting(),
+            segmentation: default_segmentation(),
+            terrain: default_terrain(),
+        }
+    }
+}
+
+fn default_lighting() -> Vec<String> {
+    vec!["lab".into()]
+}
+fn default_segmentation() -> Vec<SegmentationMode> {
+    vec![SegmentationMode::Adaptive]
+}
+fn default_terrain() -> Vec<Terrain> {
+    vec![Terrain::LabFloor]
+}
+
+/// `[sensor]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SensorSpec {
+    /// Read noise SD, 8-bit units.
+    pub read_noise: f64,
+    /// Shot noise scale.
+    pub shot_noise: f64,
+    /// Auto-exposure on.
+    pub auto_exposure: bool,
+    /// White balance for this illuminant (`None`: balanced for each run's illuminant).
+    pub white_balance_for: Option<super::lighting::Illuminant>,
+}
+
+impl Default for SensorSpec {
+    fn default() -> Self {
+        Self {
+            read_noise: 1.5,
+            shot_noise: 0.35,
+            auto_exposure: true,
+            white_balance_for: None,
+        }
+    }
+}
+
+/// `[motion]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MotionSpec {
+    /// Command latency, s.
+    pub latency_s: f64,
+    /// Linear acceleration limit, m/s².
+    pub accel_mps2: f64,
+    /// Yaw acceleration limit, deg/s².
+    pub yaw_accel_dps2: f64,
+    /// Slip override (default: the terrain's).
+    pub slip: Option<SlipSpec>,
+    /// Multiplier on the terrain's slip (1 = as tabulated).
+    pub slip_scale: f64,
+}
+
+impl Default for MotionSpec {
+    fn default() -> Self {
+        Self {
+            latency_s: 0.1,
+            accel_mps2: 0.5,
+            yaw_accel_dps2: 120.0,
+            slip: None,
+            slip_scale: 1.0,
+        }
+    }
+}
+
+/// `[imprint]`: what happens before each docking run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ImprintSpec {
+    /// Run the departure (undock + imprint) first.
+    pub enabled: bool,
+    /// Lighting during departure (default: the run's).
+    pub lighting: Option<String>,
+    /// Seconds between departure and docking (the session clock advances).
+    pub sleep_s: f64,
+}
+
+impl Default for ImprintSpec {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            lighting: None,
+            sleep_s: 0.0,
+        }
+    }
+}
+
+/// `[record]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct RecordSpec {
+    /// Save every Nth camera frame as PNG with `--out` (0: none).
+    pub frames_every: u32,
+}
+
+/// A scenario file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Name.
+    pub name: String,
+    /// Description.
+    #[serde(default)]
+    pub description: String,
+    /// Profile path (relative to the scenario file).
+    pub profile: PathBuf,
+    /// Campaign seed.
+    #[serde(default)]
+    pub seed: u64,
+    /// Trials per start and axis combination.
+    #[serde(default = "one")]
+    pub trials: u32,
+    /// Run time limit, s (default 150, the paper's).
+    #[serde(default = "default_timeout")]
+    pub timeout_s: f64,
+    /// Physics step, s.
+    #[serde(default = "default_dt")]
+    pub dt_s: f64,
+    /// Starts.
+    pub starts: StartsSpec,
+    /// Varying axes.
+    #[serde(default)]
+    pub axes: AxesSpec,
+    /// Named lighting programmes.
+    #[serde(default)]
+    pub lighting: BTreeMap<String, LightingSpec>,
+    /// Sensor.
+    #[serde(default)]
+    pub sensor: SensorSpec,
+    /// Motion.
+    #[serde(default)]
+    pub motion: MotionSpec,
+    /// Departure and imprinting.
+    #[serde(default)]
+    pub imprint: ImprintSpec,
+    /// Clutter.
+    #[serde(default)]
+    pub clutter: Vec<ClutterSpec>,
+    /// Backdrop photos (relative to the scenario file).
+    #[serde(default)]
+    pub backgrounds: Vec<PathBuf>,
+    /// Recording.
+    #[serde(default)]
+    pub record: RecordSpec,
+}
+
+fn one() -> u32 {
+    1
+}
+fn default_timeout() -> f64 {
+    150.0
+}
+fn default_dt() -> f64 {
+    0.01
+}
+
+fn preset_named(name: &str) -> Option<LightingPreset> {
+    match name {
+        "lab" => Some(LightingPreset::Lab),
+        "flashers" => Some(LightingPreset::Flashers),
+        "noon" => Some(LightingPreset::Noon),
+        "dusk" => Some(LightingPreset::Dusk),
+        "clouds" => Some(LightingPreset::Clouds),
+        "dawn" => Some(LightingPreset::Dawn),
+        _ => None,
+    }
+}
+
+impl Validate for Scenario {
+    fn validate(&self, v: &mut Validator<'_>) {
+        v.require(!self.name.trim().is_empty(), "name", || {
+            "expected a non-empty name".into()
+        });
+        v.require(self.trials >= 1, "trials", || "expected at least 1 trial".into());
+        v.positive("timeout_s", self.timeout_s);
+        v.require(self.dt_s > 0.0 && self.dt_s <= 0.05, "dt_s", || {
+            format!("expected a physics step in (0, 0.05] s, got {}", self.dt_s)
+        });
+        let s = &self.starts;
+        v.require(s.grid.is_some() || !s.points.is_empty(), "starts", || {
+            "expected a `grid` or at least one entry in `points`".into()
+        });
+        if let Some(sel) = &s.select {
+            v.require(s.grid.is_some(), "starts.select", || "`select` needs a `grid`".into());
+            for (i, p) in sel.iter().enumerate() {
+                v.require((1..=16).contains(p), &format!("starts.select[{i}]"), || {
+                    format!("expected a grid position 1–16, got {p}")
+                });
+            }
+        }
+        v.range("starts.corner_angle_deg", s.corner_angle_deg, 0.0, 90.0);
+        v.non_negative("starts.position_jitter_m", s.position_jitter_m);
+        v.non_negative("starts.heading_jitter_deg", s.heading_jitter_deg);
+        for (i, p) in s.points.iter().enumerate() {
+            let base = format!("starts.points[{i}]");
+            let polar = p.distance_m.is_some() && p.angle_deg.is_some();
+            let cart = p.x_m.is_some() && p.y_m.is_some();
+            v.require(polar != cart, &base, || {
+                "expected either distance_m and angle_deg, or x_m and y_m".into()
+            });
+            if let Some(d) = p.distance_m {
+                v.positive(&format!("{base}.distance_m"), d);
+            }
+        }
+        for (field, n) in [
+            ("axes.lighting", self.axes.lighting.len()),
+            ("axes.segmentation", self.axes.segmentation.len()),
+            ("axes.terrain", self.axes.terrain.len()),
+        ] {
+            v.require(n >= 1, field, || "expected at least one value".into());
+        }
+        for (i, name) in self.axes.lighting.iter().enumerate() {
+            v.require(self.lighting.contains_key(name) || preset_named(name).is_some(), &format!("axes.lighting[{i}]"), || {
+                format!("unknown lighting `{name}`: expected a preset (lab, flashers, noon, dusk, clouds, dawn) or a [lighting.{name}] table")
+            });
+        }
+        if let Some(name) = &self.imprint.lighting {
+            v.require(
+                self.lighting.contains_key(name) || preset_named(name).is_some(),
+                "imprint.lighting",
+                || format!("unknown lighting `{name}`"),
+            );
+        }
+        v.non_negative("imprint.sleep_s", self.imprint.sleep_s);
+        for (name, l) in &self.lighting {
+            l.validate_at(&format!("lighting.{name}"), v);
+        }
+        v.non_negative("sensor.read_noise", self.sensor.read_noise);
+        v.non_negative("sensor.shot_noise", self.sensor.shot_noise);
+        v.non_negative("motion.latency_s", self.motion.latency_s);
+        v.positive("motion.accel_mps2", self.motion.accel_mps2);
+        v.positive("motion.yaw_accel_dps2", self.motion.yaw_accel_dps2);
+        v.non_negative("motion.slip_scale", self.motion.slip_scale);
+        for (i, c) in self.clutter.iter().enumerate() {
+            v.finite(&format!("clutter[{i}].x_m"), c.x_m);
+            v.finite(&format!("clutter[{i}].y_m"), c.y_m);
+            v.require(
+                c.size_m.iter().all(|s| s.is_finite() && *s > 0.0),
+                &format!("clutter[{i}].size_m"),
+                || "expected positive sizes".into(),
+            );
+        }
+    }
+}
+
+/// A start pose with its label.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Start {
+    /// Label ("1" … "16" for the grid).
+    pub label: String,
+    /// Pose before jitter.
+    pub pose: Pose2,
+    /// Distance from the entrance, m.
+    pub distance: f64,
+    /// Angle off the axis, degrees.
+    pub angle_deg: f64,
+}
+
+/// One run of a campaign.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSpec {
+    /// Index in the campaign.
+    pub index: usize,
+    /// Start.
+    pub start: Start,
+    /// Lighting programme name.
+    pub lighting: String,
+    /// Segmentation mode.
+    pub segmentation: SegmentationMode,
+    /// Terrain.
+    pub terrain: Terrain,
+    /// Trial number.
+    pub trial: u32,
+    /// This run's seed.
+    pub seed: u64,
+    /// Seed shared by runs that differ only in segmentation (paired on the same imprint).
+    pub pair_seed: u64,
+}
+
+/// A loaded scenario with its profile.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    /// The scenario.
+    pub scenario: Scenario,
+    /// Its file.
+    pub file: PathBuf,
+    /// The profile it names.
+    pub profile: Profile,
+}
+
+impl Scenario {
+    /// Loads and validates a scenario and the profile it names.
+    ///
+    /// # Errors
+    /// [`ConfigError`] for the scenario or its profile.
+    pub fn load(path: &Path) -> Result<Loaded, ConfigError> {
+        let scenario: Scenario = config::load(path)?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let profile = Profile::load(&dir.join(&scenario.profile))?;
+        for (i, b) in scenario.backgrounds.iter().enumerate() {
+            let p = dir.join(b);
+            if !p.is_file() {
+                return Err(ConfigError::Invalid {
+                    file: path.to_path_buf(),
+                    problems: vec![config::Problem {
+                        path: format!("backgrounds[{i}]"),
+                        line: None,
+                        message: format!("file {} not found", p.display()),
+                    }],
+                });
+            }
+        }
+        Ok(Loaded {
+            scenario,
+            file: path.to_path_buf(),
+            profile,
+        })
+    }
+
+    /// The resolved lighting programme called `name`.
+    pub fn lighting_named(&self, name: &str) -> Lighting {
+        match self.lighting.get(name) {
+            Some(spec) => spec.resolve(),
+            None => LightingSpec {
+                preset: preset_named(name),
+                ..Default::default()
+            }
+            .resolve(),
+        }
+    }
+
+    /// Sensor parameters for a run under `lighting`.
+    pub fn sensor_params(&self, lighting: &Lighting) -> SensorParams {
+        let illum = self.sensor.white_balance_for.unwrap_or(lighting.illuminant).rgb();
+        SensorParams {
+            read_noise: self.sensor.read_noise as f32,
+            shot_noise: self.sensor.shot_noise as f32,
+            auto_exposure: self.sensor.auto_exposure,
+            white_balance: illum.map(|c| 1.0 / c),
+            ..SensorParams::default()
+        }
+    }
+
+    /// Slip on `terrain` for this scenario.
+    pub fn slip(&self, terrain: Terrain) -> SlipSpec {
+        let s = self.motion.slip.unwrap_or_else(|| terrain.slip());
+        let k = self.motion.slip_scale;
+        SlipSpec {
+            slip_straight: s.slip_straight * k,
+            slip_turn: (s.slip_turn * k).min(0.95),
+            noise: s.noise * k,
+            heading_noise: s.heading_noise * k,
+        }
+    }
+
+    /// The start poses, in order. Headings default to "camera facing the dock".
+    pub fn starts(&self, profile: &Profile) -> Vec<Start> {
+        let cam_yaw = profile.cameras.first().map_or(0.0, |c| c.mount.yaw_deg.to_radians());
+        let make = |label: String, x: f64, y: f64, heading: Option<f64>| {
+            let theta = heading.map(f64::to_radians).unwrap_or_else(|| (-y).atan2(-x) - cam_yaw);
+            Start {
+                label,
+                pose: Pose2::new(x, y, theta),
+                distance: x.hypot(y),
+                angle_deg: y.atan2(x).to_degrees(),
+            }
+        };
+        let mut out = Vec::new();
+        if self.starts.grid == Some(Grid::Paper16) {
+            let a = self.starts.corner_angle_deg;
+            let grid: [(f64, f64); 16] = [
+                (0.33, -a),
+                (0.33, 0.0),
+                (0.33, a),
+                (0.5, -30.0),
+                (0.5, 0.0),
+                (0.5, 30.0),
+                (1.33, -60.0),
+                (1.33, -30.0),
+                (1.33, 0.0),
+                (1.33, 30.0),
+                (1.33, 60.0),
+                (2.0, -60.0),
+                (2.0, -30.0),
+                (2.0, 0.0),
+                (2.0, 30.0),
+                (2.0, 60.0),
+            ];
+            for (i, (d, ang)) in grid.iter().enumerate() {
+                if self.starts.select.as_ref().is_some_and(|s| !s.contains(&(i + 1))) {
+                    continue;
+                }
+                let r = ang.to_radians();
+                out.push(make((i + 1).to_string(), d * r.cos(), d * r.sin(), None));
+            }
+        }
+        for (i, p) in self.starts.points.iter().enumerate() {
+            let (x, y) = match (p.distance_m, p.angle_deg, p.x_m, p.y_m) {
+                (Some(d), Some(a), _, _) => (d * a.to_radians().cos(), d * a.to_radians().sin()),
+                (_, _, Some(x), Some(y)) => (x, y),
+                _ => continue,
+            };
+            let label = p.label.clone().unwrap_or_else(|| format!("p{}", i + 1));
+            out.push(make(label, x, y, p.heading_deg));
+        }
+        out
+    }
+
+    /// Every run of the campaign in a fixed order: starts × lighting × segmentation ×
+    /// terrain × trials.
+    pub fn runs(&self, profile: &Profile) -> Vec<RunSpec> {
+        let mut out = Vec::new();
+        for (si, start) in self.starts(profile).into_iter().enumerate() {
+            for (li, lighting) in self.axes.lighting.iter().enumerate() {
+                for seg in &self.axes.segmentation {
+                    for (ti, terrain) in self.axes.terrain.iter().enumerate() {
+                        for trial in 0..self.trials {
+                            let index = out.len();
+                            let key = ((si as u64) << 40) ^ ((li as u64) << 32) ^ ((ti as u64) << 24) ^ trial as u64;
+                            out.push(RunSpec {
+                                index,
+                                start: start.clone(),
+                                lighting: lighting.clone(),
+                                segmentation: *seg,
+                                terrain: *terrain,
+                                trial,
+                                seed: super::rng::splitmix64(self.seed ^ super::rng::splitmix64(index as u64 + 1)),
+                                pair_seed: super::rng::splitmix64(self.seed ^ super::rng::splitmix64(key ^ 0xA11CE)),
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+}

@@ -1,0 +1,184 @@
+//! 3-D scene description: textured planar primitives and spheres in the world frame.
+//!
+//! World (dock) frame: origin at the middle of the dock entrance on the ground, +x out of
+//! the dock along its axis (toward the approach zone), +z up. Metres.
+
+use crate::perception::RgbImage;
+use nalgebra::{Point3, Vector3};
+use std::sync::Arc;
+
+/// Linear-light albedo from an sRGB byte colour, scaled by a paint reflectance.
+pub fn albedo(srgb: [u8; 3], reflectance: f32) -> [f32; 3] {
+    srgb.map(|c| srgb_to_linear(c as f32 / 255.0) * reflectance)
+}
+
+/// sRGB transfer function inverse.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// What a surface looks like, as a function of its local coordinates (a, b) in metres
+/// (a along the primitive's `u` axis, b along `v`, origin at its centre).
+#[derive(Debug, Clone)]
+pub enum Material {
+    /// One linear albedo.
+    Solid([f32; 3]),
+    /// Two halves split at a = 0: `left` for a < 0, `right` for a ≥ 0 (anti-aliased).
+    TwoBlock {
+        /// Albedo for a < 0.
+        left: [f32; 3],
+        /// Albedo for a ≥ 0.
+        right: [f32; 3],
+    },
+    /// A photo stretched over the primitive (row 0 at b = +half_v, column 0 at a = −half_u).
+    Image(Arc<RgbImage>),
+    /// Value noise in cells of `cell` metres around `base` with relative contrast `contrast`.
+    Noise {
+        /// Mean albedo.
+        base: [f32; 3],
+        /// Relative amplitude.
+        contrast: f32,
+        /// Cell size, m.
+        cell: f32,
+    },
+}
+
+/// Geometry of a primitive.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Shape {
+    /// A rectangle: centre, unit axes `u` and `v` (normal = u × v), half extents.
+    Rect {
+        /// Centre.
+        centre: Point3<f64>,
+        /// First in-plane axis (unit).
+        u: Vector3<f64>,
+        /// Second in-plane axis (unit).
+        v: Vector3<f64>,
+        /// Half extents along u and v, m.
+        half: [f64; 2],
+    },
+    /// A disc: centre, in-plane axes, radius.
+    Disc {
+        /// Centre.
+        centre: Point3<f64>,
+        /// First in-plane axis (unit).
+        u: Vector3<f64>,
+        /// Second in-plane axis (unit).
+        v: Vector3<f64>,
+        /// Radius, m.
+        radius: f64,
+    },
+    /// A triangle.
+    Triangle {
+        /// Vertices.
+        p: [Point3<f64>; 3],
+    },
+    /// A sphere.
+    Sphere {
+        /// Centre.
+        centre: Point3<f64>,
+        /// Radius, m.
+        radius: f64,
+    },
+}
+
+/// What a primitive is, so lighting effects can target it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tag {
+    /// Part of a docking target (fiducial, pyramid, module markers).
+    Target,
+    /// The mother robot or dock body.
+    Body,
+    /// Clutter.
+    Clutter,
+    /// Background walls and photos.
+    Backdrop,
+    /// The robot's own parts.
+    Own,
+}
+
+/// One renderable object.
+#[derive(Debug, Clone)]
+pub struct Prim {
+    /// Geometry.
+    pub shape: Shape,
+    /// Appearance.
+    pub material: Material,
+    /// Specular strength (0 = matte).
+    pub gloss: f32,
+    /// Seen from both sides (otherwise only from the side the normal points to).
+    pub two_sided: bool,
+    /// Role.
+    pub tag: Tag,
+}
+
+impl Prim {
+    /// A matte, one-sided primitive.
+    pub fn new(shape: Shape, material: Material, tag: Tag) -> Self {
+        Self {
+            shape,
+            material,
+            gloss: 0.0,
+            two_sided: false,
+            tag,
+        }
+    }
+
+    /// Corner points bounding the primitive (for screen-space culling).
+    pub fn bounds(&self) -> Vec<Point3<f64>> {
+        match &self.shape {
+            Shape::Rect { centre, u, v, half } => [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .iter()
+                .map(|(a, b)| centre + u * (a * half[0]) + v * (b * half[1]))
+                .collect(),
+            Shape::Disc { centre, u, v, radius } => [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .iter()
+                .map(|(a, b)| centre + u * (a * radius) + v * (b * radius))
+                .collect(),
+            Shape::Triangle { p } => p.to_vec(),
+            Shape::Sphere { centre, radius } => {
+                let mut out = Vec::with_capacity(8);
+                for dx in [-1.0, 1.0] {
+                    for dy in [-1.0, 1.0] {
+                        for dz in [-1.0, 1.0] {
+                            out.push(centre + Vector3::new(dx, dy, dz) * *radius);
+                        }
+                    }
+                }
+                out
+            }
+        }
+    }
+}
+
+/// Axis-aligned box as five visible faces (no bottom): helper for bodies and clutter.
+pub fn boxed(min: Point3<f64>, max: Point3<f64>, material: Material, tag: Tag) -> Vec<Prim> {
+    let c = Point3::from((min.coords + max.coords) / 2.0);
+    let h = (max - min) / 2.0;
+    let (x, y, z) = (Vector3::x(), Vector3::y(), Vector3::z());
+    let face = |centre: Point3<f64>, u: Vector3<f64>, v: Vector3<f64>, half: [f64; 2]| {
+        Prim::new(Shape::Rect { centre, u, v, half }, material.clone(), tag)
+    };
+    vec![
+        face(c + x * h.x, y, z, [h.y, h.z]),  // +x face, normal +x
+        face(c - x * h.x, -y, z, [h.y, h.z]), // −x face
+        face(c + y * h.y, -x, z, [h.x, h.z]), // +y face
+        face(c - y * h.y, x, z, [h.x, h.z]),  // −y face
+        face(c + z * h.z, x, y, [h.x, h.y]),  // top
+    ]
+}
+
+/// A scene: primitives over a textured ground plane (z = 0) under a sky.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// Objects.
+    pub prims: Vec<Prim>,
+    /// Ground appearance.
+    pub ground: Material,
+    /// Sky radiance (linear), seen where no ray hits anything.
+    pub sky: [f32; 3],
+}

@@ -1,0 +1,352 @@
+//! Builds the 3-D scene and the 2-D dock geometry for a profile.
+//!
+//! World (dock) frame: origin at the middle of the dock entrance on the ground, +x out of
+//! the dock along its axis, +z up. The mother's (or station's) body lies at x < 0.
+
+use super::SimError;
+use super::scene::{Material, Prim, Scene, Shape, Tag, albedo, boxed};
+use crate::perception::RgbImage;
+use crate::profile::{NamedColor, Profile};
+use nalgebra::{Point3, Vector3};
+use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+
+/// A clutter object placed by a scenario.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClutterSpec {
+    /// What it is.
+    pub kind: ClutterKind,
+    /// Centre x (world), m.
+    pub x_m: f64,
+    /// Centre y (world), m.
+    pub y_m: f64,
+    /// Height of the bottom (boxes) or centre (panels, copies) above ground, m.
+    #[serde(default)]
+    pub z_m: f64,
+    /// Size (x, y, z) of a box, or (width, height) of a panel, m.
+    #[serde(default)]
+    pub size_m: Vec<f64>,
+    /// Colour of a box or panel.
+    #[serde(default)]
+    pub color: Option<NamedColor>,
+    /// Facing direction of panels and fiducial copies, degrees (0: faces +x, toward the
+    /// approach zone).
+    #[serde(default)]
+    pub facing_deg: f64,
+}
+
+/// Kinds of clutter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ClutterKind {
+    /// A coloured box standing on the ground.
+    Box,
+    /// A flat coloured panel.
+    Panel,
+    /// An exact copy of the fiducial, upright.
+    FiducialCopy,
+    /// A copy of the fiducial turned upside down (rotated 180° in its plane).
+    FiducialCopyUpsideDown,
+}
+
+/// 2-D geometry the motion model and judge need.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DockGeometry {
+    /// Body footprint: x from `-body_length` to 0, |y| ≤ `body_half_width`.
+    pub body_length: f64,
+    /// Half the body's width, m.
+    pub body_half_width: f64,
+    /// Half the entrance width, m.
+    pub entrance_half: f64,
+    /// Depth of the pouch from the entrance to the contact plates, m.
+    pub depth: f64,
+    /// Largest lateral error at the entrance, m.
+    pub tol_lateral: f64,
+    /// Largest heading error at the entrance, rad.
+    pub tol_heading: f64,
+    /// The robot must lower itself to enter (Bujold).
+    pub needs_lowered: bool,
+    /// The dock is a target on the ground that the robot drives onto (RAPOSA's pyramid):
+    /// there is no body to collide with.
+    pub open: bool,
+}
+
+/// A built world.
+#[derive(Debug, Clone)]
+pub struct World {
+    /// What cameras see.
+    pub scene: Scene,
+    /// What the judge checks.
+    pub dock: DockGeometry,
+    /// Index of the primitives that form the target (for shadows and tests).
+    pub target_prims: Vec<usize>,
+}
+
+fn y_axis() -> Vector3<f64> {
+    Vector3::y()
+}
+
+fn z_axis() -> Vector3<f64> {
+    Vector3::z()
+}
+
+/// Rotates `v` about +z by `deg`.
+fn yaw(v: Vector3<f64>, deg: f64) -> Vector3<f64> {
+    let (s, c) = deg.to_radians().sin_cos();
+    Vector3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z)
+}
+
+fn paint(c: NamedColor) -> [f32; 3] {
+    albedo(c.rgb(), 0.85)
+}
+
+/// Builds the world for `profile` with `clutter` and optional backdrop photos.
+///
+/// # Errors
+/// [`SimError::Unsupported`] for a fiducial kind the simulator cannot build yet.
+pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbImage>]) -> Result<World, SimError> {
+    let mut prims = Vec::new();
+    let mut target_prims = Vec::new();
+    let dock_spec = profile
+        .dock
+        .ok_or_else(|| SimError::Unsupported("a profile without [dock]".into()))?;
+    let entrance_half = dock_spec.entrance_width_m / 2.0;
+    let mut dock = DockGeometry {
+        body_length: 1.2,
+        body_half_width: 0.45,
+        entrance_half,
+        depth: dock_spec.depth_m,
+        tol_lateral: profile.success.lateral_tolerance_m,
+        tol_heading: profile.success.heading_tolerance_deg.to_radians(),
+        needs_lowered: false,
+        open: false,
+    };
+    let body_grey = albedo([70, 72, 75], 1.0);
+    if let Some(fid) = profile.fiducial.two_block {
+        // Silver Bullet's rear: a box body with the pouch opening at x = 0, the flap over it.
+        dock.needs_lowered = true;
+        let (h, w2) = (0.75, dock.body_half_width);
+        let top = fid.center_height_m + fid.height_m / 2.0 + 0.08;
+        let bottom = (fid.center_height_m - fid.height_m / 2.0 - 0.04).max(0.02);
+        let mut body = boxed(
+            Point3::new(-dock.body_length, -w2, 0.05),
+            Point3::new(0.0, w2, h),
+            Material::Solid(body_grey),
+            Tag::Body,
+        );
+        body.remove(0); // the rear face is rebuilt around the opening
+        prims.extend(body);
+        let rear = |y0: f64, y1: f64, z0: f64, z1: f64| {
+            Prim::new(
+                Shape::Rect {
+                    centre: Point3::new(0.0, (y0 + y1) / 2.0, (z0 + z1) / 2.0),
+                    u: y_axis(),
+                    v: z_axis(),
+                    half: [(y1 - y0) / 2.0, (z1 - z0) / 2.0],
+                },
+                Material::Solid(body_grey),
+                Tag::Body,
+            )
+        };
+        prims.push(rear(-w2, -entrance_half, 0.05, h));
+        prims.push(rear(entrance_half, w2, 0.05, h));
+        prims.push(rear(-entrance_half, entrance_half, top, h));
+        // The dark pouch behind the flap, and the gate folded down as a ramp.
+        prims.push(rear(-entrance_half, entrance_half, bottom, top));
+        prims.last_mut().expect("pushed").material = Material::Solid(albedo([20, 20, 22], 1.0));
+        prims.last_mut().expect("pushed").shape = Shape::Rect {
+            centre: Point3::new(-0.01, 0.0, (bottom + top) / 2.0),
+            u: y_axis(),
+            v: z_axis(),
+            half: [entrance_half, (top - bottom) / 2.0],
+        };
+        let ramp_len: f64 = 0.35;
+        let slope = (bottom / ramp_len).atan();
+        prims.push(Prim::new(
+            Shape::Rect {
+                centre: Point3::new(ramp_len / 2.0, 0.0, bottom / 2.0),
+                u: y_axis(),
+                v: Vector3::new(-slope.cos(), 0.0, slope.sin()),
+                half: [entrance_half + 0.03, ramp_len / 2.0 / slope.cos()],
+            },
+            Material::Noise {
+                base: albedo([110, 110, 112], 1.0),
+                contrast: 0.15,
+                cell: 0.01,
+            },
+            Tag::Body,
+        ));
+        // The flap: left colour on the viewer's left (world −y) when facing it from +x.
+        target_prims.push(prims.len());
+        let mut flap = Prim::new(
+            Shape::Rect {
+                centre: Point3::new(0.004, 0.0, fid.center_height_m),
+                u: y_axis(),
+                v: z_axis(),
+                half: [fid.width_m / 2.0, fid.height_m / 2.0],
+            },
+            Material::TwoBlock {
+                left: paint(fid.left_color),
+                right: paint(fid.right_color),
+            },
+            Tag::Target,
+        );
+        flap.gloss = 0.6;
+        prims.push(flap);
+    } else if let Some(pyr) = profile.fiducial.pyramid {
+        // RAPOSA's tether-end pyramid lying on the ground at the origin, its axis along +x:
+        // an orange guide ball on top and blue-painted front edges.
+        dock.open = true;
+        dock.body_length = 0.0;
+        dock.body_half_width = 0.0;
+        let base = 0.16;
+        let apex = Point3::new(-0.05, 0.0, pyr.ball_height_m.max(0.05));
+        let corners = [
+            Point3::new(base / 2.0, -base / 2.0, 0.0),
+            Point3::new(base / 2.0, base / 2.0, 0.0),
+            Point3::new(-base / 2.0 - 0.1, base / 2.0, 0.0),
+            Point3::new(-base / 2.0 - 0.1, -base / 2.0, 0.0),
+        ];
+        let grey = Material::Solid(albedo([150, 150, 150], 1.0));
+        for i in 0..4 {
+            let (a, b) = (corners[i], corners[(i + 1) % 4]);
+            let mut t = Prim::new(Shape::Triangle { p: [a, b, apex] }, grey.clone(), Tag::Target);
+            t.two_sided = true;
+            target_prims.push(prims.len());
+            prims.push(t);
+        }
+        // Blue edges: two strips of length h standing on the front face's sides.
+        let h = pyr.blue_edge_length_m;
+        for side in [-1.0, 1.0] {
+            let y = side * pyr.edge_to_ball_m;
+            target_prims.push(prims.len());
+            let mut strip = Prim::new(
+                Shape::Rect {
+                    centre: Point3::new(0.09, y, h / 2.0),
+                    u: y_axis(),
+                    v: z_axis(),
+                    half: [0.008, h / 2.0],
+                },
+                Material::Solid(paint(pyr.edge_color)),
+                Tag::Target,
+            );
+            strip.two_sided = true;
+            prims.push(strip);
+        }
+        target_prims.push(prims.len());
+        let mut ball = Prim::new(
+            Shape::Sphere {
+                centre: Point3::new(0.0, 0.0, pyr.ball_height_m),
+                radius: pyr.ball_diameter_m / 2.0,
+            },
+            Material::Solid(paint(pyr.ball_color)),
+            Tag::Target,
+        );
+        ball.gloss = 0.3;
+        prims.push(ball);
+    } else {
+        return Err(SimError::Unsupported(format!(
+            "the simulator builds two-block and pyramid targets so far; profile `{}` has another fiducial",
+            profile.name
+        )));
+    }
+    for c in clutter {
+        add_clutter(&mut prims, c, profile);
+    }
+    // Backdrop: walls 3 m behind the dock and to the sides, with photos when given.
+    let walls = [
+        (Point3::new(-3.0, 0.0, 1.2), y_axis(), 3.5),
+        (Point3::new(0.5, 3.2, 1.2), Vector3::x(), 3.5),
+        (Point3::new(0.5, -3.2, 1.2), -Vector3::x(), 3.5),
+    ];
+    for (i, (centre, u, half_w)) in walls.iter().enumerate() {
+        let material = match backdrops.get(i % backdrops.len().max(1)) {
+            Some(im) if !backdrops.is_empty() => Material::Image(im.clone()),
+            _ => Material::Noise {
+                base: albedo([150, 148, 140], 1.0),
+                contrast: 0.2,
+                cell: 0.25,
+            },
+        };
+        prims.push(Prim::new(
+            Shape::Rect {
+                centre: *centre,
+                u: *u,
+                v: z_axis(),
+                half: [*half_w, 1.2],
+            },
+            material,
+            Tag::Backdrop,
+        ));
+    }
+    Ok(World {
+        scene: Scene {
+            prims,
+            ground: Material::Noise {
+                base: albedo([125, 122, 115], 1.0),
+                contrast: 0.25,
+                cell: 0.02,
+            },
+            sky: [0.9, 0.95, 1.0],
+        },
+        dock,
+        target_prims,
+    })
+}
+
+fn add_clutter(prims: &mut Vec<Prim>, c: &ClutterSpec, profile: &Profile) {
+    let size = |i: usize, d: f64| c.size_m.get(i).copied().unwrap_or(d);
+    let colour = c.color.map(paint).unwrap_or(albedo([200, 200, 200], 0.8));
+    let u = yaw(y_axis(), c.facing_deg);
+    match c.kind {
+        ClutterKind::Box => {
+            let (sx, sy, sz) = (size(0, 0.1), size(1, 0.1), size(2, 0.1));
+            prims.extend(boxed(
+                Point3::new(c.x_m - sx / 2.0, c.y_m - sy / 2.0, c.z_m),
+                Point3::new(c.x_m + sx / 2.0, c.y_m + sy / 2.0, c.z_m + sz),
+                Material::Solid(colour),
+                Tag::Clutter,
+            ));
+        }
+        ClutterKind::Panel => {
+            let mut p = Prim::new(
+                Shape::Rect {
+                    centre: Point3::new(c.x_m, c.y_m, c.z_m.max(size(1, 0.1) / 2.0)),
+                    u,
+                    v: z_axis(),
+                    half: [size(0, 0.1) / 2.0, size(1, 0.1) / 2.0],
+                },
+                Material::Solid(colour),
+                Tag::Clutter,
+            );
+            p.two_sided = true;
+            prims.push(p);
+        }
+        ClutterKind::FiducialCopy | ClutterKind::FiducialCopyUpsideDown => {
+            if let Some(f) = profile.fiducial.two_block {
+                let upside_down = c.kind == ClutterKind::FiducialCopyUpsideDown;
+                // Turning the flap 180° in its plane puts the right colour on the left.
+                let (left, right) = if upside_down {
+                    (f.right_color, f.left_color)
+                } else {
+                    (f.left_color, f.right_color)
+                };
+                let z = if c.z_m > 0.0 { c.z_m } else { f.center_height_m };
+                prims.push(Prim::new(
+                    Shape::Rect {
+                        centre: Point3::new(c.x_m, c.y_m, z),
+                        u,
+                        v: z_axis(),
+                        half: [f.width_m / 2.0, f.height_m / 2.0],
+                    },
+                    Material::TwoBlock {
+                        left: paint(left),
+                        right: paint(right),
+                    },
+                    Tag::Clutter,
+                ));
+            }
+        }
+    }
+}
