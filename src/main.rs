@@ -15,6 +15,54 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Run one docking run of a scenario in the simulator.
+    ///
+    /// Prints one line (or, with --json, the run record: start, outcome, time_s, path_m,
+    /// entrance errors, track …). With --out DIR, writes DIR/trajectory.csv and every Nth
+    /// camera frame (the scenario's [record] frames_every) to DIR/frames/.
+    Dock {
+        /// Scenario file.
+        #[arg(long, value_name = "S")]
+        scenario: PathBuf,
+        /// Start label (grid position 1–16, or list entry).
+        #[arg(long, value_name = "N", conflicts_with = "at")]
+        start: Option<String>,
+        /// Explicit start: x,y,heading (metres, metres, degrees) in the dock frame.
+        #[arg(long, value_name = "X,Y,HEADING", value_parser = parse_at)]
+        at: Option<(f64, f64, f64)>,
+        /// Seed (default: the scenario's).
+        #[arg(long, value_name = "K")]
+        seed: Option<u64>,
+        /// Print the run record as JSON.
+        #[arg(long)]
+        json: bool,
+        /// Output folder.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
+    /// Run a scenario's whole trial campaign in the simulator, in parallel.
+    ///
+    /// Prints a table per start group (success rate, mean and SD of time to dock, effective
+    /// velocity, commands per metre, failures by reason). With --out DIR: DIR/runs.jsonl
+    /// (one line per finished run, in run order), DIR/summary.json, DIR/trajectories.svg,
+    /// DIR/success_map.svg and per-run trajectories.
+    Trials {
+        /// Scenario file.
+        #[arg(value_name = "S")]
+        scenario: PathBuf,
+        /// Output folder.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Print the summary JSON instead of the table.
+        #[arg(long)]
+        json: bool,
+        /// Worker threads (default: all cores).
+        #[arg(long, value_name = "N", default_value_t = 0)]
+        jobs: usize,
+        /// Skip runs already in DIR/runs.jsonl.
+        #[arg(long, requires = "out")]
+        resume: bool,
+    },
     /// Validate profile and scenario files.
     ///
     /// Prints `ok FILE` for each valid file. For each invalid file prints every problem
@@ -63,12 +111,76 @@ enum Command {
     },
 }
 
+fn parse_at(s: &str) -> Result<(f64, f64, f64), String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>().map_err(|e| format!("`{x}`: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x, y, h] if v.iter().all(|x| x.is_finite()) => Ok((x, y, h)),
+        _ => Err("expected three finite numbers: x,y,heading".into()),
+    }
+}
+
 fn main() -> ExitCode {
+    // Logs (decisions, phase changes, colour-model switches, safe stops) go to stderr when
+    // RUST_LOG asks for them, e.g. RUST_LOG=marsupial=debug.
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
+        .with_writer(std::io::stderr)
+        .try_init();
     let cli = Cli::parse();
     match cli.command {
         Command::Check { files } => {
             let bad = marsupial::cli::check::run(&files, &mut std::io::stdout(), &mut std::io::stderr());
             if bad == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+        }
+        Command::Dock {
+            scenario,
+            start,
+            at,
+            seed,
+            json,
+            out,
+        } => {
+            let opts = marsupial::cli::sim_cmds::DockOptions {
+                scenario,
+                start,
+                at,
+                seed,
+                json,
+                out,
+            };
+            match marsupial::cli::sim_cmds::dock(&opts, &mut std::io::stdout()) {
+                Ok(_) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        Command::Trials {
+            scenario,
+            out,
+            json,
+            jobs,
+            resume,
+        } => {
+            let opts = marsupial::cli::sim_cmds::TrialsOptions {
+                scenario,
+                out,
+                json,
+                jobs,
+                resume,
+                progress: std::io::IsTerminal::is_terminal(&std::io::stderr()),
+            };
+            match marsupial::cli::sim_cmds::trials(&opts, &mut std::io::stdout()) {
+                Ok(_) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
         }
         Command::Detect {
             profile,

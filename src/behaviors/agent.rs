@@ -39,8 +39,13 @@ pub enum BuildError {
 /// # Errors
 /// [`BuildError`] when the profile's approach has no implementation or lacks what it needs.
 pub fn agent_for(profile: &Profile) -> Result<Box<dyn Agent>, BuildError> {
-    Err(BuildError::NoBehavior {
-        profile: profile.name.clone(),
-        approach: profile.behavior.approach,
-    })
+    match profile.behavior.approach {
+        ApproachKind::RatioSteering | ApproachKind::PotentialField if profile.fiducial.two_block.is_some() => {
+            Ok(Box::new(super::bujold::BujoldAgent::new(profile)?))
+        }
+        approach => Err(BuildError::NoBehavior {
+            profile: profile.name.clone(),
+            approach,
+        }),
+    }
 }

@@ -2,14 +2,10 @@
 //!
 //! An [`Agent`] is everything one robot runs for a docking experiment: optionally a
 //! departure phase (undock, imprint the fiducial on the way out) and the docking phase.
-//! It is itself a [`Behavior`] whose tick dispatches on the current phase, so the reactive
+//! It is itself a [`Behavior`](crate::schemas::Behavior) whose tick dispatches on the current phase, so the reactive
 //! loop, the threaded runtime and the simulator all drive it the same way.
 
 pub mod agent;
+pub mod bujold;
 
 pub use agent::{Agent, BuildError, agent_for};
-
-use crate::schemas::Behavior;
-
-#[doc(hidden)]
-pub fn _assert_object_safe(_: &dyn Behavior) {}

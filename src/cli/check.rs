@@ -5,12 +5,21 @@ use crate::profile::Profile;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// Validates one file, choosing its kind from its contents.
+/// Validates one file, choosing its kind from its contents: a scenario names its profile
+/// with a top-level `profile = "path"`; anything else is checked as a profile.
 ///
 /// # Errors
 /// The file's [`ConfigError`].
 pub fn check_file(path: &Path) -> Result<(), ConfigError> {
-    Profile::load(path).map(|_| ())
+    let is_scenario = std::fs::read_to_string(path)
+        .ok()
+        .and_then(|s| s.parse::<toml::Table>().ok())
+        .is_some_and(|t| t.get("profile").is_some_and(|v| v.is_str()));
+    if is_scenario {
+        crate::sim::scenario::Scenario::load(path).map(|_| ())
+    } else {
+        Profile::load(path).map(|_| ())
+    }
 }
 
 /// Checks every file, printing `ok FILE` to `out` for each valid one and the error to

@@ -21,6 +21,7 @@ pub mod overlay;
 pub mod sct;
 pub mod segment;
 pub mod two_block;
+pub mod two_block_pose;
 
 pub use colour_model::{AngleStats, ColorMode, ColorModel, ColorModelParams, Imprinter, StatsAccumulator};
 pub use components::{Component, Labeler, Run};

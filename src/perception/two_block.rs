@@ -266,6 +266,10 @@ pub struct TwoBlockPercept {
     /// Horizontal offset of the pair's midpoint from the image centre, px (positive:
     /// right of centre in the image as delivered, i.e. after any 180° flip).
     pub offset_px: f64,
+    /// Bounding box of the image-left block (x_min, y_min, x_max, y_max), px.
+    pub left_bbox: [u32; 4],
+    /// Bounding box of the image-right block, px.
+    pub right_bbox: [u32; 4],
     /// Statistics that segmented this frame.
     pub mode: ColorMode,
     /// Frame size (width, height).
@@ -285,6 +289,8 @@ impl TwoBlockPercept {
             left_centroid: [0.0; 2],
             right_centroid: [0.0; 2],
             offset_px: 0.0,
+            left_bbox: [0; 4],
+            right_bbox: [0; 4],
             mode,
             image_size,
         }
@@ -437,6 +443,8 @@ impl TwoBlockSchema {
             left_centroid: pair.left.centroid,
             right_centroid: pair.right.centroid,
             offset_px: mid - size.0 as f64 / 2.0,
+            left_bbox: pair.left.bbox,
+            right_bbox: pair.right.bbox,
             mode,
             image_size: size,
         })

@@ -25,6 +25,9 @@ pub struct ImprintSpec {
     pub sample_frac: f64,
     /// Frames averaged.
     pub frames: u32,
+    /// Camera-to-fiducial distance at which the departing robot imprints, m (the
+    /// rectangles are where the blocks appear from there).
+    pub at_distance_m: f64,
 }
 
 /// The `[perception]` table. Every field is optional; missing ones take the defaults of
@@ -94,6 +97,7 @@ impl Default for ImprintSpec {
             right_rect: [0.50, 0.40, 0.62, 0.60],
             sample_frac: 0.5,
             frames: 5,
+            at_distance_m: 0.6,
         }
     }
 }

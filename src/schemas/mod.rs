@@ -9,6 +9,9 @@ pub mod behavior;
 pub mod inputs;
 pub mod motor_output;
 pub mod percept;
+pub mod potential_field;
+pub mod ratio_steering;
+pub mod search;
 pub mod traits;
 pub mod vector;
 
@@ -16,5 +19,8 @@ pub use behavior::{Behavior, FailureReason, Feedback, Outcome, Presence, SchemaB
 pub use inputs::{CameraInput, Inputs, OdometryReading, TetherReading};
 pub use motor_output::{Auxiliary, DriveCommand, Guides, MotorOutput, Posture, TetherCommand};
 pub use percept::{Percept, Stamped};
+pub use potential_field::PotentialField;
+pub use ratio_steering::RatioSteering;
+pub use search::{DeadReckoning, SearchRotation};
 pub use traits::{MotorSchema, PerceptualSchema};
 pub use vector::MotionVector;

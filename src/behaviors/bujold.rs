@@ -1,0 +1,659 @@
+//! Bujold's docking (seed 004): undock and imprint on departure, then close-dock.
+//!
+//! Departure: back out of the pouch lowered (the camera watching the flap), raise, and at
+//! the profile's imprint distance stop for `imprint.frames` frames to imprint the blocks'
+//! colours; keep adapting while driving on out (seed 004 §IV.C).
+//!
+//! Docking (the paper's "close dock" within the whole docking behavior):
+//!
+//! 1. **search**: rotate in place until the fiducial is acquired (toward the side it was
+//!    last seen), bounded by `search_timeout_s`;
+//! 2. **approach**: ratio steering ([`RatioSteering`]) or potential fields
+//!    ([`PotentialField`]) on the fiducial's relative pose, speed falling with the summed
+//!    pixel count; the fiducial lost for 1.5 s sends the robot back to search;
+//! 3. **decide** at `dock_total_px`: stop, average five frames; balanced and centred
+//!    (estimated lateral and heading errors within the profile's tolerances) → back in;
+//!    otherwise **move away** 35 cm and retry, up to `max_retries`;
+//! 4. **back in**: lower and drive blind by odometry until the dock switch closes.
+//!
+//! Every phase has a timeout (`phase_timeout_s`). Every exit commands zero velocity; a
+//! failure close to the dock first moves away from the entrance, then stops.
+
+use super::agent::{Agent, BuildError};
+use crate::geometry::Pose2;
+use crate::perception::TwoBlockSchema;
+use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
+use crate::profile::{ApproachKind, Profile};
+use crate::schemas::{
+    Auxiliary, Behavior, DeadReckoning, DriveCommand, FailureReason, Feedback, Inputs, MotorOutput, Outcome, Percept,
+    PerceptualSchema, Posture, PotentialField, RatioSteering, SearchRotation, Step,
+};
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Phase {
+    Idle,
+    Undock,
+    Imprint {
+        frames: u32,
+    },
+    DriveOut,
+    Search,
+    Approach,
+    Decide,
+    BackIn,
+    MoveAway {
+        failing: Option<FailureReason>,
+    },
+    /// Turn, drive and turn by odometry to a staging pose on the dock axis.
+    Reposition {
+        stage: u8,
+        target: Pose2,
+    },
+    Done,
+}
+
+impl Phase {
+    fn name(&self) -> &'static str {
+        match self {
+            Phase::Idle => "idle",
+            Phase::Undock => "undock",
+            Phase::Imprint { .. } => "imprint",
+            Phase::DriveOut => "drive_out",
+            Phase::Search => "search",
+            Phase::Approach => "approach",
+            Phase::Decide => "decide",
+            Phase::BackIn => "back_in",
+            Phase::MoveAway { .. } => "move_away",
+            Phase::Reposition { .. } => "reposition",
+            Phase::Done => "done",
+        }
+    }
+}
+
+/// Bujold's agent.
+pub struct BujoldAgent {
+    schema: TwoBlockSchema,
+    geometry: TwoBlockGeometry,
+    steering: RatioSteering,
+    field: Option<PotentialField>,
+    search: SearchRotation,
+    phase: Phase,
+    phase_start: f64,
+    run_start: Option<f64>,
+    odo_mark: Pose2,
+    retries: u32,
+    max_retries: u32,
+    phase_timeout: f64,
+    search_timeout: f64,
+    ever_seen: bool,
+    last_seen: Option<f64>,
+    last_side: f64,
+    samples: Vec<FiducialView>,
+    tol_lateral: f64,
+    tol_heading: f64,
+    depth: f64,
+    /// Distance from the camera back to the robot's rear, m.
+    rear_behind_camera: f64,
+    /// Odometry travel from the start of departure at which to imprint, m.
+    imprint_at: f64,
+    drive_out: f64,
+    imprint_frames: u32,
+    imprinted: bool,
+    samples_distance: f64,
+    /// Low-passed viewing angle (rad): single-frame estimates are noisy at range.
+    alpha_filtered: Option<f64>,
+    /// Reliable frames folded into `alpha_filtered` since the last (re)start.
+    settled: u32,
+}
+
+/// Distance from the dock the robot drives to on departure, m.
+pub const DEPARTURE_DISTANCE_M: f64 = 1.2;
+/// How far a retry backs off, m.
+pub const MOVE_AWAY_M: f64 = 0.35;
+/// Staging distance on the dock axis for repositioning, m.
+pub const STAGING_X_M: f64 = 0.75;
+/// Lateral error (m) above which a reliable view triggers repositioning.
+pub const REPOSITION_LATERAL_M: f64 = 0.08;
+/// Blocks at least this tall (px) give a viewing angle good enough to plan on.
+pub const RELIABLE_HEIGHT_PX: f64 = 40.0;
+
+impl BujoldAgent {
+    /// Builds the agent from a profile with a `[fiducial.two_block]` and
+    /// `[behavior.ratio_steering]` (and `[behavior.potential_field]` when selected).
+    ///
+    /// # Errors
+    /// [`BuildError::Profile`] when something it needs is missing.
+    pub fn new(profile: &Profile) -> Result<Self, BuildError> {
+        let missing = |what: &str| BuildError::Profile {
+            profile: profile.name.clone(),
+            what: what.into(),
+        };
+        let fid = profile
+            .fiducial
+            .two_block
+            .ok_or_else(|| missing("needs [fiducial.two_block]"))?;
+        let cam = profile.cameras.first().ok_or_else(|| missing("needs a camera"))?;
+        let dock = profile.dock.ok_or_else(|| missing("needs [dock]"))?;
+        let g = profile
+            .behavior
+            .ratio_steering
+            .ok_or_else(|| missing("needs [behavior.ratio_steering]"))?;
+        let schema = TwoBlockSchema::from_profile(profile, 0).map_err(|e| missing(&e.to_string()))?;
+        let geometry = TwoBlockGeometry::new(cam, &fid);
+        let tick_s = 1.0 / profile.loop_.rate_hz;
+        let restricted = profile.drive.kind == crate::profile::DriveKind::TurnOrDrive;
+        let field = match profile.behavior.approach {
+            ApproachKind::PotentialField => {
+                let p = profile
+                    .behavior
+                    .potential_field
+                    .ok_or_else(|| missing("needs [behavior.potential_field]"))?;
+                Some(PotentialField {
+                    sector: p.approach_sector_deg.to_radians(),
+                    coercive_attraction: p.coercive_attraction,
+                    gain: p.gain,
+                    k_theta: p.k_theta,
+                })
+            }
+            _ => None,
+        };
+        Ok(Self {
+            schema,
+            geometry,
+            steering: RatioSteering {
+                geometry,
+                image_width: cam.width_px as f64,
+                dead_band: g.dead_band,
+                understeer: g.understeer,
+                turn_rate: g.turn_rate_dps.to_radians(),
+                speed: g.drive_speed_mps,
+                dock_total_px: g.dock_total_px as f64,
+                tick_s,
+                restricted,
+            },
+            field,
+            search: SearchRotation {
+                rate: g.turn_rate_dps.to_radians(),
+                first_sweep: 0.0,
+                doubling: false,
+            },
+            phase: Phase::Idle,
+            phase_start: 0.0,
+            run_start: None,
+            odo_mark: Pose2::default(),
+            retries: 0,
+            max_retries: profile.behavior.max_retries,
+            phase_timeout: profile.behavior.phase_timeout_s,
+            search_timeout: profile.behavior.search_timeout_s,
+            ever_seen: false,
+            last_seen: None,
+            last_side: 1.0,
+            samples: Vec::with_capacity(8),
+            tol_lateral: profile.success.lateral_tolerance_m,
+            tol_heading: profile.success.heading_tolerance_deg.to_radians(),
+            depth: dock.depth_m,
+            rear_behind_camera: profile.body.length_m / 2.0 + cam.mount.x_m * geometry.drive_dir,
+            // Departure starts with the rear at the plates: the camera is then
+            // depth − rear_behind_camera inside the entrance.
+            imprint_at: profile.perception.imprint.at_distance_m + dock.depth_m
+                - (profile.body.length_m / 2.0 + cam.mount.x_m * geometry.drive_dir),
+            drive_out: DEPARTURE_DISTANCE_M,
+            imprint_frames: profile.perception.imprint.frames,
+            imprinted: false,
+            samples_distance: 0.0,
+            alpha_filtered: None,
+            settled: 0,
+        })
+    }
+
+    /// The perceptual schema (colour model state, last detection).
+    pub fn schema(&self) -> &TwoBlockSchema {
+        &self.schema
+    }
+
+    /// True once a departure imprinted successfully.
+    pub fn imprinted(&self) -> bool {
+        self.imprinted
+    }
+
+    fn enter(&mut self, phase: Phase, now: f64, odo: Pose2) {
+        tracing::debug!(target: "marsupial::behavior", from = self.phase.name(), to = phase.name(), now, "bujold phase");
+        self.phase = phase;
+        self.phase_start = now;
+        self.odo_mark = odo;
+        self.samples.clear();
+    }
+
+    fn travelled(&self, odo: &Pose2) -> f64 {
+        (odo.x - self.odo_mark.x).hypot(odo.y - self.odo_mark.y)
+    }
+
+    fn feedback(&self, now: f64) -> Feedback {
+        Feedback {
+            phase: self.phase.name(),
+            elapsed: now - self.run_start.unwrap_or(now),
+            retries: self.retries,
+        }
+    }
+
+    fn fail(&mut self, reason: FailureReason, now: f64, odo: Pose2, near_dock: bool) -> Step {
+        if near_dock {
+            self.enter(Phase::MoveAway { failing: Some(reason) }, now, odo);
+            return Step::running(MotorOutput::stop(), self.feedback(now));
+        }
+        self.phase = Phase::Done;
+        Step::done(
+            Outcome::Failed(reason),
+            MotorOutput::stop().with_aux(raised()),
+            self.feedback(now),
+        )
+    }
+
+    /// Starts a repositioning to the staging point on the dock axis, from the estimated
+    /// pose in the dock frame (`view`) and the current odometry pose.
+    fn reposition(&mut self, view: &FiducialView, now: f64, odo: Pose2) {
+        // Robot centre in the dock frame: the camera sits `rear_behind_camera − L/2` ahead
+        // of the rear; near enough to treat the camera as the centre here.
+        let here = Pose2::new(
+            view.distance * view.alpha.cos(),
+            view.distance * view.alpha.sin(),
+            view.heading,
+        );
+        let stage_x = (here.x + 0.15).max(STAGING_X_M);
+        let stage = Pose2::new(stage_x, 0.0, 0.0);
+        // dock → odometry: odo = T ⊕ dock, T = odo ⊕ here⁻¹.
+        let t = odo.compose(&here.relative(&Pose2::default()));
+        let target = t.compose(&stage);
+        tracing::debug!(target: "marsupial::behavior", now, x = here.x, y = here.y, heading_deg = here.theta.to_degrees(), "reposition to the axis");
+        self.enter(Phase::Reposition { stage: 0, target }, now, odo);
+    }
+
+    fn approach_command(&self, view: &FiducialView) -> MotorOutput {
+        match &self.field {
+            None => self.steering.act(view),
+            Some(pf) => {
+                let pose = Pose2::new(
+                    view.distance * view.alpha.cos(),
+                    view.distance * view.alpha.sin(),
+                    view.heading,
+                );
+                let t = pf.twist(&pose, self.geometry.drive_dir);
+                let cmd = if self.steering.restricted {
+                    // Turn OR drive: turn while the heading error exceeds the dead band.
+                    if (t.omega * self.steering.tick_s).abs() > self.steering.dead_band * 0.5 {
+                        DriveCommand::Turn {
+                            omega: t.omega.clamp(-self.steering.turn_rate, self.steering.turn_rate),
+                        }
+                    } else {
+                        DriveCommand::Straight {
+                            v: self.steering.speed_for(view.total_px as f64),
+                        }
+                    }
+                } else {
+                    DriveCommand::Twist(t)
+                };
+                MotorOutput::drive(cmd)
+            }
+        }
+    }
+}
+
+fn lowered() -> Auxiliary {
+    Auxiliary {
+        posture: Some(Posture::Lowered),
+        ..Auxiliary::default()
+    }
+}
+
+fn raised() -> Auxiliary {
+    Auxiliary {
+        posture: Some(Posture::Raised),
+        ..Auxiliary::default()
+    }
+}
+
+impl Behavior for BujoldAgent {
+    fn name(&self) -> &str {
+        "bujold"
+    }
+
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+        let now = inputs.now;
+        self.run_start.get_or_insert(now);
+        let odo = inputs.odometry.map(|o| o.value.pose).unwrap_or_default();
+        // Perception runs every tick so adaptation follows the light, except while
+        // imprinting (the imprint must not be mixed with adapted statistics).
+        let percept = self.schema.perceive(inputs);
+        let mut view = FiducialView::from_percept(&percept, &self.geometry);
+        let mut planning: Option<FiducialView> = None;
+        if let Some(v) = view.as_mut() {
+            // The ratio cue is only as good as the blocks are big: at 1.3 m two-pixel noise
+            // is ±35° of viewing angle. Weight it by reliability (zero for blocks under
+            // 18 px tall, full above 43 px), then low-pass. Far away the robot therefore
+            // pursues the fiducial along the line of sight; the aim point fades in close.
+            let trust = ((v.height_px - 18.0) / 25.0).clamp(0.0, 1.0);
+            let a = match self.alpha_filtered {
+                None => v.alpha,
+                Some(prev) => prev + 0.3 * (v.alpha - prev),
+            };
+            self.alpha_filtered = Some(a);
+            if v.height_px >= RELIABLE_HEIGHT_PX {
+                self.settled += 1;
+            }
+            // Planning (repositioning, the final decision) uses the filtered estimate;
+            // steering uses it scaled by its trust.
+            planning = Some(FiducialView {
+                alpha: a,
+                heading: crate::geometry::wrap_angle(a - v.bearing),
+                ..*v
+            });
+            v.alpha = a * trust;
+            v.heading = crate::geometry::wrap_angle(v.alpha - v.bearing);
+        }
+        if percept.found() {
+            self.ever_seen = true;
+            self.last_seen = Some(now);
+            if let Some(v) = &view {
+                self.last_side = if v.bearing >= 0.0 { 1.0 } else { -1.0 };
+            }
+        }
+        if self.phase_start == f64::NEG_INFINITY {
+            self.phase_start = now;
+            self.odo_mark = odo;
+        }
+        let in_phase = now - self.phase_start;
+        let dir = self.geometry.drive_dir;
+        if let Some(v) = &view {
+            tracing::trace!(target: "marsupial::behavior", now, phase = self.phase.name(), d = v.distance, alpha_deg = v.alpha.to_degrees(), heading_deg = v.heading.to_degrees(), offset = v.offset_px, total = v.total_px, mode = %percept.mode, "view");
+        } else {
+            tracing::trace!(target: "marsupial::behavior", now, phase = self.phase.name(), mode = %percept.mode, "no fiducial");
+        }
+        if inputs.docked_contact() && !matches!(self.phase, Phase::Undock | Phase::Idle | Phase::Done) {
+            self.phase = Phase::Done;
+            return Some(Step::done(
+                Outcome::Docked,
+                MotorOutput::stop().with_aux(lowered()),
+                self.feedback(now),
+            ));
+        }
+        if !matches!(self.phase, Phase::Idle | Phase::Done | Phase::MoveAway { .. }) && in_phase > self.phase_timeout {
+            let near = matches!(self.phase, Phase::Decide | Phase::BackIn | Phase::Approach);
+            return Some(self.fail(FailureReason::Timeout, now, odo, near));
+        }
+        let step = match self.phase {
+            Phase::Idle | Phase::Done => return None,
+            // ---- departure ----
+            Phase::Undock => {
+                // Drive out of the pouch (front first, away from the dock), lowered.
+                if self.travelled(&odo) >= self.depth + 0.05 {
+                    self.enter(Phase::DriveOut, now, self.odo_mark);
+                }
+                Step::running(
+                    MotorOutput {
+                        drive: DriveCommand::Straight { v: -dir * 0.05 },
+                        aux: lowered(),
+                    },
+                    self.feedback(now),
+                )
+            }
+            Phase::DriveOut => {
+                let out = self.travelled(&odo);
+                if !self.imprinted && out >= self.imprint_at {
+                    self.enter(Phase::Imprint { frames: 0 }, now, self.odo_mark);
+                    Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                } else if out >= self.drive_out {
+                    self.phase = Phase::Done;
+                    let outcome = if self.imprinted {
+                        Outcome::Completed
+                    } else {
+                        Outcome::Failed(FailureReason::TargetNeverDetected)
+                    };
+                    Step::done(outcome, MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                } else {
+                    Step::running(
+                        MotorOutput {
+                            drive: DriveCommand::Straight { v: -dir * 0.06 },
+                            aux: raised(),
+                        },
+                        self.feedback(now),
+                    )
+                }
+            }
+            Phase::Imprint { frames } => {
+                if let Some(cam) = inputs.camera(0) {
+                    self.schema.imprint_frame(&cam.image);
+                }
+                let frames = frames + 1;
+                if frames >= self.imprint_frames {
+                    self.imprinted = self.schema.finish_imprint(now);
+                    let mark = self.odo_mark;
+                    self.enter(Phase::DriveOut, now, mark);
+                } else {
+                    self.phase = Phase::Imprint { frames };
+                }
+                Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+            }
+            // ---- docking ----
+            Phase::Search => {
+                if let Some(v) = view {
+                    self.enter(Phase::Approach, now, odo);
+                    Step::running(self.approach_command(&v).with_aux(raised()), self.feedback(now))
+                } else if in_phase > self.search_timeout {
+                    let reason = if self.ever_seen {
+                        FailureReason::TargetLost
+                    } else {
+                        FailureReason::TargetNeverDetected
+                    };
+                    self.fail(reason, now, odo, false)
+                } else {
+                    let mut s = self.search;
+                    s.rate *= self.last_side;
+                    Step::running(
+                        MotorOutput::drive(s.act(in_phase)).with_aux(raised()),
+                        self.feedback(now),
+                    )
+                }
+            }
+            Phase::Approach => match view {
+                Some(v) if v.total_px as f64 >= self.steering.dock_total_px => {
+                    self.enter(Phase::Decide, now, odo);
+                    Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                }
+                Some(_)
+                    if self.settled >= 10
+                        && planning.is_some_and(|p| {
+                            p.height_px >= RELIABLE_HEIGHT_PX
+                                && (p.distance * p.alpha.sin()).abs() > REPOSITION_LATERAL_M
+                        })
+                        && self.retries < self.max_retries =>
+                {
+                    // Close enough to trust the viewing angle and clearly off the axis:
+                    // creeping in would only arrive misaligned.
+                    self.retries += 1;
+                    if let Some(p) = planning {
+                        self.reposition(&p, now, odo);
+                    }
+                    Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                }
+                Some(v) => Step::running(self.approach_command(&v).with_aux(raised()), self.feedback(now)),
+                None => {
+                    if self.last_seen.is_none_or(|t| now - t > 1.5) {
+                        self.enter(Phase::Search, now, odo);
+                    }
+                    Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                }
+            },
+            Phase::Decide => {
+                if let Some(v) = planning {
+                    self.samples.push(v);
+                }
+                if self.samples.len() < 5 {
+                    if in_phase > 3.0 {
+                        // Lost at the gate: back off and look again.
+                        self.retries += 1;
+                        self.enter(Phase::MoveAway { failing: None }, now, odo);
+                    }
+                    Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                } else {
+                    let n = self.samples.len() as f64;
+                    let alpha = self.samples.iter().map(|s| s.alpha).sum::<f64>() / n;
+                    let heading = self.samples.iter().map(|s| s.heading).sum::<f64>() / n;
+                    let dist = self.samples.iter().map(|s| s.distance).sum::<f64>() / n;
+                    // Lateral error where the rear will reach the entrance: backing a distance
+                    // s at heading θ shifts the robot by −s·sin θ.
+                    let to_go = (dist - self.rear_behind_camera).max(0.0);
+                    let arrive = dist * alpha.sin() - to_go * heading.sin();
+                    if arrive.abs() <= 0.8 * self.tol_lateral && heading.abs() <= 0.8 * self.tol_heading {
+                        self.samples_distance = dist;
+                        self.enter(Phase::BackIn, now, odo);
+                        Step::running(MotorOutput::stop().with_aux(lowered()), self.feedback(now))
+                    } else {
+                        self.retries += 1;
+                        if self.retries > self.max_retries {
+                            return Some(self.fail(FailureReason::RetriesExhausted, now, odo, true));
+                        }
+                        let mean = FiducialView {
+                            alpha,
+                            heading,
+                            distance: dist,
+                            ..self.samples[0]
+                        };
+                        self.reposition(&mean, now, odo);
+                        Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                    }
+                }
+            }
+            Phase::BackIn => {
+                // Blind: the entrance is about `distance − rear_behind_camera` away, then the
+                // pouch; 15 cm of margin before declaring a miss.
+                let est = self.samples_distance.max(0.1);
+                let dr = DeadReckoning {
+                    speed: dir * 0.04,
+                    distance: (est - self.rear_behind_camera).max(0.0) + self.depth + 0.15,
+                };
+                match dr.act(self.travelled(&odo)) {
+                    Some(cmd) => Step::running(
+                        MotorOutput {
+                            drive: cmd,
+                            aux: lowered(),
+                        },
+                        self.feedback(now),
+                    ),
+                    None => self.fail(FailureReason::FailedToControl, now, odo, true),
+                }
+            }
+            Phase::Reposition { stage, target } => {
+                let (dx, dy) = (target.x - odo.x, target.y - odo.y);
+                let dist = dx.hypot(dy);
+                let tol = 3f64.to_radians();
+                let turn = |err: f64| {
+                    let w = (2.0 * err).clamp(-self.steering.turn_rate, self.steering.turn_rate);
+                    MotorOutput::drive(DriveCommand::Turn { omega: w }).with_aux(raised())
+                };
+                match stage {
+                    0 | 1 if dist < 0.03 => {
+                        self.phase = Phase::Reposition { stage: 2, target };
+                        Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                    }
+                    0 => {
+                        // Face the staging point with the end that leads toward it.
+                        let bearing = dy.atan2(dx);
+                        let forward =
+                            crate::geometry::wrap_angle(bearing - odo.theta).abs() <= std::f64::consts::FRAC_PI_2;
+                        let want = if forward {
+                            bearing
+                        } else {
+                            bearing + std::f64::consts::PI
+                        };
+                        let err = crate::geometry::wrap_angle(want - odo.theta);
+                        if err.abs() < tol {
+                            self.phase = Phase::Reposition { stage: 1, target };
+                            Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                        } else {
+                            Step::running(turn(err), self.feedback(now))
+                        }
+                    }
+                    1 => {
+                        let heading_to = dy.atan2(dx);
+                        let ahead =
+                            crate::geometry::wrap_angle(heading_to - odo.theta).abs() <= std::f64::consts::FRAC_PI_2;
+                        let v = if ahead {
+                            self.steering.speed
+                        } else {
+                            -self.steering.speed
+                        };
+                        Step::running(
+                            MotorOutput::drive(DriveCommand::Straight { v }).with_aux(raised()),
+                            self.feedback(now),
+                        )
+                    }
+                    _ => {
+                        let err = crate::geometry::wrap_angle(target.theta - odo.theta);
+                        if err.abs() < tol {
+                            self.alpha_filtered = None;
+                            self.settled = 0;
+                            self.enter(Phase::Approach, now, odo);
+                            Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                        } else {
+                            Step::running(turn(err), self.feedback(now))
+                        }
+                    }
+                }
+            }
+            Phase::MoveAway { failing } => {
+                if self.travelled(&odo) >= MOVE_AWAY_M || in_phase > 20.0 {
+                    match failing {
+                        Some(reason) => {
+                            self.phase = Phase::Done;
+                            Step::done(
+                                Outcome::Failed(reason),
+                                MotorOutput::stop().with_aux(raised()),
+                                self.feedback(now),
+                            )
+                        }
+                        None => {
+                            self.enter(Phase::Approach, now, odo);
+                            Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                        }
+                    }
+                } else {
+                    Step::running(
+                        MotorOutput {
+                            drive: DriveCommand::Straight { v: -dir * 0.06 },
+                            aux: raised(),
+                        },
+                        self.feedback(now),
+                    )
+                }
+            }
+        };
+        Some(step)
+    }
+
+    fn reset(&mut self) {
+        self.phase = Phase::Idle;
+        self.run_start = None;
+        self.retries = 0;
+    }
+}
+
+impl Agent for BujoldAgent {
+    fn begin_departure(&mut self) -> bool {
+        self.run_start = None;
+        self.phase = Phase::Undock;
+        self.phase_start = f64::NEG_INFINITY;
+        self.imprinted = false;
+        true
+    }
+
+    fn begin_docking(&mut self) {
+        self.run_start = None;
+        self.alpha_filtered = None;
+        self.settled = 0;
+        self.retries = 0;
+        self.ever_seen = false;
+        self.last_seen = None;
+        self.phase = Phase::Search;
+        self.phase_start = f64::NEG_INFINITY;
+    }
+}

@@ -1,0 +1,210 @@
+//! `marsupial dock` and `marsupial trials`: runs in the simulator.
+
+use crate::behaviors::agent_for;
+use crate::sim::SimError;
+use crate::sim::campaign::{self, CampaignOptions, GroupSummary, RunRecord, Summary};
+use crate::sim::scenario::Scenario;
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Options of `marsupial dock`.
+#[derive(Debug, Clone, Default)]
+pub struct DockOptions {
+    /// Scenario file.
+    pub scenario: PathBuf,
+    /// 1-based start (grid position or list entry); default the first.
+    pub start: Option<String>,
+    /// Explicit start (x, y, heading°) instead.
+    pub at: Option<(f64, f64, f64)>,
+    /// Override the scenario seed.
+    pub seed: Option<u64>,
+    /// Print the run record as JSON.
+    pub json: bool,
+    /// Output folder (trajectory CSV, frames).
+    pub out: Option<PathBuf>,
+}
+
+/// Runs one docking run.
+///
+/// # Errors
+/// [`SimError`] for bad scenarios, missing behaviors or unwritable output.
+pub fn dock(opts: &DockOptions, out: &mut dyn Write) -> Result<RunRecord, SimError> {
+    let mut loaded = Scenario::load(&opts.scenario)?;
+    if let Some(s) = opts.seed {
+        loaded.scenario.seed = s;
+    }
+    if let Some((x, y, h)) = opts.at {
+        loaded.scenario.starts.grid = None;
+        loaded.scenario.starts.points = vec![crate::sim::scenario::StartPoint {
+            distance_m: None,
+            angle_deg: None,
+            x_m: Some(x),
+            y_m: Some(y),
+            heading_deg: Some(h),
+            label: Some("at".into()),
+        }];
+    }
+    let prepared = campaign::prepare(loaded)?;
+    let spec = match &opts.start {
+        None => prepared.runs.first(),
+        Some(label) => prepared
+            .runs
+            .iter()
+            .find(|r| &r.start.label == label || r.start.label == format!("p{label}")),
+    }
+    .cloned()
+    .ok_or_else(|| {
+        SimError::Unsupported(format!(
+            "no start {:?} in the scenario",
+            opts.start.clone().unwrap_or_default()
+        ))
+    })?;
+    let frames_dir = opts.out.as_ref().map(|d| d.join("frames"));
+    if let Some(d) = &frames_dir {
+        std::fs::create_dir_all(d).map_err(|source| SimError::Io {
+            path: d.display().to_string(),
+            source,
+        })?;
+    }
+    let every = prepared.loaded.scenario.record.frames_every;
+    let rec = campaign::run_one(&prepared, &spec, &agent_for, frames_dir.as_deref().map(|d| (d, every)))?;
+    if let Some(d) = &opts.out {
+        let p = d.join("trajectory.csv");
+        campaign::write_track_csv(&p, &rec).map_err(|source| SimError::Io {
+            path: p.display().to_string(),
+            source,
+        })?;
+    }
+    let _ = if opts.json {
+        writeln!(out, "{}", serde_json::to_string(&rec).unwrap_or_default())
+    } else {
+        writeln!(
+            out,
+            "start {} ({:.2} m, {:+.0}°): {} in {:.1} s, {:.2} m driven{}",
+            rec.start,
+            rec.distance_m,
+            rec.angle_deg,
+            rec.outcome,
+            rec.time_s,
+            rec.path_m,
+            rec.entrance_lateral_m
+                .map(|l| format!(
+                    ", entrance error {:+.1} cm / {:+.1}°",
+                    l * 100.0,
+                    rec.entrance_heading_deg.unwrap_or(0.0)
+                ))
+                .unwrap_or_default()
+        )
+    };
+    Ok(rec)
+}
+
+/// Options of `marsupial trials`.
+#[derive(Debug, Clone, Default)]
+pub struct TrialsOptions {
+    /// Scenario file.
+    pub scenario: PathBuf,
+    /// Output folder.
+    pub out: Option<PathBuf>,
+    /// Print the summary JSON instead of the table.
+    pub json: bool,
+    /// Worker threads (0: all cores).
+    pub jobs: usize,
+    /// Skip runs already in `out/runs.jsonl`.
+    pub resume: bool,
+    /// Progress bar.
+    pub progress: bool,
+}
+
+fn fmt_opt(v: Option<f64>, prec: usize) -> String {
+    v.map(|x| format!("{x:.prec$}")).unwrap_or_else(|| "-".into())
+}
+
+/// Prints a summary as a table like the paper's.
+pub fn print_table(s: &Summary, out: &mut dyn Write) -> std::io::Result<()> {
+    let vary = |f: &dyn Fn(&GroupSummary) -> &String| {
+        let first = s.groups.first().map(f);
+        s.groups.iter().any(|g| Some(f(g)) != first)
+    };
+    let (vl, vs, vt) = (
+        vary(&|g| &g.lighting),
+        vary(&|g| &g.segmentation),
+        vary(&|g| &g.terrain),
+    );
+    writeln!(out, "{}", s.scenario)?;
+    let mut head = String::from("start ");
+    if vl {
+        head.push_str(" lighting  ");
+    }
+    if vs {
+        head.push_str(" segmentation");
+    }
+    if vt {
+        head.push_str(" terrain   ");
+    }
+    writeln!(
+        out,
+        "{head}  runs  success  mean time (s)  sd (s)  v_eff (cm/s)  cmds/m  failures"
+    )?;
+    let row = |g: &GroupSummary, out: &mut dyn Write| -> std::io::Result<()> {
+        let mut line = format!("{:<6}", g.start);
+        if vl {
+            line.push_str(&format!(" {:<10}", g.lighting));
+        }
+        if vs {
+            line.push_str(&format!(" {:<12}", g.segmentation));
+        }
+        if vt {
+            line.push_str(&format!(" {:<10}", g.terrain));
+        }
+        let fails: Vec<String> = g.failures.iter().map(|(k, v)| format!("{k}×{v}")).collect();
+        writeln!(
+            out,
+            "{line}  {:>4}  {:>6.2}  {:>13}  {:>6}  {:>12}  {:>6.2}  {}",
+            g.runs,
+            g.success_rate,
+            fmt_opt(g.mean_time_s, 1),
+            fmt_opt(g.sd_time_s, 1),
+            fmt_opt(g.v_eff_cmps, 2),
+            g.commands_per_m,
+            fails.join(" ")
+        )
+    };
+    for g in &s.groups {
+        row(g, out)?;
+    }
+    row(&s.overall, out)
+}
+
+/// Runs a campaign and prints its table (or JSON).
+///
+/// # Errors
+/// [`SimError`].
+pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimError> {
+    let loaded = Scenario::load(&opts.scenario)?;
+    let prepared = campaign::prepare(loaded)?;
+    let started = std::time::Instant::now();
+    let (_records, summary) = campaign::run_campaign(
+        &prepared,
+        &agent_for,
+        &CampaignOptions {
+            out: opts.out.clone(),
+            jobs: opts.jobs,
+            resume: opts.resume,
+            progress: opts.progress,
+            per_run_files: opts.out.is_some(),
+        },
+    )?;
+    if opts.json {
+        let _ = writeln!(out, "{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
+    } else {
+        let _ = print_table(&summary, out);
+        let _ = writeln!(
+            out,
+            "{} runs in {:.1} s wall time",
+            prepared.runs.len(),
+            started.elapsed().as_secs_f64()
+        );
+    }
+    Ok(summary)
+}

@@ -1,0 +1,114 @@
+//! A relative pose from the two-block percept, for motor schemas.
+//!
+//! * Range from the blocks' apparent height: d = f·h / H_img.
+//! * Bearing of the pair from the optical axis: atan(offset / f).
+//! * Viewing angle α (the robot's position angle off the dock axis): the nearer block looks
+//!   bigger. Each block's width and height scale with 1/distance and the block centres sit
+//!   ±w/4 from the middle, so the signed pixel-count (area) asymmetry is
+//!   (L − R)/(L + R) ≈ (w/2)·sin α / d, giving sin α ≈ 2·d·asym / w: the paper's ratio cue
+//!   (seed 004 §V) made metric. It is weak at
+//!   2 m (a 60° view changes the counts by 2 %) and strong near the gate, where the final
+//!   alignment is decided. (The fiducial's foreshortened aspect looks like a stronger cue
+//!   far away, but segmentation erodes the blocks' outer edges by a pixel, which biases it
+//!   by tens of degrees at range; we measured it in the simulator and left it out.)
+//!
+//! Sign conventions come from the camera mount, so the same code serves a rear camera
+//! rolled 180° (Bujold) and a forward camera.
+
+use super::camera_model::{CameraModel, body_from_camera};
+use super::two_block::TwoBlockPercept;
+use crate::profile::{CameraSpec, TwoBlockSpec};
+use nalgebra::Vector3;
+
+/// What a motor schema needs to know about the camera and the fiducial.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TwoBlockGeometry {
+    /// Horizontal focal length, px.
+    pub fx: f64,
+    /// Fiducial width and height, m.
+    pub size: (f64, f64),
+    /// +1 when image-right is the robot's −y side (right), −1 when it is +y.
+    pub image_right_sign: f64,
+    /// −1 when the camera looks backwards (the robot backs in), +1 when forwards.
+    pub drive_dir: f64,
+}
+
+impl TwoBlockGeometry {
+    /// From the profile's camera and fiducial.
+    pub fn new(camera: &CameraSpec, fiducial: &TwoBlockSpec) -> Self {
+        let fx = match CameraModel::from_spec(camera) {
+            CameraModel::Pinhole(p) => p.fx,
+            CameraModel::Fisheye(_) => camera.width_px as f64 / 2.0,
+        };
+        let r = body_from_camera(&camera.mount);
+        let right = r * Vector3::x();
+        let axis = r * Vector3::z();
+        Self {
+            fx,
+            size: (fiducial.width_m, fiducial.height_m),
+            image_right_sign: if right.y < 0.0 { 1.0 } else { -1.0 },
+            drive_dir: if axis.x < 0.0 { -1.0 } else { 1.0 },
+        }
+    }
+}
+
+/// Estimated relative pose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FiducialView {
+    /// Camera-to-fiducial distance, m.
+    pub distance: f64,
+    /// Robot position angle off the dock axis, rad (positive toward the dock's +y).
+    pub alpha: f64,
+    /// Signed pixel asymmetry (L − R)/(L + R), oriented so positive means α > 0.
+    pub asym: f64,
+    /// Pair offset from the image centre, px (as delivered).
+    pub offset_px: f64,
+    /// Bearing of the fiducial from the camera's viewing direction, rad, counter-clockwise
+    /// positive in the robot's frame.
+    pub bearing: f64,
+    /// Estimated robot heading in the dock frame, rad (0: rear toward the dock for a
+    /// backing robot, front toward it for a forward one, facing along the axis).
+    pub heading: f64,
+    /// Total pixels of both blocks.
+    pub total_px: u64,
+    /// Mean block height in the image, px (the estimates' reliability grows with it).
+    pub height_px: f64,
+}
+
+impl FiducialView {
+    /// Estimates the view from a found percept (`None` when not found or degenerate).
+    pub fn from_percept(p: &TwoBlockPercept, g: &TwoBlockGeometry) -> Option<Self> {
+        if !p.found || p.total_px == 0 {
+            return None;
+        }
+        let h_img = ((p.left_bbox[3] - p.left_bbox[1] + 1) + (p.right_bbox[3] - p.right_bbox[1] + 1)) as f64 / 2.0;
+        let (w, h) = g.size;
+        let distance = g.fx * h / h_img.max(1.0);
+        // A pin-hole camera magnifies off-axis objects: a pixel at angle φ from the optical
+        // axis subtends cos³φ/f² sr. Counting solid angle instead of pixels keeps the ratio a
+        // cue of the viewing angle alone, not of where the fiducial sits in the image (which
+        // would otherwise feed the steering back into itself).
+        let (cx, cy) = (p.image_size.0 as f64 / 2.0, p.image_size.1 as f64 / 2.0);
+        let solid = |count: u64, c: [f64; 2]| {
+            let r = (c[0] - cx).hypot(c[1] - cy) / g.fx;
+            count as f64 / (1.0 + r * r).powf(1.5)
+        };
+        let (l, r) = (solid(p.left_px, p.left_centroid), solid(p.right_px, p.right_centroid));
+        let asym = (l - r) / (l + r) * g.image_right_sign * -g.drive_dir;
+        let alpha = (2.0 * distance * asym / w)
+            .clamp(-1.0, 1.0)
+            .asin()
+            .clamp(-80f64.to_radians(), 80f64.to_radians());
+        let bearing = (p.offset_px / g.fx).atan() * g.image_right_sign * -g.drive_dir;
+        Some(Self {
+            distance,
+            alpha,
+            asym,
+            offset_px: p.offset_px,
+            bearing,
+            heading: crate::geometry::wrap_angle(alpha - bearing),
+            total_px: p.total_px,
+            height_px: h_img,
+        })
+    }
+}

@@ -1,0 +1,180 @@
+//! Ratio steering (seed 004 §V), in aim-point form.
+//!
+//! The paper maps the left/right pixel-count ratio to a steering command, with a dead band
+//! around straight ahead and deliberate understeer; the robot turns OR drives. Here the
+//! ratio (with the aspect cue of [`FiducialView`]) places an aim point on the dock axis
+//! halfway between the robot and the dock, and the schema keeps the fiducial where it
+//! must appear in the image for the robot's motion to head at that aim point. So the
+//! robot curves onto the axis as it closes in, and a balanced ratio with a centred
+//! fiducial means "on the axis, facing it": the paper's docking condition.
+//!
+//! * error e = (offset − desired offset) / (half image width);
+//! * |e| ≤ dead band: drive (toward the dock) at a speed that falls with the summed pixel
+//!   count; otherwise turn in place by `understeer` × the angle error this tick, capped at
+//!   the turn rate. Drives that can do both get one twist instead.
+
+use super::motor_output::{DriveCommand, MotorOutput};
+use crate::geometry::Twist;
+use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
+
+/// The ratio-steering motor schema.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RatioSteering {
+    /// Camera and fiducial geometry.
+    pub geometry: TwoBlockGeometry,
+    /// Image width, px.
+    pub image_width: f64,
+    /// Dead band on the normalised steering error.
+    pub dead_band: f64,
+    /// Fraction of the angle error turned per tick (< 1 understeers).
+    pub understeer: f64,
+    /// Turn rate cap, rad/s.
+    pub turn_rate: f64,
+    /// Drive speed far from the dock, m/s.
+    pub speed: f64,
+    /// Summed pixel count at the dock.
+    pub dock_total_px: f64,
+    /// Loop period, s.
+    pub tick_s: f64,
+    /// Turn OR drive (true), or both at once.
+    pub restricted: bool,
+}
+
+impl RatioSteering {
+    /// The aim-point angle δ (rad): how far the motion direction should point away from the
+    /// fiducial so that it heads at the point on the axis halfway in.
+    pub fn aim_angle(view: &FiducialView) -> f64 {
+        let (d, a) = (view.distance, view.alpha);
+        let (px, py) = (d * a.cos(), d * a.sin());
+        let aim = 0.5 * px;
+        let to_dock = (-py).atan2(-px);
+        let to_aim = (-py).atan2(aim - px);
+        crate::geometry::wrap_angle(to_aim - to_dock)
+    }
+
+    /// Normalised steering error in [−∞, ∞]; positive means "turn counter-clockwise" for the
+    /// mount in `geometry`.
+    pub fn error(&self, view: &FiducialView) -> f64 {
+        let g = &self.geometry;
+        let desired = g.fx * Self::aim_angle(view).tan() * g.image_right_sign * g.drive_dir;
+        let e = (view.offset_px - desired) / (self.image_width / 2.0);
+        e * -g.drive_dir * g.image_right_sign
+    }
+
+    /// Forward speed (signed toward the dock) for a summed pixel count.
+    pub fn speed_for(&self, total_px: f64) -> f64 {
+        let k = (1.0 - total_px / self.dock_total_px).clamp(0.3, 1.0);
+        self.speed * k * self.geometry.drive_dir
+    }
+
+    /// The command for one tick.
+    pub fn act(&self, view: &FiducialView) -> MotorOutput {
+        let e = self.error(view);
+        let angle = (e * self.image_width / 2.0 / self.geometry.fx).atan();
+        let omega = (self.understeer * angle / self.tick_s).clamp(-self.turn_rate, self.turn_rate);
+        let v = self.speed_for(view.total_px as f64);
+        if !self.restricted {
+            return MotorOutput::drive(DriveCommand::Twist(Twist::new(
+                v,
+                if e.abs() <= self.dead_band { 0.0 } else { omega },
+            )));
+        }
+        if e.abs() <= self.dead_band {
+            MotorOutput::drive(DriveCommand::Straight { v })
+        } else {
+            MotorOutput::drive(DriveCommand::Turn { omega })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rear_flipped() -> TwoBlockGeometry {
+        TwoBlockGeometry {
+            fx: 182.8,
+            size: (0.18, 0.11),
+            image_right_sign: 1.0,
+            drive_dir: -1.0,
+        }
+    }
+
+    fn schema() -> RatioSteering {
+        RatioSteering {
+            geometry: rear_flipped(),
+            image_width: 256.0,
+            dead_band: 0.05,
+            understeer: 0.6,
+            turn_rate: 0.5,
+            speed: 0.06,
+            dock_total_px: 9000.0,
+            tick_s: 0.1,
+            restricted: true,
+        }
+    }
+
+    fn view(alpha_deg: f64, offset_px: f64) -> FiducialView {
+        FiducialView {
+            distance: 1.0,
+            alpha: alpha_deg.to_radians(),
+            asym: 0.0,
+            offset_px,
+            bearing: 0.0,
+            heading: 0.0,
+            total_px: 1000,
+            height_px: 30.0,
+        }
+    }
+
+    #[test]
+    fn dead_band_drives_straight_backwards() {
+        let c = schema().act(&view(0.0, 3.0));
+        assert_eq!(
+            c.drive,
+            DriveCommand::Straight {
+                v: -0.06 * (1.0 - 1000.0 / 9000.0)
+            }
+        );
+    }
+
+    #[test]
+    fn turns_toward_the_fiducial_with_understeer() {
+        // Flipped rear camera: fiducial right of centre → rotate counter-clockwise.
+        let s = schema();
+        let DriveCommand::Turn { omega } = s.act(&view(0.0, 30.0)).drive else {
+            panic!()
+        };
+        let full = (30.0f64 / 182.8).atan() / 0.1;
+        assert!(omega > 0.0 && (omega - (0.6 * full).min(0.5)).abs() < 1e-9, "{omega}");
+        let DriveCommand::Turn { omega } = s.act(&view(0.0, -30.0)).drive else {
+            panic!()
+        };
+        assert!(omega < 0.0);
+    }
+
+    #[test]
+    fn off_axis_the_fiducial_is_held_off_centre_toward_the_axis() {
+        // At α = +40°, the aim point asks for the fiducial on the image's left: centred is wrong.
+        let s = schema();
+        assert!(RatioSteering::aim_angle(&view(40.0, 0.0)) > 0.1);
+        let e_centred = s.error(&view(40.0, 0.0));
+        assert!(e_centred > s.dead_band, "{e_centred}");
+        let desired = -182.8 * RatioSteering::aim_angle(&view(40.0, 0.0)).tan();
+        assert!(s.error(&view(40.0, desired)).abs() < 1e-9);
+        // Symmetric on the other side.
+        assert!((s.error(&view(-40.0, 0.0)) + e_centred).abs() < 1e-9);
+    }
+
+    #[test]
+    fn speed_falls_with_pixel_count_and_twist_for_free_drives() {
+        let mut s = schema();
+        assert!(s.speed_for(8000.0).abs() < s.speed_for(100.0).abs());
+        assert!(s.speed_for(20000.0).abs() >= 0.3 * 0.06 - 1e-12);
+        s.restricted = false;
+        let DriveCommand::Twist(t) = s.act(&view(0.0, 30.0)).drive else {
+            panic!()
+        };
+        assert!(t.v < 0.0 && t.omega > 0.0);
+    }
+}

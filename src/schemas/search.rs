@@ -1,0 +1,93 @@
+//! Search rotation and dead-reckoning back-in: the two open-loop motor schemas of docking.
+
+use super::motor_output::DriveCommand;
+
+/// Rotate in place to (re)acquire the target. With `doubling`, the sweep alternates sides
+/// and doubles after each switch (RAPOSA, seed 001 §II.E); otherwise it keeps turning one
+/// way (Bujold, seed 004 §V: "rotate until it is acquired").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SearchRotation {
+    /// Turn rate, rad/s (sign: first direction).
+    pub rate: f64,
+    /// First sweep, rad (for doubling search).
+    pub first_sweep: f64,
+    /// Alternate and double.
+    pub doubling: bool,
+}
+
+impl SearchRotation {
+    /// Command after `elapsed` seconds of searching.
+    pub fn act(&self, elapsed: f64) -> DriveCommand {
+        if !self.doubling || self.first_sweep <= 0.0 {
+            return DriveCommand::Turn { omega: self.rate };
+        }
+        // Sweep k (k = 0, 1, 2 …) turns through first·2^k, alternating direction; the turn
+        // back to the start is included in the doubled sweep.
+        let rate = self.rate.abs().max(1e-6);
+        let mut t = elapsed.max(0.0);
+        let mut k = 0;
+        loop {
+            let dur = self.first_sweep * 2f64.powi(k) / rate;
+            if t < dur || k > 30 {
+                let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+                return DriveCommand::Turn {
+                    omega: self.rate * sign,
+                };
+            }
+            t -= dur;
+            k += 1;
+        }
+    }
+}
+
+/// Drive straight a set distance by odometry (the paper's blind back-in).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DeadReckoning {
+    /// Signed speed, m/s (negative backs up).
+    pub speed: f64,
+    /// Distance to cover, m.
+    pub distance: f64,
+}
+
+impl DeadReckoning {
+    /// Command after covering `travelled` metres; `None` once the distance is done.
+    pub fn act(&self, travelled: f64) -> Option<DriveCommand> {
+        (travelled < self.distance).then_some(DriveCommand::Straight { v: self.speed })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn doubling_sweep_alternates() {
+        let s = SearchRotation {
+            rate: 0.5,
+            first_sweep: 0.5,
+            doubling: true,
+        };
+        // Sweep 0 lasts 1 s, sweep 1 lasts 2 s, sweep 2 lasts 4 s.
+        assert_eq!(s.act(0.5), DriveCommand::Turn { omega: 0.5 });
+        assert_eq!(s.act(1.5), DriveCommand::Turn { omega: -0.5 });
+        assert_eq!(s.act(2.9), DriveCommand::Turn { omega: -0.5 });
+        assert_eq!(s.act(3.1), DriveCommand::Turn { omega: 0.5 });
+        assert_eq!(s.act(7.1), DriveCommand::Turn { omega: -0.5 });
+        let plain = SearchRotation {
+            rate: -0.3,
+            first_sweep: 0.0,
+            doubling: false,
+        };
+        assert_eq!(plain.act(100.0), DriveCommand::Turn { omega: -0.3 });
+    }
+
+    #[test]
+    fn dead_reckoning_stops_at_distance() {
+        let d = DeadReckoning {
+            speed: -0.03,
+            distance: 0.5,
+        };
+        assert_eq!(d.act(0.2), Some(DriveCommand::Straight { v: -0.03 }));
+        assert_eq!(d.act(0.5), None);
+    }
+}
