@@ -114,6 +114,8 @@ pub const MOVE_AWAY_M: f64 = 0.35;
 pub const STAGING_X_M: f64 = 0.75;
 /// Lateral error (m) above which a reliable view triggers repositioning.
 pub const REPOSITION_LATERAL_M: f64 = 0.08;
+/// Closer to the body than this (m along the axis) the robot drives out before turning.
+pub const CLEARANCE_X_M: f64 = 0.45;
 /// Blocks at least this tall (px) give a viewing angle good enough to plan on.
 pub const RELIABLE_HEIGHT_PX: f64 = 40.0;
 
@@ -265,7 +267,17 @@ impl BujoldAgent {
         let t = odo.compose(&here.relative(&Pose2::default()));
         let target = t.compose(&stage);
         tracing::debug!(target: "marsupial::behavior", now, x = here.x, y = here.y, heading_deg = here.theta.to_degrees(), "reposition to the axis");
-        self.enter(Phase::Reposition { stage: 0, target }, now, odo);
+        // Beside the gate there is no room to turn in place (the body's corners sweep a
+        // circle of half the diagonal): first drive straight out, front first.
+        let clear = here.x < CLEARANCE_X_M;
+        self.enter(
+            Phase::Reposition {
+                stage: if clear { 3 } else { 0 },
+                target,
+            },
+            now,
+            odo,
+        );
     }
 
     fn approach_command(&self, view: &FiducialView) -> MotorOutput {
@@ -551,6 +563,21 @@ impl Behavior for BujoldAgent {
                     MotorOutput::drive(DriveCommand::Turn { omega: w }).with_aux(raised())
                 };
                 match stage {
+                    3 => {
+                        // Clear the body: straight out, front first, 0.3 m.
+                        if self.travelled(&odo) >= 0.3 {
+                            self.phase = Phase::Reposition { stage: 0, target };
+                            Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                        } else {
+                            Step::running(
+                                MotorOutput::drive(DriveCommand::Straight {
+                                    v: -dir * self.steering.speed,
+                                })
+                                .with_aux(raised()),
+                                self.feedback(now),
+                            )
+                        }
+                    }
                     0 | 1 if dist < 0.03 => {
                         self.phase = Phase::Reposition { stage: 2, target };
                         Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))

@@ -17,6 +17,9 @@ use super::motor_output::{DriveCommand, MotorOutput};
 use crate::geometry::Twist;
 use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
 
+/// Largest aim angle, rad (25°).
+pub const MAX_AIM_RAD: f64 = 25.0 * std::f64::consts::PI / 180.0;
+
 /// The ratio-steering motor schema.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RatioSteering {
@@ -42,14 +45,16 @@ pub struct RatioSteering {
 
 impl RatioSteering {
     /// The aim-point angle δ (rad): how far the motion direction should point away from the
-    /// fiducial so that it heads at the point on the axis halfway in.
+    /// fiducial so that it heads at the point on the axis halfway in. Capped at
+    /// [`MAX_AIM_RAD`] so the fiducial stays well inside the image; larger offsets are the
+    /// repositioning manoeuvre's job.
     pub fn aim_angle(view: &FiducialView) -> f64 {
         let (d, a) = (view.distance, view.alpha);
         let (px, py) = (d * a.cos(), d * a.sin());
         let aim = 0.5 * px;
         let to_dock = (-py).atan2(-px);
         let to_aim = (-py).atan2(aim - px);
-        crate::geometry::wrap_angle(to_aim - to_dock)
+        crate::geometry::wrap_angle(to_aim - to_dock).clamp(-MAX_AIM_RAD, MAX_AIM_RAD)
     }
 
     /// Normalised steering error in [−∞, ∞]; positive means "turn counter-clockwise" for the

@@ -456,14 +456,24 @@ impl Scenario {
         }
     }
 
-    /// The start poses, in order. Headings default to "camera facing the dock".
+    /// The start poses, in order. Headings default to "camera facing the dock". Polar
+    /// starts (and the grid) measure the distance from the entrance to the robot's end
+    /// nearest the dock, as a proctor places it; Cartesian starts give the robot's centre.
     pub fn starts(&self, profile: &Profile) -> Vec<Start> {
         let cam_yaw = profile.cameras.first().map_or(0.0, |c| c.mount.yaw_deg.to_radians());
-        let make = |label: String, x: f64, y: f64, heading: Option<f64>| {
+        let half = profile.body.length_m / 2.0;
+        let make = |label: String, x: f64, y: f64, heading: Option<f64>, polar: bool| {
             let theta = heading.map(f64::to_radians).unwrap_or_else(|| (-y).atan2(-x) - cam_yaw);
+            let (cx, cy) = if polar {
+                // Push the centre out along the bearing by half the body.
+                let b = y.atan2(x);
+                (x + half * b.cos(), y + half * b.sin())
+            } else {
+                (x, y)
+            };
             Start {
                 label,
-                pose: Pose2::new(x, y, theta),
+                pose: Pose2::new(cx, cy, theta),
                 distance: x.hypot(y),
                 angle_deg: y.atan2(x).to_degrees(),
             }
@@ -494,17 +504,17 @@ impl Scenario {
                     continue;
                 }
                 let r = ang.to_radians();
-                out.push(make((i + 1).to_string(), d * r.cos(), d * r.sin(), None));
+                out.push(make((i + 1).to_string(), d * r.cos(), d * r.sin(), None, true));
             }
         }
         for (i, p) in self.starts.points.iter().enumerate() {
-            let (x, y) = match (p.distance_m, p.angle_deg, p.x_m, p.y_m) {
-                (Some(d), Some(a), _, _) => (d * a.to_radians().cos(), d * a.to_radians().sin()),
-                (_, _, Some(x), Some(y)) => (x, y),
+            let (x, y, polar) = match (p.distance_m, p.angle_deg, p.x_m, p.y_m) {
+                (Some(d), Some(a), _, _) => (d * a.to_radians().cos(), d * a.to_radians().sin(), true),
+                (_, _, Some(x), Some(y)) => (x, y, false),
                 _ => continue,
             };
             let label = p.label.clone().unwrap_or_else(|| format!("p{}", i + 1));
-            out.push(make(label, x, y, p.heading_deg));
+            out.push(make(label, x, y, p.heading_deg, polar));
         }
         out
     }
