@@ -1,0 +1,140 @@
+//! Malformed scenarios fail with the file, field path, line and expectation, like profiles.
+
+use marsupial::config::ConfigError;
+use marsupial::sim::scenario::Scenario;
+use std::path::{Path, PathBuf};
+
+fn write(name: &str, body: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("marsupial-scenario-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let profile = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/bujold.toml");
+    let p = dir.join(name);
+    std::fs::write(
+        &p,
+        format!("name = \"bad\"\nprofile = \"{}\"\n{body}", profile.display()),
+    )
+    .unwrap();
+    p
+}
+
+fn problem(path: &Path) -> (String, Option<usize>, String) {
+    match Scenario::load(path).unwrap_err() {
+        ConfigError::Invalid { problems, .. } => {
+            (problems[0].path.clone(), problems[0].line, problems[0].message.clone())
+        }
+        e => panic!("{e:?}"),
+    }
+}
+
+#[test]
+fn malformed_scenarios_are_reported_precisely() {
+    let cases: &[(&str, &str, &str, Option<usize>, &str)] = &[
+        (
+            "no_starts.toml",
+            "[starts]\n",
+            "starts",
+            Some(3),
+            "expected a `grid` or at least one entry in `points`",
+        ),
+        (
+            "bad_grid.toml",
+            "[starts]\ngrid = \"paper17\"\n",
+            "starts.grid",
+            Some(4),
+            "unknown variant `paper17`",
+        ),
+        (
+            "bad_select.toml",
+            "[starts]\ngrid = \"paper16\"\nselect = [1, 17]\n",
+            "starts.select[1]",
+            Some(5),
+            "expected a grid position 1–16, got 17",
+        ),
+        (
+            "both_coords.toml",
+            "[starts]\npoints = [ { distance_m = 1.0, angle_deg = 3.0, x_m = 1.0, y_m = 0.0 } ]\n",
+            "starts.points[0]",
+            Some(4),
+            "either distance_m and angle_deg, or x_m and y_m",
+        ),
+        (
+            "unknown_light.toml",
+            "[starts]\ngrid = \"paper16\"\n[axes]\nlighting = [\"disco\"]\n",
+            "axes.lighting[0]",
+            Some(6),
+            "unknown lighting `disco`",
+        ),
+        (
+            "bad_terrain.toml",
+            "[starts]\ngrid = \"paper16\"\n[axes]\nterrain = [\"ice\"]\n",
+            "axes.terrain[0]",
+            Some(6),
+            "unknown variant `ice`",
+        ),
+        (
+            "typo.toml",
+            "trails = 3\n[starts]\ngrid = \"paper16\"\n",
+            "trails",
+            Some(3),
+            "unknown field `trails`",
+        ),
+        (
+            "neg_timeout.toml",
+            "timeout_s = -1.0\n[starts]\ngrid = \"paper16\"\n",
+            "timeout_s",
+            Some(3),
+            "expected a positive number",
+        ),
+        (
+            "bad_shadow.toml",
+            "[starts]\ngrid = \"paper16\"\n[lighting.x]\npreset = \"noon\"\nshadows = [ { strength = 2.0, angle_deg = 0.0, offset_m = 0.0, amplitude_m = 0.0, period_s = 1.0, softness_m = 0.0 } ]\n",
+            "lighting.x.shadows[0].strength",
+            Some(7),
+            "expected a number in [0, 1], got 2",
+        ),
+    ];
+    for (file, body, path, line, text) in cases {
+        let (p, l, m) = problem(&write(file, body));
+        assert_eq!(&p, path, "{file}: {m}");
+        assert_eq!(l, *line, "{file}");
+        assert!(m.contains(text), "{file}: {m}");
+    }
+}
+
+#[test]
+fn missing_profile_and_backdrop_name_the_files() {
+    let dir = std::env::temp_dir().join(format!("marsupial-scenario-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("no_profile.toml");
+    std::fs::write(
+        &p,
+        "name = \"x\"\nprofile = \"nowhere.toml\"\n[starts]\ngrid = \"paper16\"\n",
+    )
+    .unwrap();
+    assert!(
+        Scenario::load(&p)
+            .unwrap_err()
+            .to_string()
+            .contains("nowhere.toml: cannot read file")
+    );
+    let p = write(
+        "no_backdrop.toml",
+        "backgrounds = [\"missing.jpg\"]\n[starts]\ngrid = \"paper16\"\n",
+    );
+    let e = Scenario::load(&p).unwrap_err().to_string();
+    assert!(e.contains("backgrounds[0]") && e.contains("missing.jpg"), "{e}");
+}
+
+#[test]
+fn shipped_scenarios_are_valid_and_check_accepts_them() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let mut n = 0;
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "toml") {
+            marsupial::cli::check::check_file(&p).unwrap_or_else(|e| panic!("{e}"));
+            n += 1;
+        }
+    }
+    assert!(n >= 5);
+}
