@@ -601,18 +601,24 @@ impl Behavior for BujoldAgent {
                         }
                     }
                     1 => {
-                        let heading_to = dy.atan2(dx);
-                        let ahead =
-                            crate::geometry::wrap_angle(heading_to - odo.theta).abs() <= std::f64::consts::FRAC_PI_2;
-                        let v = if ahead {
-                            self.steering.speed
+                        // Drive along the heading until the target is abeam: the signed
+                        // distance to it along the heading crosses zero (a target off the
+                        // line of travel is never reached exactly).
+                        let along = dx * odo.theta.cos() + dy * odo.theta.sin();
+                        if along.abs() < 0.02 {
+                            self.phase = Phase::Reposition { stage: 2, target };
+                            Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
                         } else {
-                            -self.steering.speed
-                        };
-                        Step::running(
-                            MotorOutput::drive(DriveCommand::Straight { v }).with_aux(raised()),
-                            self.feedback(now),
-                        )
+                            let v = self
+                                .steering
+                                .speed
+                                .min(along.abs() / self.steering.tick_s)
+                                .copysign(along);
+                            Step::running(
+                                MotorOutput::drive(DriveCommand::Straight { v }).with_aux(raised()),
+                                self.feedback(now),
+                            )
+                        }
                     }
                     _ => {
                         let err = crate::geometry::wrap_angle(target.theta - odo.theta);
