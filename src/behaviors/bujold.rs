@@ -310,6 +310,49 @@ impl BujoldAgent {
     }
 }
 
+/// The at-dock decision (seed 004 §V): "if the ratio of left to right pixel counts is close
+/// to one and the fiducial is centred, back in; otherwise move away and retry", made
+/// metric: average the views, predict the lateral error where the rear will reach the
+/// entrance (backing a distance s at heading θ shifts the robot by −s·sin θ), and back in
+/// only if that and the heading are within 80 % of the profile's tolerances.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Decision {
+    /// Back in now.
+    pub back_in: bool,
+    /// Mean viewing angle, rad.
+    pub alpha: f64,
+    /// Mean heading, rad.
+    pub heading: f64,
+    /// Mean camera distance, m.
+    pub distance: f64,
+    /// Predicted lateral error at the entrance, m.
+    pub lateral_at_entrance: f64,
+}
+
+/// See [`Decision`]. `samples` must not be empty (an empty slice decides "no").
+pub fn at_dock_decision(
+    samples: &[FiducialView],
+    rear_behind_camera: f64,
+    tol_lateral: f64,
+    tol_heading: f64,
+) -> Decision {
+    let n = samples.len().max(1) as f64;
+    let alpha = samples.iter().map(|s| s.alpha).sum::<f64>() / n;
+    let heading = samples.iter().map(|s| s.heading).sum::<f64>() / n;
+    let distance = samples.iter().map(|s| s.distance).sum::<f64>() / n;
+    let to_go = (distance - rear_behind_camera).max(0.0);
+    let lateral_at_entrance = distance * alpha.sin() - to_go * heading.sin();
+    Decision {
+        back_in: !samples.is_empty()
+            && lateral_at_entrance.abs() <= 0.8 * tol_lateral
+            && heading.abs() <= 0.8 * tol_heading,
+        alpha,
+        heading,
+        distance,
+        lateral_at_entrance,
+    }
+}
+
 fn lowered() -> Auxiliary {
     Auxiliary {
         posture: Some(Posture::Lowered),
@@ -507,15 +550,14 @@ impl Behavior for BujoldAgent {
                     }
                     Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
                 } else {
-                    let n = self.samples.len() as f64;
-                    let alpha = self.samples.iter().map(|s| s.alpha).sum::<f64>() / n;
-                    let heading = self.samples.iter().map(|s| s.heading).sum::<f64>() / n;
-                    let dist = self.samples.iter().map(|s| s.distance).sum::<f64>() / n;
-                    // Lateral error where the rear will reach the entrance: backing a distance
-                    // s at heading θ shifts the robot by −s·sin θ.
-                    let to_go = (dist - self.rear_behind_camera).max(0.0);
-                    let arrive = dist * alpha.sin() - to_go * heading.sin();
-                    if arrive.abs() <= 0.8 * self.tol_lateral && heading.abs() <= 0.8 * self.tol_heading {
+                    let d = at_dock_decision(
+                        &self.samples,
+                        self.rear_behind_camera,
+                        self.tol_lateral,
+                        self.tol_heading,
+                    );
+                    let (alpha, heading, dist) = (d.alpha, d.heading, d.distance);
+                    if d.back_in {
                         self.samples_distance = dist;
                         self.enter(Phase::BackIn, now, odo);
                         Step::running(MotorOutput::stop().with_aux(lowered()), self.feedback(now))
@@ -688,5 +730,47 @@ impl Agent for BujoldAgent {
         self.last_seen = None;
         self.phase = Phase::Search;
         self.phase_start = f64::NEG_INFINITY;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn view(alpha_deg: f64, heading_deg: f64) -> FiducialView {
+        FiducialView {
+            distance: 0.38,
+            alpha: alpha_deg.to_radians(),
+            asym: 0.0,
+            offset_px: 0.0,
+            bearing: 0.0,
+            heading: heading_deg.to_radians(),
+            total_px: 4600,
+            height_px: 50.0,
+        }
+    }
+
+    #[test]
+    fn centred_and_balanced_backs_in() {
+        let d = at_dock_decision(&[view(0.5, 0.5); 5], 0.15, 0.02, 5f64.to_radians());
+        assert!(d.back_in, "{d:?}");
+    }
+
+    #[test]
+    fn off_axis_or_skewed_moves_away() {
+        // 3° off the axis at 0.38 m is 2 cm: beyond 80 % of the ±2 cm tolerance.
+        assert!(!at_dock_decision(&[view(3.0, 0.0); 5], 0.15, 0.02, 5f64.to_radians()).back_in);
+        // On the axis but heading 4.5°: within 5° but beyond 80 % of it.
+        assert!(!at_dock_decision(&[view(0.0, 4.5); 5], 0.15, 0.02, 5f64.to_radians()).back_in);
+        // A small offset cancelled by a heading that steers back onto the axis: backs in.
+        let d = at_dock_decision(&[view(1.5, 2.0); 5], 0.15, 0.02, 5f64.to_radians());
+        assert!(d.lateral_at_entrance.abs() < 0.003 && d.back_in, "{d:?}");
+        assert!(!at_dock_decision(&[], 0.15, 0.02, 0.1).back_in);
+    }
+
+    #[test]
+    fn averages_the_samples() {
+        let d = at_dock_decision(&[view(2.0, 0.0), view(-2.0, 0.0)], 0.15, 0.02, 0.1);
+        assert!(d.alpha.abs() < 1e-12 && d.back_in);
     }
 }

@@ -184,7 +184,7 @@ pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimE
     let loaded = Scenario::load(&opts.scenario)?;
     let prepared = campaign::prepare(loaded)?;
     let started = std::time::Instant::now();
-    let (_records, summary) = campaign::run_campaign(
+    let (records, summary) = campaign::run_campaign(
         &prepared,
         &agent_for,
         &CampaignOptions {
@@ -195,10 +195,25 @@ pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimE
             per_run_files: opts.out.is_some(),
         },
     )?;
+    let comparison = prepared
+        .loaded
+        .scenario
+        .compare
+        .map(|t| crate::sim::paper::comparison(t, &records));
+    if let (Some(c), Some(dir)) = (&comparison, &opts.out) {
+        let p = dir.join("paper_comparison.txt");
+        std::fs::write(&p, c).map_err(|source| SimError::Io {
+            path: p.display().to_string(),
+            source,
+        })?;
+    }
     if opts.json {
         let _ = writeln!(out, "{}", serde_json::to_string_pretty(&summary).unwrap_or_default());
     } else {
         let _ = print_table(&summary, out);
+        if let Some(c) = &comparison {
+            let _ = writeln!(out, "\n{c}");
+        }
         let _ = writeln!(
             out,
             "{} runs in {:.1} s wall time",

@@ -35,6 +35,7 @@ pub mod campaign;
 pub mod dock;
 pub mod engine;
 pub mod motion;
+pub mod paper;
 pub mod plot;
 pub mod scenario;
 pub mod tether;

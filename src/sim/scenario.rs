@@ -245,6 +245,9 @@ pub struct Scenario {
     /// Recording.
     #[serde(default)]
     pub record: RecordSpec,
+    /// A published table to print beside the results.
+    #[serde(default)]
+    pub compare: Option<super::paper::PaperTable>,
 }
 
 fn one() -> u32 {
