@@ -256,14 +256,21 @@ impl Renderer {
 
     fn screen_bounds(&self, prim: &Prim, to_cam: &dyn Fn(&Point3<f64>) -> Vector3<f64>) -> Option<[usize; 4]> {
         let full = Some([0, 0, self.width, self.height]);
-        let pts: Vec<Vector3<f64>> = prim.bounds().iter().map(to_cam).collect();
+        // Fixed-size scratch: culling runs for every primitive every frame.
+        let corners = prim.bounds();
+        let mut pts = [Vector3::zeros(); 8];
+        let n = corners.as_slice().len();
+        for (q, p) in pts.iter_mut().zip(corners.as_slice()) {
+            *q = to_cam(p);
+        }
+        let pts = &pts[..n];
         let fisheye = matches!(self.model, CameraModel::Fisheye(_));
         if fisheye {
             // Wide-angle projection bends edges: project the corners, widen generously, and
             // fall back to the whole frame when a corner is outside the model's field.
             let mut lo = [f64::INFINITY; 2];
             let mut hi = [f64::NEG_INFINITY; 2];
-            for p in &pts {
+            for p in pts {
                 let px = self.model.project(p)?;
                 for i in 0..2 {
                     lo[i] = lo[i].min(px[i]);
@@ -276,36 +283,40 @@ impl Renderer {
                 .or(full);
         }
         // Pin-hole: clip the outline (a polygon, or the box corners of a sphere) to z ≥ near,
-        // then project.
+        // then project. Clipping a polygon against one plane adds at most one vertex.
         const NEAR: f64 = 1e-3;
-        let outline: Vec<Vector3<f64>> = if matches!(prim.shape, Shape::Sphere { .. }) {
+        let mut clipped = [Vector3::zeros(); 9];
+        let mut m = 0;
+        if matches!(prim.shape, Shape::Sphere { .. }) {
             if pts.iter().all(|p| p.z <= NEAR) {
                 return None;
             }
             if pts.iter().any(|p| p.z <= NEAR) {
                 return full;
             }
-            pts
+            clipped[..n].copy_from_slice(pts);
+            m = n;
         } else {
-            let mut out = Vec::with_capacity(pts.len() + 2);
-            for i in 0..pts.len() {
-                let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+            for i in 0..n {
+                let (a, b) = (pts[i], pts[(i + 1) % n]);
                 if a.z >= NEAR {
-                    out.push(a);
+                    clipped[m] = a;
+                    m += 1;
                 }
                 if (a.z >= NEAR) != (b.z >= NEAR) {
                     let t = (NEAR - a.z) / (b.z - a.z);
-                    out.push(a + (b - a) * t);
+                    clipped[m] = a + (b - a) * t;
+                    m += 1;
                 }
             }
-            out
-        };
+        }
+        let outline = &clipped[..m];
         if outline.is_empty() {
             return None;
         }
         let mut lo = [f64::INFINITY; 2];
         let mut hi = [f64::NEG_INFINITY; 2];
-        for p in &outline {
+        for p in outline {
             // Project without distortion first (exact for the clipped polygon's extent)…
             let (x, y) = (p.x / p.z, p.y / p.z);
             let px = match &self.model {

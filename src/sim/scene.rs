@@ -128,30 +128,59 @@ impl Prim {
         }
     }
 
-    /// Corner points bounding the primitive (for screen-space culling).
-    pub fn bounds(&self) -> Vec<Point3<f64>> {
+    /// Corner points bounding the primitive (for screen-space culling): the outline of a
+    /// planar primitive in order, or the eight box corners of a sphere. A fixed array, so
+    /// the renderer's per-frame culling allocates nothing.
+    pub fn bounds(&self) -> Corners {
+        let mut c = Corners {
+            pts: [Point3::origin(); 8],
+            len: 0,
+        };
+        let square = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
         match &self.shape {
-            Shape::Rect { centre, u, v, half } => [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-                .iter()
-                .map(|(a, b)| centre + u * (a * half[0]) + v * (b * half[1]))
-                .collect(),
-            Shape::Disc { centre, u, v, radius } => [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-                .iter()
-                .map(|(a, b)| centre + u * (a * radius) + v * (b * radius))
-                .collect(),
-            Shape::Triangle { p } => p.to_vec(),
+            Shape::Rect { centre, u, v, half } => {
+                for (a, b) in square {
+                    c.push(centre + u * (a * half[0]) + v * (b * half[1]));
+                }
+            }
+            Shape::Disc { centre, u, v, radius } => {
+                for (a, b) in square {
+                    c.push(centre + u * (a * radius) + v * (b * radius));
+                }
+            }
+            Shape::Triangle { p } => p.iter().for_each(|q| c.push(*q)),
             Shape::Sphere { centre, radius } => {
-                let mut out = Vec::with_capacity(8);
                 for dx in [-1.0, 1.0] {
                     for dy in [-1.0, 1.0] {
                         for dz in [-1.0, 1.0] {
-                            out.push(centre + Vector3::new(dx, dy, dz) * *radius);
+                            c.push(centre + Vector3::new(dx, dy, dz) * *radius);
                         }
                     }
                 }
-                out
             }
         }
+        c
+    }
+}
+
+/// Up to eight bounding points of a primitive.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Corners {
+    pts: [Point3<f64>; 8],
+    len: usize,
+}
+
+impl Corners {
+    fn push(&mut self, p: Point3<f64>) {
+        if self.len < self.pts.len() {
+            self.pts[self.len] = p;
+            self.len += 1;
+        }
+    }
+
+    /// The points.
+    pub fn as_slice(&self) -> &[Point3<f64>] {
+        &self.pts[..self.len]
     }
 }
 
