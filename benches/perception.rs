@@ -46,7 +46,7 @@ fn bench_size(c: &mut Criterion, w: usize, h: usize) {
     });
     let ranges = schema.model().ranges();
     let cr = [ColorRange::Sct(ranges[0]), ColorRange::Sct(ranges[1])];
-    let mut seg = Segmenter::new(w);
+    let mut seg = Segmenter::new();
     let mut masks = [Mask::new(w, h), Mask::new(w, h)];
     g.bench_function("stage_1_segment_both_colours", |b| {
         b.iter(|| seg.segment(black_box(&view), &cr, &mut masks).expect("segment"))

@@ -111,6 +111,17 @@ enum Command {
     },
 }
 
+/// Exit status of a subcommand: success, or the error on stderr and status 1.
+fn exit_code<T, E: std::fmt::Display>(result: Result<T, E>) -> ExitCode {
+    match result {
+        Ok(_) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
 fn parse_at(s: &str) -> Result<(f64, f64, f64), String> {
     let v: Vec<f64> = s
         .split(',')
@@ -151,13 +162,7 @@ fn main() -> ExitCode {
                 json,
                 out,
             };
-            match marsupial::cli::sim_cmds::dock(&opts, &mut std::io::stdout()) {
-                Ok(_) => ExitCode::SUCCESS,
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::FAILURE
-                }
-            }
+            exit_code(marsupial::cli::sim_cmds::dock(&opts, &mut std::io::stdout()))
         }
         Command::Trials {
             scenario,
@@ -174,13 +179,7 @@ fn main() -> ExitCode {
                 resume,
                 progress: std::io::IsTerminal::is_terminal(&std::io::stderr()),
             };
-            match marsupial::cli::sim_cmds::trials(&opts, &mut std::io::stdout()) {
-                Ok(_) => ExitCode::SUCCESS,
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::FAILURE
-                }
-            }
+            exit_code(marsupial::cli::sim_cmds::trials(&opts, &mut std::io::stdout()))
         }
         Command::Detect {
             profile,
@@ -202,13 +201,7 @@ fn main() -> ExitCode {
                 interval,
                 images,
             };
-            match marsupial::cli::detect::run(&opts, &mut std::io::stdout()) {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::FAILURE
-                }
-            }
+            exit_code(marsupial::cli::detect::run(&opts, &mut std::io::stdout()))
         }
     }
 }

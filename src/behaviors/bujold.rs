@@ -108,6 +108,8 @@ pub struct BujoldAgent {
 
 /// Distance from the dock the robot drives to on departure, m.
 pub const DEPARTURE_DISTANCE_M: f64 = 1.2;
+/// Speed driving away from the dock (departure, backing off), m/s.
+pub const DEPARTURE_SPEED_MPS: f64 = 0.06;
 /// How far a retry backs off, m.
 pub const MOVE_AWAY_M: f64 = 0.35;
 /// Staging distance on the dock axis for repositioning, m.
@@ -228,6 +230,20 @@ impl BujoldAgent {
 
     fn travelled(&self, odo: &Pose2) -> f64 {
         (odo.x - self.odo_mark.x).hypot(odo.y - self.odo_mark.y)
+    }
+
+    /// Stand still, raised.
+    fn hold(&self, now: f64) -> Step {
+        Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+    }
+
+    /// Drive straight away from the dock (front first), raised, at the departure speed.
+    fn drive_away(&self, now: f64) -> Step {
+        let v = -self.geometry.drive_dir * DEPARTURE_SPEED_MPS;
+        Step::running(
+            MotorOutput::drive(DriveCommand::Straight { v }).with_aux(raised()),
+            self.feedback(now),
+        )
     }
 
     fn feedback(&self, now: f64) -> Feedback {
@@ -455,7 +471,7 @@ impl Behavior for BujoldAgent {
                 let out = self.travelled(&odo);
                 if !self.imprinted && out >= self.imprint_at {
                     self.enter(Phase::Imprint { frames: 0 }, now, self.odo_mark);
-                    Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                    self.hold(now)
                 } else if out >= self.drive_out {
                     self.phase = Phase::Done;
                     let outcome = if self.imprinted {
@@ -465,13 +481,7 @@ impl Behavior for BujoldAgent {
                     };
                     Step::done(outcome, MotorOutput::stop().with_aux(raised()), self.feedback(now))
                 } else {
-                    Step::running(
-                        MotorOutput {
-                            drive: DriveCommand::Straight { v: -dir * 0.06 },
-                            aux: raised(),
-                        },
-                        self.feedback(now),
-                    )
+                    self.drive_away(now)
                 }
             }
             Phase::Imprint { frames } => {
@@ -486,7 +496,7 @@ impl Behavior for BujoldAgent {
                 } else {
                     self.phase = Phase::Imprint { frames };
                 }
-                Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                self.hold(now)
             }
             // ---- docking ----
             Phase::Search => {
@@ -512,7 +522,7 @@ impl Behavior for BujoldAgent {
             Phase::Approach => match view {
                 Some(v) if v.total_px as f64 >= self.steering.dock_total_px => {
                     self.enter(Phase::Decide, now, odo);
-                    Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                    self.hold(now)
                 }
                 Some(_)
                     if self.settled >= 10
@@ -528,14 +538,14 @@ impl Behavior for BujoldAgent {
                     if let Some(p) = planning {
                         self.reposition(&p, now, odo);
                     }
-                    Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                    self.hold(now)
                 }
                 Some(v) => Step::running(self.approach_command(&v).with_aux(raised()), self.feedback(now)),
                 None => {
                     if self.last_seen.is_none_or(|t| now - t > 1.5) {
                         self.enter(Phase::Search, now, odo);
                     }
-                    Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                    self.hold(now)
                 }
             },
             Phase::Decide => {
@@ -548,7 +558,7 @@ impl Behavior for BujoldAgent {
                         self.retries += 1;
                         self.enter(Phase::MoveAway { failing: None }, now, odo);
                     }
-                    Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                    self.hold(now)
                 } else {
                     let d = at_dock_decision(
                         &self.samples,
@@ -573,7 +583,7 @@ impl Behavior for BujoldAgent {
                             ..self.samples[0]
                         };
                         self.reposition(&mean, now, odo);
-                        Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                        self.hold(now)
                     }
                 }
             }
@@ -609,7 +619,7 @@ impl Behavior for BujoldAgent {
                         // Clear the body: straight out, front first, 0.3 m.
                         if self.travelled(&odo) >= 0.3 {
                             self.phase = Phase::Reposition { stage: 0, target };
-                            Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                            self.hold(now)
                         } else {
                             Step::running(
                                 MotorOutput::drive(DriveCommand::Straight {
@@ -622,7 +632,7 @@ impl Behavior for BujoldAgent {
                     }
                     0 | 1 if dist < 0.03 => {
                         self.phase = Phase::Reposition { stage: 2, target };
-                        Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                        self.hold(now)
                     }
                     0 => {
                         // Face the staging point with the end that leads toward it.
@@ -637,7 +647,7 @@ impl Behavior for BujoldAgent {
                         let err = crate::geometry::wrap_angle(want - odo.theta);
                         if err.abs() < tol {
                             self.phase = Phase::Reposition { stage: 1, target };
-                            Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                            self.hold(now)
                         } else {
                             Step::running(turn(err), self.feedback(now))
                         }
@@ -649,7 +659,7 @@ impl Behavior for BujoldAgent {
                         let along = dx * odo.theta.cos() + dy * odo.theta.sin();
                         if along.abs() < 0.02 {
                             self.phase = Phase::Reposition { stage: 2, target };
-                            Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                            self.hold(now)
                         } else {
                             let v = self
                                 .steering
@@ -668,7 +678,7 @@ impl Behavior for BujoldAgent {
                             self.alpha_filtered = None;
                             self.settled = 0;
                             self.enter(Phase::Approach, now, odo);
-                            Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                            self.hold(now)
                         } else {
                             Step::running(turn(err), self.feedback(now))
                         }
@@ -688,17 +698,11 @@ impl Behavior for BujoldAgent {
                         }
                         None => {
                             self.enter(Phase::Approach, now, odo);
-                            Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+                            self.hold(now)
                         }
                     }
                 } else {
-                    Step::running(
-                        MotorOutput {
-                            drive: DriveCommand::Straight { v: -dir * 0.06 },
-                            aux: raised(),
-                        },
-                        self.feedback(now),
-                    )
+                    self.drive_away(now)
                 }
             }
         };

@@ -168,7 +168,7 @@ pub fn run(opts: &DetectOptions, out: &mut dyn Write) -> Result<(), DetectError>
 }
 
 fn write_record(out: &mut dyn Write, image: &str, p: &TwoBlockPercept, us: f64, json: bool) -> Result<(), DetectError> {
-    let found = |v| if p.found { Some(v) } else { None };
+    let found = |v: [f64; 2]| p.found.then_some(v);
     let rec = DetectRecord {
         image,
         width: p.image_size.0,
@@ -180,7 +180,7 @@ fn write_record(out: &mut dyn Write, image: &str, p: &TwoBlockPercept, us: f64, 
         ratio: p.ratio,
         left_centroid: found(p.left_centroid),
         right_centroid: found(p.right_centroid),
-        offset_px: found([p.offset_px, 0.0]).map(|v| v[0]),
+        offset_px: p.found.then_some(p.offset_px),
         mode: p.mode.to_string(),
         us_per_frame: (us * 10.0).round() / 10.0,
     };

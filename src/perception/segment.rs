@@ -247,14 +247,13 @@ pub struct Segmenter {
 
 impl Default for Segmenter {
     fn default() -> Self {
-        Self::new(0)
+        Self::new()
     }
 }
 
 impl Segmenter {
-    /// A segmenter. `_max_width` is accepted for symmetry with the other perception
-    /// structs; the tables do not depend on the frame size.
-    pub fn new(_max_width: usize) -> Self {
+    /// A segmenter; its tables do not depend on the frame size.
+    pub fn new() -> Self {
         Self {
             thresholds: Vec::with_capacity(8),
             b_table: vec![0; 1 << 16],
@@ -378,7 +377,7 @@ mod tests {
         });
         let im = RgbImage::from_raw(4, 1, vec![0, 200, 210, 190, 10, 200, 5, 5, 5, 128, 128, 128]).unwrap();
         let mut masks = [Mask::new(4, 1), Mask::new(4, 1)];
-        Segmenter::new(4)
+        Segmenter::new()
             .segment(&im.view(), &[cyan, magenta], &mut masks)
             .unwrap();
         assert_eq!(masks[0].data(), &[1, 0, 0, 0]);
@@ -428,7 +427,7 @@ mod tests {
         }
         let cr: Vec<ColorRange> = ranges.iter().map(|r| ColorRange::Sct(*r)).collect();
         let mut masks: Vec<Mask> = (0..cr.len()).map(|_| Mask::new(n, n * n)).collect();
-        Segmenter::new(n).segment(&im.view(), &cr, &mut masks).unwrap();
+        Segmenter::new().segment(&im.view(), &cr, &mut masks).unwrap();
         for (range, mask) in ranges.iter().zip(&masks) {
             for y in 0..n * n {
                 for x in 0..n {
@@ -457,7 +456,7 @@ mod tests {
         };
         let im = RgbImage::from_raw(1, 1, vec![0, 0, 200]).unwrap();
         let mut m = [Mask::new(1, 1)];
-        Segmenter::new(1)
+        Segmenter::new()
             .segment(&im.view(), &[ColorRange::Sct(r)], &mut m)
             .unwrap();
         assert!(!m[0].get(0, 0));
@@ -477,7 +476,7 @@ mod tests {
         assert!(!red.contains([120, 110, 110]), "low saturation");
         let im = RgbImage::from_raw(2, 1, vec![250, 10, 30, 20, 20, 20]).unwrap();
         let mut m = [Mask::new(2, 1)];
-        Segmenter::new(2)
+        Segmenter::new()
             .segment(&im.view(), &[ColorRange::Hsv(red)], &mut m)
             .unwrap();
         assert_eq!(m[0].data(), &[1, 0]);
@@ -491,7 +490,7 @@ mod tests {
             s: [0.0, 1.0],
             v: [0.0, 1.0],
         });
-        let mut seg = Segmenter::new(3);
+        let mut seg = Segmenter::new();
         assert!(matches!(
             seg.segment(&im.view(), &[r], &mut [Mask::new(2, 2)]),
             Err(VisionError::SizeMismatch { .. })

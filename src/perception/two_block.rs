@@ -98,7 +98,7 @@ impl TwoBlockDetector {
             width,
             height,
             limits,
-            segmenter: Segmenter::new(width),
+            segmenter: Segmenter::new(),
             masks: [Mask::new(width, height), Mask::new(width, height)],
             labelers: [Labeler::new(width, height), Labeler::new(width, height)],
             candidates: [Vec::with_capacity(max_cand), Vec::with_capacity(max_cand)],

@@ -13,6 +13,16 @@ pub enum SegmentationMode {
     Static,
 }
 
+impl SegmentationMode {
+    /// The name used in TOML and output.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            SegmentationMode::Adaptive => "adaptive",
+            SegmentationMode::Static => "static",
+        }
+    }
+}
+
 /// Where the two blocks appear in the image as the daughter leaves the dock.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]

@@ -17,7 +17,7 @@ use super::world::{self, World};
 use crate::behaviors::{Agent, BuildError};
 use crate::geometry::Pose2;
 use crate::perception::RgbImage;
-use crate::profile::{Profile, SegmentationMode};
+use crate::profile::Profile;
 use crate::schemas::Outcome;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -114,20 +114,6 @@ pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
     let world = world::build(&loaded.profile, &loaded.scenario.clutter, &backdrops)?;
     let runs = loaded.scenario.runs(&loaded.profile);
     Ok(Prepared { loaded, world, runs })
-}
-
-fn seg_name(m: SegmentationMode) -> &'static str {
-    match m {
-        SegmentationMode::Adaptive => "adaptive",
-        SegmentationMode::Static => "static",
-    }
-}
-
-fn terrain_name(t: super::motion::Terrain) -> String {
-    serde_json::to_value(t)
-        .ok()
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap_or_default()
 }
 
 /// Runs one run of a prepared campaign. `frames` (folder, every N) records camera frames.
@@ -230,8 +216,8 @@ pub fn run_one(
         index: spec.index,
         start: s.label.clone(),
         lighting: spec.lighting.clone(),
-        segmentation: seg_name(spec.segmentation).into(),
-        terrain: terrain_name(spec.terrain),
+        segmentation: spec.segmentation.as_str().into(),
+        terrain: spec.terrain.as_str().into(),
         trial: spec.trial,
         seed: spec.seed,
         distance_m: s.distance,

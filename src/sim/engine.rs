@@ -325,9 +325,11 @@ impl<'w> Sim<'w> {
                                 Some((to.to_world(-length / 2.0, 0.0).1, crate::geometry::wrap_angle(to.theta)));
                         }
                         self.inside = true;
-                        // The pouch guides the robot: only motion along the axis remains.
+                        // The pouch's walls guide the robot: it keeps its entrance offset
+                        // within the clearance and moves only along the axis.
                         let (lat, _) = self.entrance.unwrap_or((0.0, 0.0));
-                        self.pose = Pose2::new(to.x, lat * 0.5, 0.0);
+                        let clearance = (self.world.dock.entrance_half - width / 2.0).max(0.0);
+                        self.pose = Pose2::new(to.x, lat.clamp(-clearance, clearance), 0.0);
                     }
                     Contact::Docked => {
                         self.pose = to;

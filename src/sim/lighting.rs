@@ -534,11 +534,7 @@ impl LightState {
 
     /// Irradiance (linear RGB) on a surface with world normal `n` at `at`.
     pub fn irradiance_at(&self, n: &Vector3<f64>, at: &Point3<f64>, tag: Tag) -> [f32; 3] {
-        let direct = self.sun * (n.dot(&self.sun_dir).max(0.0) as f32);
-        let mut e = [0.0f32; 3];
-        for (c, v) in e.iter_mut().enumerate() {
-            *v = self.illum[c] * self.level * (self.ambient + direct);
-        }
+        let mut e = self.irradiance(n);
         if tag != Tag::Backdrop {
             for (pos, angle, power, rgb) in &self.flashers {
                 let d = pos - at;
@@ -556,13 +552,11 @@ impl LightState {
         e
     }
 
-    /// Irradiance at no particular place (flashers ignored): ground and backdrops.
-    pub fn irradiance(&self, n: &Vector3<f64>, tag: Tag) -> [f32; 3] {
-        self.irradiance_at(
-            n,
-            &Point3::new(1e6, 1e6, 1e6),
-            if tag == Tag::Backdrop { tag } else { Tag::Backdrop },
-        )
+    /// Ambient plus sun on a surface with world normal `n`, with no flashers (the ground
+    /// and backdrops, which have no single position).
+    pub fn irradiance(&self, n: &Vector3<f64>) -> [f32; 3] {
+        let direct = self.sun * (n.dot(&self.sun_dir).max(0.0) as f32);
+        [0, 1, 2].map(|c| self.illum[c] * self.level * (self.ambient + direct))
     }
 
     /// Sky brightness multiplier.

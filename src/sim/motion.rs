@@ -48,6 +48,18 @@ pub struct SlipSpec {
 }
 
 impl Terrain {
+    /// The name used in TOML and output.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Terrain::LabFloor => "lab_floor",
+            Terrain::Steel => "steel",
+            Terrain::Grass => "grass",
+            Terrain::Gravel => "gravel",
+            Terrain::Sand => "sand",
+            Terrain::Uneven => "uneven",
+        }
+    }
+
     /// Default slip of this terrain.
     pub fn slip(&self) -> SlipSpec {
         let (s, t, n, h) = match self {
@@ -185,6 +197,20 @@ mod tests {
             slip_turn: 0.0,
             noise: 0.0,
             heading_noise: 0.0,
+        }
+    }
+
+    #[test]
+    fn names_match_the_toml_spelling() {
+        use Terrain::*;
+        for t in [LabFloor, Steel, Grass, Gravel, Sand, Uneven] {
+            assert_eq!(serde_json::to_value(t).unwrap(), t.as_str());
+        }
+        for m in [
+            crate::profile::SegmentationMode::Adaptive,
+            crate::profile::SegmentationMode::Static,
+        ] {
+            assert_eq!(serde_json::to_value(m).unwrap(), m.as_str());
         }
     }
 

@@ -9,14 +9,15 @@
 //! footprint at that depth, gives a coverage in [0, 1] that blends over what lies behind,
 //! so moving a target by a fraction of a pixel changes the image.
 //!
-//! The sensor then applies white balance, exposure (auto-exposure follows the previous
-//! frame's brightness, so a sudden light change over- or under-exposes a few frames), shot
+//! The sensor then applies white balance, exposure (auto-exposure moves only halfway
+//! toward the level this frame needs, in log terms, so a sudden light change over- or
+//! under-exposes the next few frames), shot
 //! and read noise from a per-frame offset into a seeded noise table, clipping at
 //! saturation, and sRGB gamma into 8-bit RGB.
 
 use super::lighting::LightState;
 use super::rng::NoiseTable;
-use super::scene::{Material, Prim, Scene, Shape, Tag};
+use super::scene::{Material, Prim, Scene, Shape};
 use crate::perception::RgbImage;
 use crate::perception::camera_model::CameraModel;
 use nalgebra::{Matrix3, Point3, Vector3};
@@ -358,7 +359,7 @@ impl Renderer {
         let (rx, ry, rz) = (row(0), row(1), row(2));
         let cz = pose.position.z as f32;
         let (cx, cy) = (pose.position.x as f32, pose.position.y as f32);
-        let irr = light.irradiance(&Vector3::z(), Tag::Backdrop);
+        let irr = light.irradiance(&Vector3::z());
         let sky = scene.sky.map(|s| s * light.sky_scale());
         for (((px, alpha), ray), ang) in self
             .radiance

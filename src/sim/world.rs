@@ -153,14 +153,16 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
         prims.push(rear(entrance_half, w2, 0.05, h));
         prims.push(rear(-entrance_half, entrance_half, top, h));
         // The dark pouch behind the flap, and the gate folded down as a ramp.
-        prims.push(rear(-entrance_half, entrance_half, bottom, top));
-        prims.last_mut().expect("pushed").material = Material::Solid(albedo([20, 20, 22], 1.0));
-        prims.last_mut().expect("pushed").shape = Shape::Rect {
-            centre: Point3::new(-0.01, 0.0, (bottom + top) / 2.0),
-            u: y_axis(),
-            v: z_axis(),
-            half: [entrance_half, (top - bottom) / 2.0],
-        };
+        prims.push(Prim::new(
+            Shape::Rect {
+                centre: Point3::new(-0.01, 0.0, (bottom + top) / 2.0),
+                u: y_axis(),
+                v: z_axis(),
+                half: [entrance_half, (top - bottom) / 2.0],
+            },
+            Material::Solid(albedo([20, 20, 22], 1.0)),
+            Tag::Body,
+        ));
         let ramp_len: f64 = 0.35;
         let slope = (bottom / ramp_len).atan();
         prims.push(Prim::new(
