@@ -2,9 +2,9 @@
 //!
 //! One thread per camera captures into pooled buffers and hands frames to the loop over a
 //! one-slot crossbeam channel where the newest frame replaces an unread older one
-//! (latest-frame-wins). One sensor thread polls encoders (integrated into odometry with
-//! the profile's kinematics), the tether and the dock switch. One actuator thread applies
-//! commands. The calling thread runs the loop at the profile's fixed rate, counting
+//! (latest-frame-wins). One sensor thread polls the encoders (integrated into odometry with
+//! the profile's kinematics) and the dock switch. One actuator thread applies commands and
+//! also reads the tether reel, which is one device for both. The calling thread runs the loop at the profile's fixed rate, counting
 //! overruns (ticks that started late). Stamps come from one monotonic clock started with
 //! the run, so `Inputs::now − stamp` is a true age and the staleness check works.
 
