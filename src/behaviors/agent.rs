@@ -11,6 +11,17 @@ pub trait Agent: Behavior {
     fn begin_departure(&mut self) -> bool;
     /// Switches to the docking phase; the robot may have been moved since departure.
     fn begin_docking(&mut self);
+    /// Counters of the current docking run (for campaign records).
+    fn stats(&self) -> AgentStats {
+        AgentStats::default()
+    }
+}
+
+/// Counters an agent keeps per docking run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct AgentStats {
+    /// Alignment manoeuvres started (RAPOSA's region-II iterations).
+    pub manoeuvres: u32,
 }
 
 /// Why no agent could be built for a profile.
@@ -42,6 +53,9 @@ pub fn agent_for(profile: &Profile) -> Result<Box<dyn Agent>, BuildError> {
     match profile.behavior.approach {
         ApproachKind::RatioSteering | ApproachKind::PotentialField if profile.fiducial.two_block.is_some() => {
             Ok(Box::new(super::bujold::BujoldAgent::new(profile)?))
+        }
+        ApproachKind::SevenState if profile.fiducial.pyramid.is_some() => {
+            Ok(Box::new(super::raposa::RaposaAgent::new(profile)?))
         }
         approach => Err(BuildError::NoBehavior {
             profile: profile.name.clone(),

@@ -7,5 +7,6 @@
 
 pub mod agent;
 pub mod bujold;
+pub mod raposa;
 
-pub use agent::{Agent, BuildError, agent_for};
+pub use agent::{Agent, AgentStats, BuildError, agent_for};

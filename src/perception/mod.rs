@@ -9,6 +9,7 @@
 //! * [`components`]: 8-connected labelling with per-component moments.
 //! * [`colour_model`]: imprinting, adaptation and the fallback chain of seed 004 Fig. 5.
 //! * [`two_block`]: Bujold's two-block fiducial detector and its perceptual schema.
+//! * [`pyramid`] and [`pyramid_pose`]: RAPOSA's pyramid detector, its geometry and schema.
 //! * [`overlay`]: drawing a detection over its frame.
 
 pub mod camera_model;
@@ -18,6 +19,8 @@ pub mod fastmath;
 pub mod hsv;
 pub mod image;
 pub mod overlay;
+pub mod pyramid;
+pub mod pyramid_pose;
 pub mod sct;
 pub mod segment;
 pub mod two_block;
@@ -27,6 +30,8 @@ pub use colour_model::{AngleStats, ColorMode, ColorModel, ColorModelParams, Impr
 pub use components::{Component, Labeler, Run};
 pub use hsv::{Hsv, HsvPlanes, hsv_from_rgb};
 pub use image::{ImageError, RgbImage, RgbView};
+pub use pyramid::{BlueRegion, Ellipse, PyramidDetection, PyramidDetector, PyramidPair, PyramidShape};
+pub use pyramid_pose::{PyramidGeometry, PyramidPercept, PyramidSchema, PyramidView};
 pub use sct::{Sct, SctPlanes, sct_from_rgb};
 pub use segment::{ColorRange, HsvRange, Mask, SctRange, Segmenter};
 pub use two_block::{Block, Pair, PairLimits, TwoBlockDetector, TwoBlockPercept, TwoBlockSchema};

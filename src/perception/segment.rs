@@ -70,7 +70,13 @@ impl HsvRange {
     /// True when the pixel falls in the box.
     #[inline]
     pub fn contains(&self, rgb: [u8; 3]) -> bool {
-        let p = Hsv::from_rgb(rgb);
+        self.contains_hsv(&Hsv::from_rgb(rgb))
+    }
+
+    /// True when an already converted pixel falls in the box (lets several ranges share
+    /// one conversion).
+    #[inline]
+    pub fn contains_hsv(&self, p: &Hsv) -> bool {
         let h_ok = if self.h[0] <= self.h[1] {
             p.h >= self.h[0] && p.h <= self.h[1]
         } else {
@@ -161,6 +167,11 @@ impl Mask {
         if x < self.width && y < self.height {
             self.data[y * self.width + x] = on as u8;
         }
+    }
+
+    /// The bytes, mutable (callers must store only 0 or 1).
+    pub fn data_mut(&mut self) -> &mut [u8] {
+        &mut self.data
     }
 
     /// Number of set pixels.

@@ -63,30 +63,68 @@ pub struct PotentialFieldGains {
     pub k_theta: f64,
 }
 
-/// Gains and thresholds of RAPOSA's seven-state servo (seed 001 §II.D–E).
+/// Gains and thresholds of RAPOSA's seven-state servo (seed 001 §II.D–E). The paper gives
+/// the control laws and a few thresholds; `profiles/raposa.toml` says where each value
+/// comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SevenStateGains {
-    /// State 1 near law v = K_lin·√(A_ref/A), m/s.
+    /// State 1 near law v = K_lin·√(A₁/A), m/s (A₁ the ball's area at 1 m, so v ≈ K_lin·d).
     pub k_lin: f64,
     /// ω = −K_ang·x_dev, rad/s per pixel.
     pub k_ang: f64,
-    /// Arm = −K_arm·y_dev, rad per pixel.
+    /// Arm = −K_arm·y_dev at the end of state 1, rad per pixel.
     pub k_arm: f64,
-    /// Constant speed beyond about 1 m, m/s.
+    /// Constant state-1 speed beyond `far_distance_m`, m/s.
     pub far_speed_mps: f64,
-    /// Region II above this angle α, degrees (paper: 15).
+    /// Beyond this camera-to-ball distance state 1 drives at constant speed, and a lone
+    /// ellipse selects state 3, m (paper: about 1 m).
+    pub far_distance_m: f64,
+    /// Region II above this α, degrees (paper: 15).
     pub angle_threshold_deg: f64,
-    /// Region II above this distance, m (paper: 0.34).
+    /// Extra α allowed right after a region-II manoeuvre, degrees (the paper's "tolerance
+    /// within a certain distance range" for odometry error).
+    pub settle_tolerance_deg: f64,
+    /// Region II only beyond this socket-to-ball distance; closer, α is unreliable and
+    /// state 1 runs (the paper's dead zone), m (paper: 0.34).
     pub distance_threshold_m: f64,
-    /// Tracking ball radius around the previous ellipse, px (paper: 20).
-    pub tracking_ball_px: f64,
-    /// State 6 starts when the ellipse is at this distance, m (paper: 0.3).
+    /// Leave the dead zone first: a misaligned robot closer than `distance_threshold_m`
+    /// backs away to `dead_zone_exit_m` before choosing again (not in the paper, whose
+    /// points 1 and 3 never docked).
+    pub leave_dead_zone: bool,
+    /// Socket-to-ball distance to back off to when leaving the dead zone, m.
+    pub dead_zone_exit_m: f64,
+    /// State 6 starts at this camera-to-ball distance (area threshold), m (paper: 0.3).
     pub final_distance_m: f64,
     /// State 6 speed, m/s.
     pub final_speed_mps: f64,
     /// State 6 duration, s.
     pub final_time_s: f64,
+    /// Region II lands the socket on the axis at this distance δ from the ball, m.
+    pub region2_distance_m: f64,
+    /// State 7 (vision-tracked rotation) turn rate, degrees per second: low, so the
+    /// ellipse can be tracked.
+    pub vision_turn_rate_dps: f64,
+    /// State 7 ends when the predicted ellipse comes this close to the image edge, px.
+    pub fov_margin_px: f64,
+    /// State 7 stops on a lost ellipse and gives up after this many frames without it.
+    pub lost_frames: u32,
+    /// Odometry rotation rate, degrees per second.
+    pub turn_rate_dps: f64,
+    /// Largest travel speed of the (x_ref, y_ref) controller, m/s.
+    pub travel_speed_mps: f64,
+    /// Inverse controller: speed per metre of remaining distance, 1/s.
+    pub k_rho: f64,
+    /// Inverse controller: yaw rate per radian of heading error, 1/s.
+    pub k_heading: f64,
+    /// Travel ends within this distance of (x_ref, y_ref), m.
+    pub position_tolerance_m: f64,
+    /// Rotations end within this angle, degrees.
+    pub rotation_tolerance_deg: f64,
+    /// Slow search: turn rate, degrees per second.
+    pub search_rate_dps: f64,
+    /// Slow search: first sweep, degrees (doubles after each switch, capped below 360°).
+    pub search_sweep_deg: f64,
 }
 
 /// Gains of Axel's two-arc docking (seed 000).
@@ -195,21 +233,50 @@ pub(crate) fn validate_behavior(b: &BehaviorSpec, v: &mut Validator<'_>) {
         ApproachKind::SevenState => match &b.seven_state {
             None => missing(v, "seven_state"),
             Some(g) => {
-                v.positive("behavior.seven_state.k_lin", g.k_lin);
-                v.positive("behavior.seven_state.k_ang", g.k_ang);
-                v.non_negative("behavior.seven_state.k_arm", g.k_arm);
-                v.positive("behavior.seven_state.far_speed_mps", g.far_speed_mps);
-                v.range(
-                    "behavior.seven_state.angle_threshold_deg",
-                    g.angle_threshold_deg,
-                    0.0,
-                    90.0,
+                let n = |f: &str| format!("behavior.seven_state.{f}");
+                for (f, x) in [
+                    ("k_lin", g.k_lin),
+                    ("k_ang", g.k_ang),
+                    ("far_speed_mps", g.far_speed_mps),
+                    ("far_distance_m", g.far_distance_m),
+                    ("distance_threshold_m", g.distance_threshold_m),
+                    ("dead_zone_exit_m", g.dead_zone_exit_m),
+                    ("final_distance_m", g.final_distance_m),
+                    ("final_speed_mps", g.final_speed_mps),
+                    ("final_time_s", g.final_time_s),
+                    ("region2_distance_m", g.region2_distance_m),
+                    ("vision_turn_rate_dps", g.vision_turn_rate_dps),
+                    ("turn_rate_dps", g.turn_rate_dps),
+                    ("travel_speed_mps", g.travel_speed_mps),
+                    ("k_rho", g.k_rho),
+                    ("k_heading", g.k_heading),
+                    ("position_tolerance_m", g.position_tolerance_m),
+                    ("rotation_tolerance_deg", g.rotation_tolerance_deg),
+                    ("search_rate_dps", g.search_rate_dps),
+                    ("search_sweep_deg", g.search_sweep_deg),
+                ] {
+                    v.positive(&n(f), x);
+                }
+                v.non_negative(&n("k_arm"), g.k_arm);
+                v.non_negative(&n("fov_margin_px"), g.fov_margin_px);
+                v.non_negative(&n("settle_tolerance_deg"), g.settle_tolerance_deg);
+                v.range(&n("angle_threshold_deg"), g.angle_threshold_deg, 0.0, 90.0);
+                v.require(g.search_sweep_deg < 360.0, &n("search_sweep_deg"), || {
+                    format!("expected a first sweep under 360°, got {}", g.search_sweep_deg)
+                });
+                v.require(g.lost_frames >= 1, &n("lost_frames"), || {
+                    "expected at least 1 frame".into()
+                });
+                v.require(
+                    g.dead_zone_exit_m > g.distance_threshold_m,
+                    &n("dead_zone_exit_m"),
+                    || {
+                        format!(
+                            "expected more than distance_threshold_m ({}), got {}",
+                            g.distance_threshold_m, g.dead_zone_exit_m
+                        )
+                    },
                 );
-                v.positive("behavior.seven_state.distance_threshold_m", g.distance_threshold_m);
-                v.positive("behavior.seven_state.tracking_ball_px", g.tracking_ball_px);
-                v.positive("behavior.seven_state.final_distance_m", g.final_distance_m);
-                v.positive("behavior.seven_state.final_speed_mps", g.final_speed_mps);
-                v.positive("behavior.seven_state.final_time_s", g.final_time_s);
             }
         },
         ApproachKind::TwoArc => match &b.two_arc {

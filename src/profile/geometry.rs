@@ -66,13 +66,15 @@ pub(crate) fn validate_body(b: &BodySpec, v: &mut Validator<'_>) {
     v.positive("body.height_m", b.height_m);
 }
 
-pub(crate) fn validate_dock(d: &DockSpec, body: &BodySpec, v: &mut Validator<'_>) {
+/// `target_enters_robot`: the dock is a target that enters a socket on the robot (RAPOSA's
+/// pyramid), so the entrance is the socket's mouth and may be narrower than the body.
+pub(crate) fn validate_dock(d: &DockSpec, body: &BodySpec, target_enters_robot: bool, v: &mut Validator<'_>) {
     v.positive("dock.entrance_width_m", d.entrance_width_m);
     v.positive("dock.depth_m", d.depth_m);
     v.range("dock.funnel_half_angle_deg", d.funnel_half_angle_deg, 0.0, 89.0);
     v.positive("dock.approach_radius_m", d.approach_radius_m);
     v.range("dock.approach_half_angle_deg", d.approach_half_angle_deg, 0.0, 180.0);
-    if d.entrance_width_m > 0.0 && body.width_m > 0.0 && d.entrance_width_m < body.width_m {
+    if !target_enters_robot && d.entrance_width_m > 0.0 && body.width_m > 0.0 && d.entrance_width_m < body.width_m {
         v.problem(
             "dock.entrance_width_m",
             format!(

@@ -16,6 +16,7 @@ pub mod drive;
 pub mod fiducial;
 pub mod geometry;
 pub mod perception;
+pub mod pyramid_perception;
 
 pub use behavior::{
     ApproachKind, BehaviorSpec, Coordination, LoopSpec, PotentialFieldGains, RatioSteeringGains, SevenStateGains,
@@ -26,6 +27,7 @@ pub use drive::{DriveKind, DriveSpec};
 pub use fiducial::{CirclePlacement, CirclesSpec, FiducialSpec, MarkersSpec, NamedColor, PyramidSpec, TwoBlockSpec};
 pub use geometry::{BodySpec, DockSpec, SuccessSpec, TetherSpec};
 pub use perception::{ImprintSpec, PerceptionSpec, SegmentationMode};
+pub use pyramid_perception::{HsvBand, PyramidPerceptionSpec};
 
 use crate::arbiter::{LoopConfig, Staleness};
 use crate::config::{self, ConfigError, Validate, Validator};
@@ -82,7 +84,7 @@ impl Validate for Profile {
             c.validate_at(v, &format!("cameras[{i}]"));
         }
         if let Some(d) = &self.dock {
-            geometry::validate_dock(d, &self.body, v);
+            geometry::validate_dock(d, &self.body, self.fiducial.pyramid.is_some(), v);
         } else if self.behavior.approach != ApproachKind::None {
             v.problem("behavior.approach", "a docking approach needs a [dock] table");
         }

@@ -1,5 +1,6 @@
 //! `[perception]`: colour segmentation, imprinting/adaptation and fiducial pairing.
 
+use super::pyramid_perception::{PyramidPerceptionSpec, validate_pyramid_perception};
 use crate::config::Validator;
 use serde::{Deserialize, Serialize};
 
@@ -76,6 +77,8 @@ pub struct PerceptionSpec {
     pub max_candidates: u32,
     /// Imprint geometry.
     pub imprint: ImprintSpec,
+    /// RAPOSA's pyramid detector (HSV bands, shape and pair filters).
+    pub pyramid: PyramidPerceptionSpec,
 }
 
 impl Default for PerceptionSpec {
@@ -96,6 +99,7 @@ impl Default for PerceptionSpec {
             timeout2_s: 6.0,
             max_candidates: 64,
             imprint: ImprintSpec::default(),
+            pyramid: PyramidPerceptionSpec::default(),
         }
     }
 }
@@ -168,4 +172,5 @@ pub(crate) fn validate_perception(p: &PerceptionSpec, v: &mut Validator<'_>) {
     v.require(p.imprint.frames >= 1, "perception.imprint.frames", || {
         "expected a count ≥ 1".into()
     });
+    validate_pyramid_perception(&p.pyramid, v);
 }

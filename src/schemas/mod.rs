@@ -6,6 +6,7 @@
 //! Arkin's gain-weighted sum ([`MotionVector::weighted_sum`]).
 
 pub mod behavior;
+pub mod goto_point;
 pub mod inputs;
 pub mod motor_output;
 pub mod percept;
@@ -14,8 +15,10 @@ pub mod ratio_steering;
 pub mod search;
 pub mod traits;
 pub mod vector;
+pub mod visual_servo;
 
 pub use behavior::{Behavior, FailureReason, Feedback, Outcome, Presence, SchemaBehavior, Status, Step};
+pub use goto_point::PointController;
 pub use inputs::{CameraInput, Inputs, OdometryReading, TetherReading};
 pub use motor_output::{Auxiliary, DriveCommand, Guides, MotorOutput, Posture, TetherCommand};
 pub use percept::{Percept, Stamped};
@@ -24,3 +27,4 @@ pub use ratio_steering::RatioSteering;
 pub use search::{DeadReckoning, SearchRotation};
 pub use traits::{MotorSchema, PerceptualSchema};
 pub use vector::MotionVector;
+pub use visual_servo::ServoLaw;

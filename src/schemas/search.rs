@@ -22,12 +22,15 @@ impl SearchRotation {
             return DriveCommand::Turn { omega: self.rate };
         }
         // Sweep k (k = 0, 1, 2 …) turns through first·2^k, alternating direction; the turn
-        // back to the start is included in the doubled sweep.
+        // back to the start is included in the doubled sweep. A sweep never reaches a
+        // full turn (seed 001 §II.E: "a certain angle lower than 360°"): it is capped at
+        // 350°.
         let rate = self.rate.abs().max(1e-6);
         let mut t = elapsed.max(0.0);
         let mut k = 0;
         loop {
-            let dur = self.first_sweep * 2f64.powi(k) / rate;
+            let sweep = (self.first_sweep * 2f64.powi(k)).min(MAX_SWEEP_DEG.to_radians());
+            let dur = sweep / rate;
             if t < dur || k > 30 {
                 let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
                 return DriveCommand::Turn {
@@ -39,6 +42,9 @@ impl SearchRotation {
         }
     }
 }
+
+/// Largest sweep of the doubling search, degrees.
+pub const MAX_SWEEP_DEG: f64 = 350.0;
 
 /// Drive straight a set distance by odometry (the paper's blind back-in).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -73,6 +79,16 @@ mod tests {
         assert_eq!(s.act(2.9), DriveCommand::Turn { omega: -0.5 });
         assert_eq!(s.act(3.1), DriveCommand::Turn { omega: 0.5 });
         assert_eq!(s.act(7.1), DriveCommand::Turn { omega: -0.5 });
+        // Sweeps cap below a full turn: with a 200° first sweep the second lasts 350°.
+        let big = SearchRotation {
+            rate: 1.0,
+            first_sweep: 200f64.to_radians(),
+            doubling: true,
+        };
+        let t1 = 200f64.to_radians();
+        let t2 = t1 + 350f64.to_radians();
+        assert_eq!(big.act(t2 - 0.01), DriveCommand::Turn { omega: -1.0 });
+        assert_eq!(big.act(t2 + 0.01), DriveCommand::Turn { omega: 1.0 });
         let plain = SearchRotation {
             rate: -0.3,
             first_sweep: 0.0,

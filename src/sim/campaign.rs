@@ -70,6 +70,9 @@ pub struct RunRecord {
     pub safe_stops: u64,
     /// Departure imprinted successfully (when the agent has a departure).
     pub imprinted: Option<bool>,
+    /// Alignment manoeuvres started (RAPOSA's region-II iterations).
+    #[serde(default)]
+    pub manoeuvres: u32,
     /// True path, [x, y] in mm every 0.5 s.
     pub track: Vec<[i32; 2]>,
 }
@@ -240,6 +243,7 @@ pub fn run_one(
         entrance_heading_deg: sim.entrance.map(|e| e.1.to_degrees()),
         safe_stops: sim.safe_stops,
         imprinted,
+        manoeuvres: agent.stats().manoeuvres,
         track: sim
             .track
             .iter()
@@ -275,6 +279,9 @@ pub struct GroupSummary {
     pub commands_per_m: f64,
     /// Failures by reason.
     pub failures: BTreeMap<String, usize>,
+    /// Alignment manoeuvres per successful run: [min, max] (absent without successes).
+    #[serde(default)]
+    pub manoeuvres: Option<[u32; 2]>,
 }
 
 /// `summary.json`.
@@ -321,6 +328,10 @@ pub fn summarise(records: &[&RunRecord], labels: [&str; 4]) -> GroupSummary {
             records.iter().map(|r| r.commands_per_m).sum::<f64>() / records.len() as f64
         },
         failures,
+        manoeuvres: (!ok.is_empty()).then(|| {
+            let it = ok.iter().map(|r| r.manoeuvres);
+            [it.clone().min().unwrap_or(0), it.max().unwrap_or(0)]
+        }),
     }
 }
 

@@ -52,20 +52,7 @@ pub fn judge(
     lowered: bool,
 ) -> Contact {
     if g.open {
-        // A target lying on the ground: "docked" when the robot's rear reaches it aligned.
-        let rear = to.to_world(-length / 2.0, 0.0);
-        let heading = crate::geometry::wrap_angle(to.theta);
-        if rear.0 <= 0.02 && rear.0 > -0.1 && rear.1.abs() <= g.entrance_half {
-            return if rear.1.abs() <= g.tol_lateral && heading.abs() <= g.tol_heading {
-                Contact::Docked
-            } else {
-                Contact::Stuck {
-                    lateral: rear.1,
-                    heading,
-                }
-            };
-        }
-        return Contact::Free;
+        return judge_open(g, to, length, width);
     }
     let rear = to.to_world(-length / 2.0, 0.0);
     if inside {
@@ -99,6 +86,44 @@ pub fn judge(
     Contact::Blocked
 }
 
+/// An open dock (a target on the ground at the origin, entering the robot's rear): docked
+/// when the target reaches the rear within the socket's mouth and the robot is within
+/// tolerance; reaching it out of tolerance, or touching the target with any other part of
+/// the body, is a collision.
+fn judge_open(g: &DockGeometry, to: &Pose2, length: f64, width: f64) -> Contact {
+    let (lx, ly) = to.to_local(0.0, 0.0);
+    let rear = -length / 2.0;
+    // The target meets the socket's mouth (its front reaches the rear plane).
+    if lx >= rear - 0.05 && lx <= rear + g.depth && ly.abs() <= g.entrance_half {
+        let heading = crate::geometry::wrap_angle(to.theta);
+        return if ly.abs() <= g.tol_lateral && heading.abs() <= g.tol_heading {
+            Contact::Docked
+        } else {
+            Contact::Stuck { lateral: ly, heading }
+        };
+    }
+    if let Some([x0, x1, y0, y1]) = g.target_extent {
+        // The target's footprint corners inside the robot, or the robot's corners inside
+        // the target's footprint.
+        let target_in_robot = [(x0, y0), (x0, y1), (x1, y0), (x1, y1), (0.0, 0.0)]
+            .iter()
+            .any(|&(x, y)| {
+                let (a, b) = to.to_local(x, y);
+                a.abs() < length / 2.0 && b.abs() < width / 2.0
+            });
+        let robot_in_target = footprint(to, length, width)
+            .iter()
+            .any(|&(x, y)| x > x0 && x < x1 && y > y0 && y < y1);
+        if target_in_robot || robot_in_target {
+            return Contact::Stuck {
+                lateral: ly,
+                heading: crate::geometry::wrap_angle(to.theta),
+            };
+        }
+    }
+    Contact::Free
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -113,6 +138,7 @@ mod tests {
             tol_heading: 5f64.to_radians(),
             needs_lowered: true,
             open: false,
+            target_extent: None,
         }
     }
 
@@ -154,6 +180,76 @@ mod tests {
         assert!(
             matches!(judge(&g(), false, &from, &to, 0.4, 0.18, false), Contact::Stuck { .. }),
             "must lower first"
+        );
+    }
+
+    fn open() -> DockGeometry {
+        DockGeometry {
+            body_length: 0.0,
+            body_half_width: 0.0,
+            entrance_half: 0.06,
+            depth: 0.1,
+            tol_lateral: 0.04,
+            tol_heading: 20f64.to_radians(),
+            needs_lowered: false,
+            open: true,
+            target_extent: Some([-0.2, 0.035, -0.06, 0.06]),
+        }
+    }
+
+    #[test]
+    fn open_dock_docks_aligned_and_collides_otherwise() {
+        // Rear (0.4 m behind centre) reaching the ball at the origin, aligned.
+        assert_eq!(
+            judge(
+                &open(),
+                false,
+                &Pose2::default(),
+                &Pose2::new(0.405, 0.01, 0.1),
+                0.8,
+                0.4,
+                false
+            ),
+            Contact::Docked
+        );
+        // Same place, heading 30°: stuck.
+        assert!(matches!(
+            judge(
+                &open(),
+                false,
+                &Pose2::default(),
+                &Pose2::new(0.405, 0.0, 0.52),
+                0.8,
+                0.4,
+                false
+            ),
+            Contact::Stuck { .. }
+        ));
+        // Driving over the pyramid sideways: stuck.
+        assert!(matches!(
+            judge(
+                &open(),
+                false,
+                &Pose2::default(),
+                &Pose2::new(-0.1, 0.1, 1.57),
+                0.8,
+                0.4,
+                false
+            ),
+            Contact::Stuck { .. }
+        ));
+        // Far away: free.
+        assert_eq!(
+            judge(
+                &open(),
+                false,
+                &Pose2::default(),
+                &Pose2::new(1.0, 0.0, 0.0),
+                0.8,
+                0.4,
+                false
+            ),
+            Contact::Free
         );
     }
 

@@ -1,5 +1,6 @@
 //! The papers' published figures, for side-by-side tables printed by `marsupial trials`.
-//! A scenario opts in with `compare = "bujold-table1"` (or `"bujold-table2"`).
+//! A scenario opts in with `compare = "bujold-table1"` (or `"bujold-table2"`,
+//! `"raposa-table1"`, `"raposa-range"`, `"raposa-wide"`).
 
 use super::campaign::RunRecord;
 use serde::{Deserialize, Serialize};
@@ -13,6 +14,12 @@ pub enum PaperTable {
     BujoldTable1,
     /// Seed 004 Table II (time and success by lighting and segmentation).
     BujoldTable2,
+    /// Seed 001 Table I (mean time, σ, v_mean and success by start group).
+    RaposaTable1,
+    /// Seed 001 §III: success against distance at 0°.
+    RaposaRange,
+    /// Seed 001 §III: 80°, 90° and 110° starts at about 1.5 m.
+    RaposaWide,
 }
 
 /// Seed 004 Table Ia: start groups and the autonomous mean time to dock, s.
@@ -44,6 +51,37 @@ pub const BUJOLD_TABLE_2: [Table2Row; 8] = [
     ("dusk", "adaptive", Some((93.0, 1.00))),
     ("dusk", "static", Some((109.0, 0.70))),
 ];
+
+/// One row of seed 001 Table I: start group, mean time s, σ s, v_mean cm/s, success.
+pub type RaposaRow = (&'static [&'static str], f64, f64, f64, f64);
+
+/// Seed 001 Table I (points 1 and 3 never docked and are not in the table).
+pub const RAPOSA_TABLE_1: [RaposaRow; 9] = [
+    (&["2"], 19.41, 2.04, 1.7, 1.0),
+    (&["5"], 24.29, 2.41, 2.1, 1.0),
+    (&["9"], 37.88, 2.04, 3.5, 1.0),
+    (&["14"], 46.06, 2.48, 4.3, 1.0),
+    (&["8", "10"], 45.08, 3.98, 3.0, 1.0),
+    (&["13", "15"], 51.10, 5.24, 3.9, 1.0),
+    (&["4", "6"], 92.77, 25.18, 0.5, 0.875),
+    (&["7", "11"], 73.00, 30.72, 1.82, 1.0),
+    (&["12", "16"], 68.34, 12.18, 2.9, 1.0),
+];
+
+/// Seed 001 §III: success at 0° against start distance (2.7 m: "performed well").
+pub const RAPOSA_RANGE: [(f64, &str); 4] = [(2.5, "100 %"), (2.7, "performed well"), (2.8, "75 %"), (3.0, "0 %")];
+
+fn time_stats(rs: &[&RunRecord]) -> (Option<f64>, Option<f64>, Option<f64>) {
+    let ok: Vec<&&RunRecord> = rs.iter().filter(|r| r.success).collect();
+    if ok.is_empty() {
+        return (None, None, None);
+    }
+    let n = ok.len() as f64;
+    let mean = ok.iter().map(|r| r.time_s).sum::<f64>() / n;
+    let sd = (ok.iter().map(|r| (r.time_s - mean).powi(2)).sum::<f64>() / n).sqrt();
+    let v = ok.iter().map(|r| r.v_eff_cmps).sum::<f64>() / n;
+    (Some(mean), Some(sd), Some(v))
+}
 
 fn stats(rs: &[&RunRecord]) -> (usize, usize, Option<f64>) {
     let ok: Vec<f64> = rs.iter().filter(|r| r.success).map(|r| r.time_s).collect();
@@ -119,6 +157,93 @@ pub fn comparison(table: PaperTable, records: &[RunRecord]) -> String {
                     "{light:<9} {seg:<12}  {n:>4}  {:>13}  {:>9.2}  {pt:>14}  {pr:>10}",
                     cell(mean, 0),
                     ok as f64 / n.max(1) as f64
+                );
+            }
+        }
+        PaperTable::RaposaTable1 => {
+            let _ = writeln!(
+                s,
+                "versus seed 001 Table I (successful runs; v = start distance / time)"
+            );
+            let _ = writeln!(
+                s,
+                "group    runs  docked  time (s)  σ (s)  v (cm/s)  | paper: time (s)  σ (s)  v (cm/s)  success"
+            );
+            let mut rows: Vec<(&[&str], Option<RaposaRow>)> = vec![(&["1", "3"], None)];
+            rows.extend(RAPOSA_TABLE_1.iter().map(|r| (r.0, Some(*r))));
+            for (group, paper) in rows {
+                let rs: Vec<&RunRecord> = records.iter().filter(|r| group.contains(&r.start.as_str())).collect();
+                if rs.is_empty() {
+                    continue;
+                }
+                let (n, ok, _) = stats(&rs);
+                let (mean, sd, v) = time_stats(&rs);
+                let paper = match paper {
+                    Some((_, t, sd, v, rate)) => format!("{t:>15.2}  {sd:>5.2}  {v:>8.2}  {:>6.1} %", rate * 100.0),
+                    None => format!("{:>15}  {:>5}  {:>8}  {:>6} %", "never docked", "-", "-", 0),
+                };
+                let _ = writeln!(
+                    s,
+                    "{:<8} {:>4}  {:>6}  {:>8}  {:>5}  {:>8}  | {paper}",
+                    group.join(","),
+                    n,
+                    ok,
+                    cell(mean, 2),
+                    cell(sd, 2),
+                    cell(v, 2),
+                );
+            }
+        }
+        PaperTable::RaposaRange => {
+            let _ = writeln!(s, "versus seed 001 §III (success against distance at 0°)");
+            let _ = writeln!(s, "distance (m)  runs  docked  ours   paper");
+            let mut ds: Vec<f64> = records.iter().map(|r| r.distance_m).collect();
+            ds.sort_by(f64::total_cmp);
+            ds.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
+            for d in ds {
+                let rs: Vec<&RunRecord> = records.iter().filter(|r| (r.distance_m - d).abs() < 1e-6).collect();
+                let (n, ok, _) = stats(&rs);
+                let paper = RAPOSA_RANGE
+                    .iter()
+                    .find(|(pd, _)| (pd - d).abs() < 1e-6)
+                    .map_or("-", |p| p.1);
+                let _ = writeln!(
+                    s,
+                    "{d:>12.2}  {n:>4}  {ok:>6}  {:>3.0} %  {paper}",
+                    100.0 * ok as f64 / n.max(1) as f64
+                );
+            }
+        }
+        PaperTable::RaposaWide => {
+            let _ = writeln!(
+                s,
+                "versus seed 001 §III (80°, 90°, 110° at about 1.5 m: all docked in 1–4 min with 2–4 region-II iterations)"
+            );
+            let _ = writeln!(s, "angle (°)  runs  docked  time (s) min–max  iterations min–max");
+            let mut angles: Vec<f64> = records.iter().map(|r| r.angle_deg.abs().round()).collect();
+            angles.sort_by(f64::total_cmp);
+            angles.dedup();
+            for a in angles {
+                let rs: Vec<&RunRecord> = records
+                    .iter()
+                    .filter(|r| (r.angle_deg.abs().round() - a).abs() < 0.5)
+                    .collect();
+                let (n, ok, _) = stats(&rs);
+                let okr: Vec<&&RunRecord> = rs.iter().filter(|r| r.success).collect();
+                let span = |f: &dyn Fn(&RunRecord) -> f64| {
+                    let lo = okr.iter().map(|r| f(r)).fold(f64::INFINITY, f64::min);
+                    let hi = okr.iter().map(|r| f(r)).fold(f64::NEG_INFINITY, f64::max);
+                    if okr.is_empty() {
+                        "-".to_string()
+                    } else {
+                        format!("{lo:.0}–{hi:.0}")
+                    }
+                };
+                let _ = writeln!(
+                    s,
+                    "{a:>9.0}  {n:>4}  {ok:>6}  {:>17}  {:>19}",
+                    span(&|r| r.time_s),
+                    span(&|r| r.manoeuvres as f64)
                 );
             }
         }

@@ -68,8 +68,11 @@ pub struct DockGeometry {
     /// The robot must lower itself to enter (Bujold).
     pub needs_lowered: bool,
     /// The dock is a target on the ground that the robot drives onto (RAPOSA's pyramid):
-    /// there is no body to collide with.
+    /// there is no body; the target is at the origin and enters the robot's rear.
     pub open: bool,
+    /// Footprint of an open dock's target (x0, x1, y0, y1): touching it other than by
+    /// docking is a collision.
+    pub target_extent: Option<[f64; 4]>,
 }
 
 /// A built world.
@@ -121,6 +124,7 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
         tol_heading: profile.success.heading_tolerance_deg.to_radians(),
         needs_lowered: false,
         open: false,
+        target_extent: None,
     };
     let body_grey = albedo([70, 72, 75], 1.0);
     if let Some(fid) = profile.fiducial.two_block {
@@ -197,56 +201,71 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
         flap.gloss = 0.6;
         prims.push(flap);
     } else if let Some(pyr) = profile.fiducial.pyramid {
-        // RAPOSA's tether-end pyramid lying on the ground at the origin, its axis along +x:
-        // an orange guide ball on top and blue-painted front edges.
+        // RAPOSA's tether-end pyramid lying on the ground, its axis along +x: the orange
+        // guide ball at the origin (what enters the socket), a grey pyramid body tapering
+        // back from it, and at distance m behind the ball a square frame of blue-painted
+        // edges of side h, centred at the ball's height (seed 001 Fig. 1, 2, 6). The frame
+        // bars have depth, so the edges stay visible (thin) even side-on.
+        let (h, m, r) = (pyr.blue_edge_length_m, pyr.edge_to_ball_m, pyr.ball_diameter_m / 2.0);
+        let zc = pyr.ball_height_m.max(h / 2.0);
         dock.open = true;
         dock.body_length = 0.0;
         dock.body_half_width = 0.0;
-        let base = 0.16;
-        let apex = Point3::new(-0.05, 0.0, pyr.ball_height_m.max(0.05));
-        let corners = [
-            Point3::new(base / 2.0, -base / 2.0, 0.0),
-            Point3::new(base / 2.0, base / 2.0, 0.0),
-            Point3::new(-base / 2.0 - 0.1, base / 2.0, 0.0),
-            Point3::new(-base / 2.0 - 0.1, -base / 2.0, 0.0),
-        ];
+        dock.target_extent = Some([-m - 0.03, r, -h / 2.0 - 0.01, h / 2.0 + 0.01]);
         let grey = Material::Solid(albedo([150, 150, 150], 1.0));
+        let b = 0.35 * h;
+        let base = [(-b, -b), (-b, b), (b, b), (b, -b)].map(|(y, dz)| Point3::new(-m, y, zc + dz));
+        let apex = Point3::new(0.0, 0.0, zc);
         for i in 0..4 {
-            let (a, b) = (corners[i], corners[(i + 1) % 4]);
-            let mut t = Prim::new(Shape::Triangle { p: [a, b, apex] }, grey.clone(), Tag::Target);
+            let mut t = Prim::new(
+                Shape::Triangle {
+                    p: [base[i], base[(i + 1) % 4], apex],
+                },
+                grey.clone(),
+                Tag::Target,
+            );
             t.two_sided = true;
             target_prims.push(prims.len());
             prims.push(t);
         }
-        // Blue edges: two strips of length h standing on the front face's sides.
-        let h = pyr.blue_edge_length_m;
-        for side in [-1.0, 1.0] {
-            let y = side * pyr.edge_to_ball_m;
-            target_prims.push(prims.len());
-            let mut strip = Prim::new(
-                Shape::Rect {
-                    centre: Point3::new(0.09, y, h / 2.0),
-                    u: y_axis(),
-                    v: z_axis(),
-                    half: [0.008, h / 2.0],
-                },
-                Material::Solid(paint(pyr.edge_color)),
+        let blue = Material::Solid(paint(pyr.edge_color));
+        let (bar, depth) = (0.15 * h, 0.02);
+        let (x0, x1) = (-m - depth / 2.0, -m + depth / 2.0);
+        let (y0, y1, z0, z1) = (-h / 2.0, h / 2.0, zc - h / 2.0, zc + h / 2.0);
+        for (lo, hi) in [
+            ((y0, z0), (y0 + bar, z1)),             // one side
+            ((y1 - bar, z0), (y1, z1)),             // other side
+            ((y0 + bar, z1 - bar), (y1 - bar, z1)), // top
+            ((y0 + bar, z0), (y1 - bar, z0 + bar)), // bottom
+        ] {
+            for p in boxed(
+                Point3::new(x0, lo.0, lo.1),
+                Point3::new(x1, hi.0, hi.1),
+                blue.clone(),
                 Tag::Target,
-            );
-            strip.two_sided = true;
-            prims.push(strip);
+            ) {
+                target_prims.push(prims.len());
+                prims.push(p);
+            }
         }
         target_prims.push(prims.len());
         let mut ball = Prim::new(
             Shape::Sphere {
-                centre: Point3::new(0.0, 0.0, pyr.ball_height_m),
-                radius: pyr.ball_diameter_m / 2.0,
+                centre: Point3::new(0.0, 0.0, zc),
+                radius: r,
             },
             Material::Solid(paint(pyr.ball_color)),
             Tag::Target,
         );
         ball.gloss = 0.3;
         prims.push(ball);
+        // The tether leaves the pyramid's back along the ground.
+        prims.extend(boxed(
+            Point3::new(-2.9, -0.01, 0.0),
+            Point3::new(-m - depth, 0.01, 0.012),
+            Material::Solid(albedo([30, 30, 32], 1.0)),
+            Tag::Body,
+        ));
     } else {
         return Err(SimError::Unsupported(format!(
             "the simulator builds two-block and pyramid targets so far; profile `{}` has another fiducial",

@@ -1,0 +1,344 @@
+//! RAPOSA's pyramid geometry (seed 001 §II.C.2) and the pyramid perceptual schema.
+//!
+//! Pin-hole relations, with f the focal length in pixels:
+//!
+//! * distance from the blue height g: **d = f·h/g** (h the real blue edge length);
+//! * from the top view, with c the horizontal image distance from the ellipse centre to
+//!   the far side of the blue region and m the distance from the blue edges' midpoint to
+//!   the ball: m·sin α + (h/2)·cos α = K with **K = c·h/g**. As a quadratic in s = sin α:
+//!   (m² + h²/4)·s² − 2·K·m·s + (K² − h²/4) = 0, and the paper always takes the minus
+//!   root, s = [K·m − (h/2)·√(m² + h²/4 − K²)] / (m² + h²/4), which gives α = 0 at
+//!   c/g = ½. The left side peaks at α* = atan(2m/h) (73° for the paper's pyramid): the
+//!   estimate is valid in [0, α*] and saturates beyond;
+//! * when aligned, the distance from the ellipse area alone: d = √(A₁/A), A₁ being the
+//!   ball's area at 1 m (computed from the profile's ball diameter and the focal length,
+//!   where the paper used an offline reference image).
+//!
+//! Sign: α is the robot's angle around the pyramid axis, positive toward the dock frame's
+//! +y. Seen from +y the blue edges (behind the ball) appear to the right of the ball, so a
+//! ball left of the blue centre means α > 0.
+
+use super::image::RgbView;
+use super::pyramid::{PyramidDetection, PyramidDetector, PyramidPair, PyramidShape};
+use super::segment::HsvRange;
+use super::{VisionError, check_same_size};
+use crate::profile::Profile;
+use crate::schemas::{Inputs, Percept, PerceptualSchema};
+use serde::Serialize;
+
+/// The largest angle the quadratic can return, atan(2m/h), rad.
+pub fn max_alpha(h: f64, m: f64) -> f64 {
+    (2.0 * m / h).atan()
+}
+
+/// The minus root of the α quadratic for K = c·h/g, rad in [0, α*]. K beyond the peak
+/// (no real root) saturates at α*; K ≤ h/2 gives 0.
+///
+/// ```
+/// use marsupial::perception::pyramid_pose::alpha_from_k;
+/// let (h, m) = (0.10, 0.16);
+/// let k = |a: f64| m * a.sin() + h / 2.0 * a.cos();
+/// assert!(alpha_from_k(h / 2.0, h, m).abs() < 1e-12);
+/// assert!((alpha_from_k(k(0.5), h, m) - 0.5).abs() < 1e-9);
+/// ```
+pub fn alpha_from_k(k: f64, h: f64, m: f64) -> f64 {
+    let a = m * m + h * h / 4.0;
+    let disc = a - k * k;
+    if disc <= 0.0 {
+        return max_alpha(h, m);
+    }
+    let s = (k * m - h / 2.0 * disc.sqrt()) / a;
+    s.clamp(0.0, 1.0).asin()
+}
+
+/// Camera and target constants of the pyramid geometry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PyramidGeometry {
+    /// Focal length, px.
+    pub f_px: f64,
+    /// Principal point (x, y), px.
+    pub principal: [f64; 2],
+    /// Blue edge length h, m.
+    pub h: f64,
+    /// Blue midpoint to ball distance m, m.
+    pub m: f64,
+    /// Ball diameter, m.
+    pub ball_diameter: f64,
+}
+
+/// One frame's geometric reading of the pyramid.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PyramidView {
+    /// Camera to blue edges, d = f·h/g, m (pairs only).
+    pub blue_distance_m: Option<f64>,
+    /// Camera to ball centre, m: from the blue distance and α with a pair, else from the
+    /// ellipse area.
+    pub ball_distance_m: f64,
+    /// Signed α, rad (pairs only).
+    pub alpha: Option<f64>,
+    /// True when K reached the peak of the quadratic (α ≥ α*, estimate saturated).
+    pub alpha_saturated: bool,
+    /// Ball bearing from the optical axis, rad, positive to the image left.
+    pub bearing: f64,
+    /// Ellipse centre minus image centre, px (x right, y down).
+    pub dev_px: [f64; 2],
+    /// Ellipse pixels.
+    pub area_px: u64,
+}
+
+impl PyramidGeometry {
+    /// From a profile's first camera and `[fiducial.pyramid]`.
+    ///
+    /// # Errors
+    /// [`VisionError::Profile`] without a pin-hole camera or a pyramid fiducial.
+    pub fn from_profile(profile: &Profile, camera: usize) -> Result<Self, VisionError> {
+        let err = |what: String| VisionError::Profile { what };
+        let pyr = profile
+            .fiducial
+            .pyramid
+            .ok_or_else(|| err(format!("profile `{}` has no [fiducial.pyramid]", profile.name)))?;
+        let cam = profile
+            .cameras
+            .get(camera)
+            .ok_or_else(|| err(format!("profile `{}` has no camera {camera}", profile.name)))?;
+        let k = cam
+            .pinhole_intrinsics()
+            .ok_or_else(|| err(format!("camera `{}` is not a pin-hole camera", cam.name)))?;
+        Ok(Self {
+            f_px: k.fx,
+            principal: [k.cx, k.cy],
+            h: pyr.blue_edge_length_m,
+            m: pyr.edge_to_ball_m,
+            ball_diameter: pyr.ball_diameter_m,
+        })
+    }
+
+    /// The proportions the detector's pair filters use.
+    pub fn shape(&self) -> PyramidShape {
+        PyramidShape {
+            size_ratio: self.h / self.ball_diameter,
+            offset_ratio: self.m / self.h,
+        }
+    }
+
+    /// d = f·h/g, m.
+    pub fn distance_from_blue(&self, g_px: f64) -> f64 {
+        self.f_px * self.h / g_px.max(1e-9)
+    }
+
+    /// The ball's pixel area at 1 m, A₁ = π·(f·D/2)².
+    pub fn reference_area_px(&self) -> f64 {
+        std::f64::consts::PI * (self.f_px * self.ball_diameter / 2.0).powi(2)
+    }
+
+    /// Camera to ball from the ellipse area, d = √(A₁/A), m.
+    pub fn distance_from_area(&self, area_px: f64) -> f64 {
+        (self.reference_area_px() / area_px.max(1e-9)).sqrt()
+    }
+
+    /// Signed α for a pair, and whether it saturated.
+    pub fn alpha(&self, pair: &PyramidPair) -> (f64, bool) {
+        let b = &pair.blue;
+        let g = b.height();
+        let ex = pair.ellipse.centre[0];
+        // Box edges at pixel boundaries: x_min and x_max + 1.
+        let (c, sign) = if ex <= b.centre()[0] {
+            (b.bbox[2] as f64 + 1.0 - ex - 0.5, 1.0)
+        } else {
+            (ex + 0.5 - b.bbox[0] as f64, -1.0)
+        };
+        let k = c.max(0.0) * self.h / g;
+        let saturated = k * k >= self.m * self.m + self.h * self.h / 4.0;
+        (sign * alpha_from_k(k, self.h, self.m), saturated)
+    }
+
+    /// The geometric reading of a detection (None without an ellipse).
+    pub fn view(&self, det: &PyramidDetection) -> Option<PyramidView> {
+        let e = det.ellipse?;
+        let u = e.centre[0] + 0.5 - self.principal[0];
+        let v = e.centre[1] + 0.5 - self.principal[1];
+        let (blue_distance_m, alpha, alpha_saturated, ball_distance_m) = match &det.pair {
+            Some(p) => {
+                let d = self.distance_from_blue(p.blue.height());
+                let (a, sat) = self.alpha(p);
+                (Some(d), Some(a), sat, (d - self.m * a.cos()).max(0.05))
+            }
+            None => (None, None, false, self.distance_from_area(e.count as f64)),
+        };
+        Some(PyramidView {
+            blue_distance_m,
+            ball_distance_m,
+            alpha,
+            alpha_saturated,
+            bearing: (-u / self.f_px).atan(),
+            dev_px: [u, v],
+            area_px: e.count,
+        })
+    }
+}
+
+/// What the pyramid schema reports each frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PyramidPercept {
+    /// Capture time, s.
+    pub stamp: f64,
+    /// The raw detection.
+    pub detection: PyramidDetection,
+    /// Its geometric reading, when an ellipse was found.
+    pub view: Option<PyramidView>,
+    /// Frame size.
+    pub image_size: (usize, usize),
+}
+
+impl PyramidPercept {
+    /// Nothing seen.
+    pub fn not_found(stamp: f64, image_size: (usize, usize)) -> Self {
+        Self {
+            stamp,
+            detection: PyramidDetection {
+                pair: None,
+                ellipse: None,
+                blue: None,
+                candidates: 0,
+            },
+            view: None,
+            image_size,
+        }
+    }
+}
+
+impl Percept for PyramidPercept {
+    fn stamp(&self) -> f64 {
+        self.stamp
+    }
+    /// Found when the orange guide is seen (blue alone is not the target).
+    fn found(&self) -> bool {
+        self.view.is_some()
+    }
+}
+
+/// The pyramid perceptual schema: detector + geometry for one camera.
+#[derive(Debug, Clone)]
+pub struct PyramidSchema {
+    camera: usize,
+    detector: PyramidDetector,
+    geometry: PyramidGeometry,
+}
+
+impl PyramidSchema {
+    /// Builds the schema for camera `camera` of a profile with a `[fiducial.pyramid]`;
+    /// bands and filters come from `[perception.pyramid]`.
+    ///
+    /// # Errors
+    /// [`VisionError::Profile`] when the profile lacks the fiducial or the camera.
+    pub fn from_profile(profile: &Profile, camera: usize) -> Result<Self, VisionError> {
+        let geometry = PyramidGeometry::from_profile(profile, camera)?;
+        let cam = &profile.cameras[camera];
+        Ok(Self {
+            camera,
+            detector: PyramidDetector::new(
+                cam.width_px,
+                cam.height_px,
+                &profile.perception.pyramid,
+                geometry.shape(),
+            ),
+            geometry,
+        })
+    }
+
+    /// The geometry constants.
+    pub fn geometry(&self) -> &PyramidGeometry {
+        &self.geometry
+    }
+
+    /// The detector (masks, tracking state).
+    pub fn detector(&self) -> &PyramidDetector {
+        &self.detector
+    }
+
+    /// Retunes the (orange, blue) HSV bands from the next frame on.
+    pub fn set_bands(&mut self, orange: HsvRange, blue: HsvRange) {
+        self.detector.set_bands(orange, blue);
+    }
+
+    /// Processes one frame.
+    ///
+    /// # Errors
+    /// [`VisionError::SizeMismatch`] for a frame of the wrong size.
+    pub fn process(&mut self, view: &RgbView<'_>, stamp: f64) -> Result<PyramidPercept, VisionError> {
+        check_same_size(self.detector.size(), (view.width(), view.height()))?;
+        let detection = self.detector.detect(view)?;
+        Ok(PyramidPercept {
+            stamp,
+            detection,
+            view: self.geometry.view(&detection),
+            image_size: self.detector.size(),
+        })
+    }
+}
+
+impl PerceptualSchema for PyramidSchema {
+    type Percept = PyramidPercept;
+
+    fn perceive(&mut self, inputs: &Inputs<'_>) -> PyramidPercept {
+        let size = self.detector.size();
+        match inputs.camera(self.camera) {
+            Some(cam) => self
+                .process(&cam.image, cam.stamp)
+                .unwrap_or_else(|_| PyramidPercept::not_found(cam.stamp, size)),
+            None => PyramidPercept::not_found(inputs.now, size),
+        }
+    }
+
+    fn reset(&mut self) {
+        self.detector.reset_tracking();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Synthetic projection of the top view: the image extent c for a robot at angle α
+    /// and distance d, per the paper's model, then back through the quadratic.
+    #[test]
+    fn quadratic_inverts_the_projection_over_the_valid_range() {
+        let (h, m, f, d) = (0.10, 0.16, 360.0, 1.2);
+        let g = f * h / d;
+        let amax = max_alpha(h, m);
+        assert!((amax.to_degrees() - 72.6).abs() < 0.1);
+        for i in 0..=72 {
+            let a = (i as f64).to_radians();
+            let c = f * (m * a.sin() + h / 2.0 * a.cos()) / d;
+            let est = alpha_from_k(c * h / g, h, m);
+            assert!((est - a).abs() < 1e-9, "α = {i}°: {}", est.to_degrees());
+        }
+        // Beyond the peak the estimate folds back below α* (the paper's ambiguity) or
+        // saturates, never above α*.
+        for i in 73..=110 {
+            let a = (i as f64).to_radians();
+            let c = f * (m * a.sin() + h / 2.0 * a.cos()).abs() / d;
+            assert!(alpha_from_k(c * h / g, h, m) <= amax + 1e-12);
+        }
+    }
+
+    #[test]
+    fn minus_root_is_zero_at_half() {
+        assert_eq!(alpha_from_k(0.05, 0.10, 0.16), 0.0);
+        assert_eq!(alpha_from_k(0.0, 0.10, 0.16), 0.0, "K below h/2 clamps to 0");
+    }
+
+    #[test]
+    fn distances() {
+        let g = PyramidGeometry {
+            f_px: 360.0,
+            principal: [80.0, 60.0],
+            h: 0.1,
+            m: 0.16,
+            ball_diameter: 0.07,
+        };
+        assert!((g.distance_from_blue(18.0) - 2.0).abs() < 1e-12);
+        let a1 = g.reference_area_px();
+        assert!((g.distance_from_area(a1 / 4.0) - 2.0).abs() < 1e-12);
+    }
+}
