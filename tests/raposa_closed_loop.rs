@@ -1,0 +1,58 @@
+//! RAPOSA's seven-state docking closed in the simulator from starts across region I (on
+//! the axis, near and far, 15° off) and region II (30°, 60° and 90° on either side, and
+//! inside δ where the manoeuvre backs away). Each must dock within the profile's
+//! tolerance, region-II starts through at least one alignment manoeuvre.
+
+use marsupial::behaviors::agent_for;
+use marsupial::sim::campaign;
+use marsupial::sim::scenario::Scenario;
+use std::path::Path;
+
+#[test]
+fn docks_from_starts_across_regions_one_and_two() {
+    let dir = std::env::temp_dir().join(format!("marsupial-raposa-loop-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let profile = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml");
+    let s = dir.join("s.toml");
+    let points: [(f64, f64); 8] = [
+        (0.5, 0.0),
+        (2.0, 0.0),
+        (1.2, 10.0),
+        (0.5, -30.0),
+        (1.33, 30.0),
+        (2.0, -60.0),
+        (1.5, 60.0),
+        (1.5, -90.0),
+    ];
+    let list: Vec<String> = points
+        .iter()
+        .map(|(d, a)| format!("{{ distance_m = {d}, angle_deg = {a} }}"))
+        .collect();
+    std::fs::write(
+        &s,
+        format!(
+            "name = \"raposa-loop\"\nprofile = \"{}\"\nseed = 5\ntrials = 1\ntimeout_s = 300.0\n[starts]\nposition_jitter_m = 0.02\nheading_jitter_deg = 2.0\npoints = [{}]\n[imprint]\nenabled = false\n",
+            profile.display(),
+            list.join(", ")
+        ),
+    )
+    .unwrap();
+    let p = campaign::prepare(Scenario::load(&s).unwrap()).unwrap();
+    let (records, summary) = campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap();
+    let tol = p.loaded.profile.success;
+    for (r, (_, a)) in records.iter().zip(points) {
+        assert!(
+            r.success,
+            "start {} ({a}°): {} after {:.1} s",
+            r.start, r.outcome, r.time_s
+        );
+        assert!(r.entrance_lateral_m.unwrap().abs() <= tol.lateral_tolerance_m);
+        assert!(r.entrance_heading_deg.unwrap().abs() <= tol.heading_tolerance_deg);
+        if a.abs() >= 30.0 {
+            assert!(r.manoeuvres >= 1, "start {} ({a}°) docked without region II", r.start);
+        } else {
+            assert_eq!(r.manoeuvres, 0, "start {} ({a}°) is region I", r.start);
+        }
+    }
+    assert_eq!(summary.overall.successes, points.len());
+}
