@@ -72,6 +72,24 @@ enum Command {
         #[arg(required = true, value_name = "FILE")]
         files: Vec<PathBuf>,
     },
+    /// Fit skid-steer odometry (effective track and wheel scale) to a logged run.
+    ///
+    /// The log is CSV with a header and one line per sample:
+    /// `t,left_m,right_m,x_m,y_m,theta_rad`: cumulative wheel travel as the encoders
+    /// report it, and the true pose (motion capture, survey, or the simulator). Drive
+    /// straight and turn both ways in the log. With `--profile`, also reports whether the
+    /// fit lies in the profile's [d_min, d_max].
+    CalibrateOdometry {
+        /// The log (CSV).
+        #[arg(value_name = "LOG.csv")]
+        log: PathBuf,
+        /// Profile to compare with.
+        #[arg(long, value_name = "PROFILE")]
+        profile: Option<PathBuf>,
+        /// Print JSON: {"calibration": {...}, "within_profile_bounds": bool|null}.
+        #[arg(long)]
+        json: bool,
+    },
     /// Run the two-block perceptual schema on image files.
     ///
     /// The images are processed in order as a stream, so adaptation carries from one to
@@ -142,6 +160,12 @@ fn main() -> ExitCode {
         .try_init();
     let cli = Cli::parse();
     match cli.command {
+        Command::CalibrateOdometry { log, profile, json } => exit_code(marsupial::cli::calibrate::run(
+            &log,
+            profile.as_deref(),
+            json,
+            &mut std::io::stdout(),
+        )),
         Command::Check { files } => {
             let bad = marsupial::cli::check::run(&files, &mut std::io::stdout(), &mut std::io::stderr());
             if bad == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE }

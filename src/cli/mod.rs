@@ -1,6 +1,7 @@
 //! The `marsupial` command-line tool's subcommands, as library functions so they can be
 //! tested without spawning a process.
 
+pub mod calibrate;
 pub mod check;
 pub mod detect;
 pub mod image_io;

@@ -6,11 +6,13 @@
 //! restricted turn-or-drive base gets a turn OR a straight, never both).
 
 pub mod ackermann;
+pub mod calibration;
 pub mod differential;
 pub mod odometry;
 pub mod skid_steer;
 
 pub use ackermann::{BodyVelocity, DoubleAckermann};
+pub use calibration::{Calibration, CalibrationError, OdometrySample, calibrate, parse_log};
 pub use differential::Differential;
 pub use odometry::Odometry;
 pub use skid_steer::{SkidSteer, SkidSteerError};
