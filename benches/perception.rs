@@ -3,14 +3,26 @@
 //! space conversions for reference. Targets (issue: colour perception): whole schema under
 //! 1 ms at 640×480 and under 0.25 ms at 256×240, one core.
 //!
+//! RAPOSA's pyramid schema (HSV segmentation of both bands, ellipses, blue regions, pair
+//! filters, geometry) on a rendered frame of the pyramid, at the profile's 160×120 and at
+//! 640×480.
+//!
 //! Run: `cargo bench --bench perception` (add `-- --quick` for a fast pass).
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use marsupial::geometry::Pose2;
+use marsupial::perception::PyramidSchema;
+use marsupial::perception::camera_model::CameraModel;
 use marsupial::perception::{
     ColorRange, HsvPlanes, Labeler, Mask, SctPlanes, Segmenter, TwoBlockDetector, TwoBlockSchema, hsv_from_rgb,
     sct_from_rgb,
 };
 use marsupial::profile::Profile;
+use marsupial::sim::camera::camera_pose;
+use marsupial::sim::lighting::{LightingRun, LightingSpec};
+use marsupial::sim::render::{Renderer, SensorParams};
+use marsupial::sim::rng::Rng;
+use marsupial::sim::world;
 use std::hint::black_box;
 use std::path::Path;
 
@@ -78,9 +90,55 @@ fn bench_size(c: &mut Criterion, w: usize, h: usize) {
     g.finish();
 }
 
+fn bench_pyramid(c: &mut Criterion, w: usize, h: usize) {
+    let mut p = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml")).expect("profile");
+    p.cameras[0].width_px = w;
+    p.cameras[0].height_px = h;
+    let world = world::build(&p, &[], &[]).expect("world");
+    let cam = &p.cameras[0];
+    // Camera 1.2 m from the ball, 20° off the pyramid axis, looking at it.
+    let a = 20f64.to_radians();
+    let robot = Pose2::new(
+        1.2 * a.cos() - cam.mount.x_m * a.cos(),
+        1.2 * a.sin() - cam.mount.x_m * a.sin(),
+        a,
+    );
+    let mut r = Renderer::new(CameraModel::from_spec(cam), w, h, 1);
+    let light = LightingRun::new(LightingSpec::default().resolve(), &mut Rng::new(1), 10.0);
+    let mut frame = marsupial::perception::RgbImage::default();
+    r.render(
+        &world.scene,
+        &camera_pose(&robot, &cam.mount),
+        &light.at(0.0),
+        &SensorParams::default(),
+        1,
+        &mut frame,
+    );
+    let view = frame.view();
+    let mut schema = PyramidSchema::from_profile(&p, 0).expect("schema");
+    assert!(
+        schema.process(&view, 0.0).expect("frame").detection.pair.is_some(),
+        "bench frame must show the pyramid"
+    );
+    let mut g = c.benchmark_group(format!("raposa_schema_{w}x{h}"));
+    g.bench_function("whole_schema", |b| {
+        b.iter(|| black_box(schema.process(black_box(&view), 0.0).expect("frame")))
+    });
+    let bands = schema.detector().bands();
+    let cr = [ColorRange::Hsv(bands[0]), ColorRange::Hsv(bands[1])];
+    let mut seg = Segmenter::new();
+    let mut masks = [Mask::new(w, h), Mask::new(w, h)];
+    g.bench_function("stage_1_segment_both_bands", |b| {
+        b.iter(|| seg.segment(black_box(&view), &cr, &mut masks).expect("segment"))
+    });
+    g.finish();
+}
+
 fn benches(c: &mut Criterion) {
     bench_size(c, 640, 480);
     bench_size(c, 256, 240);
+    bench_pyramid(c, 160, 120);
+    bench_pyramid(c, 640, 480);
 }
 
 criterion_group!(perception, benches);

@@ -3,8 +3,8 @@
 //!
 //! Per frame:
 //!
-//! 1. **Segment** both colours with the operator's HSV bands (one HSV conversion per
-//!    pixel serves both bands). The bands can be changed between frames with
+//! 1. **Segment** both colours with the operator's HSV bands ([`Segmenter`], one HSV
+//!    conversion per pixel for both bands). The bands can be changed between frames with
 //!    [`PyramidDetector::set_bands`], as the paper's operator retunes them live.
 //! 2. **Orange blobs → ellipses** from second moments; filtered first by area
 //!    (`min_ellipse_px`), then by axis ratio, then by fill (blob pixels over the fitted
@@ -28,9 +28,8 @@
 //! seed 001 §II.D. All buffers are allocated in [`PyramidDetector::new`].
 
 use super::components::{Component, Labeler};
-use super::hsv::Hsv;
 use super::image::RgbView;
-use super::segment::{HsvRange, Mask};
+use super::segment::{ColorRange, HsvRange, Mask, Segmenter};
 use super::{VisionError, check_same_size};
 use crate::profile::PyramidPerceptionSpec;
 use serde::Serialize;
@@ -176,6 +175,7 @@ pub struct PyramidDetector {
     spec: PyramidPerceptionSpec,
     shape: PyramidShape,
     bands: [HsvRange; 2],
+    segmenter: Segmenter,
     masks: [Mask; 2],
     labelers: [Labeler; 2],
     ellipses: Vec<Ellipse>,
@@ -196,6 +196,7 @@ impl PyramidDetector {
             spec: *spec,
             shape,
             bands: [spec.orange.range(), spec.blue.range()],
+            segmenter: Segmenter::new(),
             masks: [Mask::new(width, height), Mask::new(width, height)],
             labelers: [Labeler::new(width, height), Labeler::new(width, height)],
             ellipses: Vec::with_capacity(n),
@@ -244,7 +245,8 @@ impl PyramidDetector {
     /// [`VisionError::SizeMismatch`] when the frame is not the detector's size.
     pub fn detect(&mut self, view: &RgbView<'_>) -> Result<PyramidDetection, VisionError> {
         check_same_size((self.width, self.height), (view.width(), view.height()))?;
-        self.segment(view);
+        self.segmenter
+            .segment(view, &self.bands.map(ColorRange::Hsv), &mut self.masks)?;
         self.collect_ellipses()?;
         self.collect_blues()?;
         let det = self.choose();
@@ -261,28 +263,6 @@ impl PyramidDetector {
             }
         }
         Ok(det)
-    }
-
-    fn segment(&mut self, view: &RgbView<'_>) {
-        let [m0, m1] = &mut self.masks;
-        let (o, b) = (m0.data_mut(), m1.data_mut());
-        let [ro, rb] = self.bands;
-        // Pixels below both bands' saturation or value floors need no hue.
-        let s_floor = ro.s[0].min(rb.s[0]);
-        let v_floor = ro.v[0].min(rb.v[0]);
-        for (i, px) in view.as_bytes().chunks_exact(3).enumerate() {
-            let (r, g, bl) = (px[0], px[1], px[2]);
-            let max = r.max(g).max(bl);
-            let min = r.min(g).min(bl);
-            if (max as f32) < v_floor * 255.0 - 1.0 || ((max - min) as f32) < s_floor * max as f32 - 1.0 {
-                o[i] = 0;
-                b[i] = 0;
-                continue;
-            }
-            let p = Hsv::from_rgb([r, g, bl]);
-            o[i] = ro.contains_hsv(&p) as u8;
-            b[i] = rb.contains_hsv(&p) as u8;
-        }
     }
 
     /// Indices of the largest components of colour `k` with at least `min` pixels, in

@@ -262,6 +262,34 @@ impl Default for Segmenter {
     }
 }
 
+/// HSV ranges: one conversion per pixel serves every HSV range. Pixels below every
+/// range's saturation and value floors (most of a background) are rejected on integers
+/// first; the margins of one 8-bit step make that test conservative, so the masks equal
+/// [`HsvRange::contains`] exactly (tested over the RGB cube).
+fn segment_hsv(bytes: &[u8], ranges: &[ColorRange], masks: &mut [Mask]) {
+    let hsv = || {
+        ranges.iter().zip(0..).filter_map(|(r, k)| match r {
+            ColorRange::Hsv(h) => Some((h, k)),
+            ColorRange::Sct(_) => None,
+        })
+    };
+    let Some(s_floor) = hsv().map(|(h, _)| h.s[0]).reduce(f32::min) else {
+        return;
+    };
+    let v_floor = hsv().map(|(h, _)| h.v[0]).fold(f32::INFINITY, f32::min);
+    for (i, px) in bytes.chunks_exact(3).enumerate() {
+        let (r, g, b) = (px[0], px[1], px[2]);
+        let (max, min) = (r.max(g).max(b), r.min(g).min(b));
+        if (max as f32) < v_floor * 255.0 - 1.0 || ((max - min) as f32) < s_floor * max as f32 - 1.0 {
+            continue; // masks were cleared
+        }
+        let p = Hsv::from_rgb([r, g, b]);
+        for (h, k) in hsv() {
+            masks[k].data[i] = h.contains_hsv(&p) as u8;
+        }
+    }
+}
+
 impl Segmenter {
     /// A segmenter; its tables do not depend on the frame size.
     pub fn new() -> Self {
@@ -291,14 +319,7 @@ impl Segmenter {
             m.data.fill(0);
         }
         let bytes = src.as_bytes();
-        // HSV ranges: a direct per-pixel test.
-        for (range, mask) in ranges.iter().zip(masks.iter_mut()) {
-            if let ColorRange::Hsv(hr) = range {
-                for (o, px) in mask.data.iter_mut().zip(bytes.chunks_exact(3)) {
-                    *o = hr.contains([px[0], px[1], px[2]]) as u8;
-                }
-            }
-        }
+        segment_hsv(bytes, ranges, masks);
         // SCT ranges: in groups of up to eight, one (r, g) table per group.
         let mut start = 0;
         while start < ranges.len() {
@@ -491,6 +512,52 @@ mod tests {
             .segment(&im.view(), &[ColorRange::Hsv(red)], &mut m)
             .unwrap();
         assert_eq!(m[0].data(), &[1, 0]);
+    }
+
+    #[test]
+    fn hsv_masks_equal_the_reference_over_the_cube() {
+        // A wrapping red, a range with no floors (no pixel is pre-rejected), an SCT range
+        // in between (groups must not disturb each other), and a narrow blue.
+        let ranges = [
+            ColorRange::Hsv(HsvRange {
+                h: [340.0, 20.0],
+                s: [0.5, 1.0],
+                v: [0.2, 1.0],
+            }),
+            ColorRange::Hsv(HsvRange {
+                h: [40.0, 90.0],
+                s: [0.0, 0.6],
+                v: [0.0, 0.9],
+            }),
+            ColorRange::Sct(SctRange {
+                a: [0.5, 1.0],
+                b: [0.0, 1.0],
+                min_l: 20.0,
+            }),
+            ColorRange::Hsv(HsvRange {
+                h: [200.0, 250.0],
+                s: [0.4, 1.0],
+                v: [0.12, 1.0],
+            }),
+        ];
+        let vals: Vec<u8> = (0..=255).step_by(5).collect();
+        let n = vals.len();
+        let mut im = RgbImage::new(n * n, n);
+        for (i, &r) in vals.iter().enumerate() {
+            for (j, &g) in vals.iter().enumerate() {
+                for (k, &b) in vals.iter().enumerate() {
+                    im.put(i * n + j, k, [r, g, b]);
+                }
+            }
+        }
+        let mut masks: Vec<Mask> = ranges.iter().map(|_| Mask::new(n * n, n)).collect();
+        Segmenter::new().segment(&im.view(), &ranges, &mut masks).unwrap();
+        for (idx, px) in im.as_bytes().chunks_exact(3).enumerate() {
+            let rgb = [px[0], px[1], px[2]];
+            for (r, m) in ranges.iter().zip(&masks) {
+                assert_eq!(m.data()[idx] != 0, r.contains(rgb), "{rgb:?} {r:?}");
+            }
+        }
     }
 
     #[test]

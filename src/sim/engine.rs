@@ -8,7 +8,7 @@
 
 use super::camera::camera_pose;
 use super::dock::{Contact, judge};
-use super::lighting::{LightingRun, ShadowBand};
+use super::lighting::{LightState, LightingRun, ShadowBand};
 use super::motion::Motion;
 use super::render::{Renderer, SensorParams};
 use super::rng::Rng;
@@ -193,7 +193,7 @@ impl<'w> Sim<'w> {
         }
     }
 
-    fn robot_shadow(&self, light: &mut super::lighting::LightState) {
+    fn robot_shadow(&self, light: &mut LightState) {
         let Some(f) = self.profile.fiducial.two_block else {
             return;
         };
@@ -241,12 +241,14 @@ impl<'w> Sim<'w> {
         let t_end = self.t + max_s;
         let (length, width) = (self.profile.body.length_m, self.profile.body.width_m);
         let mut next_track = self.t;
+        // Refilled every tick: its shadow and flasher lists keep their allocation.
+        let mut light = LightState::uniform(0.0);
         loop {
             if self.t >= t_end - 1e-9 {
                 return PhaseEnd::Timeout;
             }
             // Sense.
-            let mut light = self.light.at(self.t);
+            self.light.fill(self.t, &mut light);
             self.robot_shadow(&mut light);
             for (i, spec) in self.profile.cameras.iter().enumerate() {
                 let pose = camera_pose(&self.pose, &spec.mount);

@@ -439,6 +439,14 @@ impl LightingRun {
 
     /// The state at run time `t` (s).
     pub fn at(&self, t: f64) -> LightState {
+        let mut state = LightState::uniform(0.0);
+        self.fill(t, &mut state);
+        state
+    }
+
+    /// Writes the state at run time `t` (s) into `state`, reusing its lists (the
+    /// simulator calls this every tick without allocating).
+    pub fn fill(&self, t: f64, state: &mut LightState) {
         let l = &self.lighting;
         let hours = (self.start_s + t) / 3600.0;
         let level = (l.intensity * (1.0 + l.change_per_hour * hours)).max(0.02 * l.intensity);
@@ -449,43 +457,34 @@ impl LightingRun {
             } else {
                 1.0
             };
-        let shadows = l
-            .shadows
-            .iter()
-            .map(|s| {
-                let off = s.offset_m + s.amplitude_m * (std::f64::consts::TAU * t / s.period_s).sin();
-                let a = s.angle_deg.to_radians();
-                ShadowBand {
-                    cos: a.cos() as f32,
-                    sin: a.sin() as f32,
-                    offset: off as f32,
-                    softness: s.softness_m as f32,
-                    strength: s.strength as f32,
-                }
-            })
-            .collect();
-        LightState {
-            illum: l.illuminant.rgb(),
-            level: level as f32,
-            ambient: l.ambient as f32,
-            sun: sun as f32,
-            sun_dir: l.sun_dir,
-            glare: (l.glare * sun.max(0.3)) as f32,
-            flashers: l
-                .flashers
-                .iter()
-                .map(|f| {
-                    let angle = std::f64::consts::TAU * t / f.period_s;
-                    (
-                        Point3::new(f.x_m, f.y_m, f.z_m),
-                        angle,
-                        f.power as f32,
-                        super::scene::albedo(f.rgb, 1.0),
-                    )
-                })
-                .collect(),
-            shadows,
-        }
+        state.illum = l.illuminant.rgb();
+        state.level = level as f32;
+        state.ambient = l.ambient as f32;
+        state.sun = sun as f32;
+        state.sun_dir = l.sun_dir;
+        state.glare = (l.glare * sun.max(0.3)) as f32;
+        state.shadows.clear();
+        state.shadows.extend(l.shadows.iter().map(|s| {
+            let off = s.offset_m + s.amplitude_m * (std::f64::consts::TAU * t / s.period_s).sin();
+            let a = s.angle_deg.to_radians();
+            ShadowBand {
+                cos: a.cos() as f32,
+                sin: a.sin() as f32,
+                offset: off as f32,
+                softness: s.softness_m as f32,
+                strength: s.strength as f32,
+            }
+        }));
+        state.flashers.clear();
+        state.flashers.extend(l.flashers.iter().map(|f| {
+            let angle = std::f64::consts::TAU * t / f.period_s;
+            (
+                Point3::new(f.x_m, f.y_m, f.z_m),
+                angle,
+                f.power as f32,
+                super::scene::albedo(f.rgb, 1.0),
+            )
+        }));
     }
 
     /// True when the robot's own shadow should be cast on the target.
