@@ -20,49 +20,14 @@ enum Command {
     /// Prints one line (or, with --json, the run record: start, outcome, time_s, path_m,
     /// entrance errors, track …). With --out DIR, writes DIR/trajectory.csv and every Nth
     /// camera frame (the scenario's [record] frames_every) to DIR/frames/.
-    Dock {
-        /// Scenario file.
-        #[arg(long, value_name = "S")]
-        scenario: PathBuf,
-        /// Start label (grid position 1–16, or list entry).
-        #[arg(long, value_name = "N", conflicts_with = "at")]
-        start: Option<String>,
-        /// Explicit start: x,y,heading (metres, metres, degrees) in the dock frame.
-        #[arg(long, value_name = "X,Y,HEADING", value_parser = parse_at)]
-        at: Option<(f64, f64, f64)>,
-        /// Seed (default: the scenario's).
-        #[arg(long, value_name = "K")]
-        seed: Option<u64>,
-        /// Print the run record as JSON.
-        #[arg(long)]
-        json: bool,
-        /// Output folder.
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-    },
+    Dock(marsupial::cli::sim_cmds::DockOptions),
     /// Run a scenario's whole trial campaign in the simulator, in parallel.
     ///
     /// Prints a table per start group (success rate, mean and SD of time to dock, effective
     /// velocity, commands per metre, failures by reason). With --out DIR: DIR/runs.jsonl
     /// (one line per finished run, in run order), DIR/summary.json, DIR/trajectories.svg,
     /// DIR/success_map.svg and per-run trajectories.
-    Trials {
-        /// Scenario file.
-        #[arg(value_name = "S")]
-        scenario: PathBuf,
-        /// Output folder.
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-        /// Print the summary JSON instead of the table.
-        #[arg(long)]
-        json: bool,
-        /// Worker threads (default: all cores).
-        #[arg(long, value_name = "N", default_value_t = 0)]
-        jobs: usize,
-        /// Skip runs already in DIR/runs.jsonl.
-        #[arg(long, requires = "out")]
-        resume: bool,
-    },
+    Trials(marsupial::cli::sim_cmds::TrialsOptions),
     /// Validate profile and scenario files.
     ///
     /// Prints `ok FILE` for each valid file. For each invalid file prints every problem
@@ -100,33 +65,7 @@ enum Command {
     /// `--json` prints one object per image: image, width, height, found, left_px,
     /// right_px, total_px, ratio, left_centroid, right_centroid, offset_px, mode
     /// (adapted / imprinted / table) and us_per_frame (median over --repeat runs).
-    Detect {
-        /// Profile with a [fiducial.two_block] (e.g. profiles/bujold.toml).
-        #[arg(long, value_name = "PROFILE")]
-        profile: PathBuf,
-        /// Imprint on this image first (repeatable; several frames are averaged).
-        #[arg(long, value_name = "IMAGE")]
-        imprint: Vec<PathBuf>,
-        /// Static segmentation: keep the imprint, never adapt.
-        #[arg(long = "static")]
-        static_mode: bool,
-        /// One JSON object per image.
-        #[arg(long)]
-        json: bool,
-        /// Write the frame with segmented pixels painted in (PNG); with several images an
-        /// index is added: OUT-000.png, OUT-001.png …
-        #[arg(long, value_name = "OUT.png")]
-        overlay: Option<PathBuf>,
-        /// Time the whole schema this many times per image and report the median.
-        #[arg(long, value_name = "N", default_value_t = 1)]
-        repeat: usize,
-        /// Seconds between images (default: one frame period of the profile's camera).
-        #[arg(long, value_name = "S")]
-        interval: Option<f64>,
-        /// Images, in stream order.
-        #[arg(required = true, value_name = "IMAGE")]
-        images: Vec<PathBuf>,
-    },
+    Detect(marsupial::cli::detect::DetectOptions),
 }
 
 /// Exit status of a subcommand: success, or the error on stderr and status 1.
@@ -137,17 +76,6 @@ fn exit_code<T, E: std::fmt::Display>(result: Result<T, E>) -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::FAILURE
         }
-    }
-}
-
-fn parse_at(s: &str) -> Result<(f64, f64, f64), String> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f64>().map_err(|e| format!("`{x}`: {e}")))
-        .collect::<Result<_, _>>()?;
-    match v[..] {
-        [x, y, h] if v.iter().all(|x| x.is_finite()) => Ok((x, y, h)),
-        _ => Err("expected three finite numbers: x,y,heading".into()),
     }
 }
 
@@ -170,62 +98,11 @@ fn main() -> ExitCode {
             let bad = marsupial::cli::check::run(&files, &mut std::io::stdout(), &mut std::io::stderr());
             if bad == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE }
         }
-        Command::Dock {
-            scenario,
-            start,
-            at,
-            seed,
-            json,
-            out,
-        } => {
-            let opts = marsupial::cli::sim_cmds::DockOptions {
-                scenario,
-                start,
-                at,
-                seed,
-                json,
-                out,
-            };
-            exit_code(marsupial::cli::sim_cmds::dock(&opts, &mut std::io::stdout()))
-        }
-        Command::Trials {
-            scenario,
-            out,
-            json,
-            jobs,
-            resume,
-        } => {
-            let opts = marsupial::cli::sim_cmds::TrialsOptions {
-                scenario,
-                out,
-                json,
-                jobs,
-                resume,
-                progress: std::io::IsTerminal::is_terminal(&std::io::stderr()),
-            };
+        Command::Dock(opts) => exit_code(marsupial::cli::sim_cmds::dock(&opts, &mut std::io::stdout())),
+        Command::Trials(mut opts) => {
+            opts.progress = std::io::IsTerminal::is_terminal(&std::io::stderr());
             exit_code(marsupial::cli::sim_cmds::trials(&opts, &mut std::io::stdout()))
         }
-        Command::Detect {
-            profile,
-            imprint,
-            static_mode,
-            json,
-            overlay,
-            repeat,
-            interval,
-            images,
-        } => {
-            let opts = marsupial::cli::detect::DetectOptions {
-                profile,
-                imprint,
-                static_mode,
-                json,
-                overlay,
-                repeat,
-                interval,
-                images,
-            };
-            exit_code(marsupial::cli::detect::run(&opts, &mut std::io::stdout()))
-        }
+        Command::Detect(opts) => exit_code(marsupial::cli::detect::run(&opts, &mut std::io::stdout())),
     }
 }

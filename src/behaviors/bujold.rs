@@ -272,11 +272,7 @@ impl BujoldAgent {
     fn reposition(&mut self, view: &FiducialView, now: f64, odo: Pose2) {
         // Robot centre in the dock frame: the camera sits `rear_behind_camera − L/2` ahead
         // of the rear; near enough to treat the camera as the centre here.
-        let here = Pose2::new(
-            view.distance * view.alpha.cos(),
-            view.distance * view.alpha.sin(),
-            view.heading,
-        );
+        let here = view.dock_pose();
         let stage_x = (here.x + 0.15).max(STAGING_X_M);
         let stage = Pose2::new(stage_x, 0.0, 0.0);
         // dock → odometry: odo = T ⊕ dock, T = odo ⊕ here⁻¹.
@@ -300,12 +296,7 @@ impl BujoldAgent {
         match &self.field {
             None => self.steering.act(view),
             Some(pf) => {
-                let pose = Pose2::new(
-                    view.distance * view.alpha.cos(),
-                    view.distance * view.alpha.sin(),
-                    view.heading,
-                );
-                let t = pf.twist(&pose, self.geometry.drive_dir);
+                let t = pf.twist(&view.dock_pose(), self.geometry.drive_dir);
                 let cmd = if self.steering.restricted {
                     // Turn OR drive: turn while the heading error exceeds the dead band.
                     if (t.omega * self.steering.tick_s).abs() > self.steering.dead_band * 0.5 {

@@ -11,26 +11,33 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use thiserror::Error;
 
-/// Options of `marsupial detect`.
-#[derive(Debug, Clone, PartialEq)]
+/// Options of `marsupial detect` (also its command-line arguments).
+#[derive(Debug, Clone, PartialEq, clap::Args)]
 pub struct DetectOptions {
-    /// Profile file.
+    /// Profile with a [fiducial.two_block] (e.g. profiles/bujold.toml).
+    #[arg(long, value_name = "PROFILE")]
     pub profile: PathBuf,
-    /// Images to imprint on first (in order).
+    /// Imprint on this image first (repeatable; several frames are averaged).
+    #[arg(long, value_name = "IMAGE")]
     pub imprint: Vec<PathBuf>,
-    /// Static segmentation (imprint only, never adapt).
+    /// Static segmentation: keep the imprint, never adapt.
+    #[arg(long = "static")]
     pub static_mode: bool,
-    /// One JSON object per image instead of text.
+    /// One JSON object per image.
+    #[arg(long)]
     pub json: bool,
-    /// Overlay output path (an index is inserted before the extension when several images
-    /// are given).
+    /// Write the frame with segmented pixels painted in (PNG); with several images an
+    /// index is added: OUT-000.png, OUT-001.png …
+    #[arg(long, value_name = "OUT.png")]
     pub overlay: Option<PathBuf>,
-    /// Timed runs per image (median reported).
+    /// Time the whole schema this many times per image and report the median.
+    #[arg(long, value_name = "N", default_value_t = 1)]
     pub repeat: usize,
-    /// Seconds between consecutive images (drives the fallback timeouts); default one frame
-    /// period of the profile's camera.
+    /// Seconds between images (default: one frame period of the profile's camera).
+    #[arg(long, value_name = "S")]
     pub interval: Option<f64>,
-    /// Images to process, in order.
+    /// Images, in stream order.
+    #[arg(required = true, value_name = "IMAGE")]
     pub images: Vec<PathBuf>,
 }
 

@@ -3,25 +3,47 @@
 use crate::behaviors::agent_for;
 use crate::sim::SimError;
 use crate::sim::campaign::{self, CampaignOptions, GroupSummary, RunRecord, Summary};
+use crate::sim::paper::cell;
 use crate::sim::scenario::Scenario;
 use std::io::Write;
 use std::path::PathBuf;
 
-/// Options of `marsupial dock`.
-#[derive(Debug, Clone, Default)]
+/// Options of `marsupial dock` (also its command-line arguments).
+#[derive(Debug, Clone, Default, clap::Args)]
 pub struct DockOptions {
     /// Scenario file.
+    #[arg(long, value_name = "S")]
     pub scenario: PathBuf,
-    /// 1-based start (grid position or list entry); default the first.
+    /// Start label (grid position 1–16, or list entry); default the first.
+    #[arg(long, value_name = "N", conflicts_with = "at")]
     pub start: Option<String>,
-    /// Explicit start (x, y, heading°) instead.
+    /// Explicit start: x,y,heading (metres, metres, degrees) in the dock frame.
+    #[arg(long, value_name = "X,Y,HEADING", value_parser = parse_at)]
     pub at: Option<(f64, f64, f64)>,
-    /// Override the scenario seed.
+    /// Seed (default: the scenario's).
+    #[arg(long, value_name = "K")]
     pub seed: Option<u64>,
     /// Print the run record as JSON.
+    #[arg(long)]
     pub json: bool,
     /// Output folder (trajectory CSV, frames).
+    #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+}
+
+/// Parses `--at x,y,heading`.
+///
+/// # Errors
+/// A message when the text is not three finite comma-separated numbers.
+pub fn parse_at(s: &str) -> Result<(f64, f64, f64), String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>().map_err(|e| format!("`{x}`: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x, y, h] if v.iter().all(|x| x.is_finite()) => Ok((x, y, h)),
+        _ => Err("expected three finite numbers: x,y,heading".into()),
+    }
 }
 
 /// Runs one docking run.
@@ -99,25 +121,27 @@ pub fn dock(opts: &DockOptions, out: &mut dyn Write) -> Result<RunRecord, SimErr
     Ok(rec)
 }
 
-/// Options of `marsupial trials`.
-#[derive(Debug, Clone, Default)]
+/// Options of `marsupial trials` (also its command-line arguments).
+#[derive(Debug, Clone, Default, clap::Args)]
 pub struct TrialsOptions {
     /// Scenario file.
+    #[arg(value_name = "S")]
     pub scenario: PathBuf,
     /// Output folder.
+    #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Print the summary JSON instead of the table.
+    #[arg(long)]
     pub json: bool,
-    /// Worker threads (0: all cores).
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N", default_value_t = 0)]
     pub jobs: usize,
-    /// Skip runs already in `out/runs.jsonl`.
+    /// Skip runs already in DIR/runs.jsonl.
+    #[arg(long, requires = "out")]
     pub resume: bool,
-    /// Progress bar.
+    /// Progress bar on stderr (set by the binary when stderr is a terminal).
+    #[arg(skip)]
     pub progress: bool,
-}
-
-fn fmt_opt(v: Option<f64>, prec: usize) -> String {
-    v.map(|x| format!("{x:.prec$}")).unwrap_or_else(|| "-".into())
 }
 
 /// Prints a summary as a table like the paper's.
@@ -163,9 +187,9 @@ pub fn print_table(s: &Summary, out: &mut dyn Write) -> std::io::Result<()> {
             "{line}  {:>4}  {:>6.2}  {:>13}  {:>6}  {:>12}  {:>6.2}  {}",
             g.runs,
             g.success_rate,
-            fmt_opt(g.mean_time_s, 1),
-            fmt_opt(g.sd_time_s, 1),
-            fmt_opt(g.v_eff_cmps, 2),
+            cell(g.mean_time_s, 1),
+            cell(g.sd_time_s, 1),
+            cell(g.v_eff_cmps, 2),
             g.commands_per_m,
             fails.join(" ")
         )

@@ -76,6 +76,16 @@ pub struct FiducialView {
 }
 
 impl FiducialView {
+    /// The camera's position in the dock frame (at `distance` along angle α) with the
+    /// robot's estimated heading: the relative pose motor schemas and planners work on.
+    pub fn dock_pose(&self) -> crate::geometry::Pose2 {
+        crate::geometry::Pose2::new(
+            self.distance * self.alpha.cos(),
+            self.distance * self.alpha.sin(),
+            self.heading,
+        )
+    }
+
     /// Estimates the view from a found percept (`None` when not found or degenerate).
     pub fn from_percept(p: &TwoBlockPercept, g: &TwoBlockGeometry) -> Option<Self> {
         if !p.found || p.total_px == 0 {

@@ -2,7 +2,7 @@
 //! A scenario opts in with `compare = "bujold-table1"` (or `"bujold-table2"`,
 //! `"raposa-table1"`, `"raposa-range"`, `"raposa-wide"`).
 
-use super::campaign::RunRecord;
+use super::campaign::{RunRecord, summarise};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 
@@ -71,25 +71,14 @@ pub const RAPOSA_TABLE_1: [RaposaRow; 9] = [
 /// Seed 001 §III: success at 0° against start distance (2.7 m: "performed well").
 pub const RAPOSA_RANGE: [(f64, &str); 4] = [(2.5, "100 %"), (2.7, "performed well"), (2.8, "75 %"), (3.0, "0 %")];
 
-fn time_stats(rs: &[&RunRecord]) -> (Option<f64>, Option<f64>, Option<f64>) {
-    let ok: Vec<&&RunRecord> = rs.iter().filter(|r| r.success).collect();
-    if ok.is_empty() {
-        return (None, None, None);
-    }
-    let n = ok.len() as f64;
-    let mean = ok.iter().map(|r| r.time_s).sum::<f64>() / n;
-    let sd = (ok.iter().map(|r| (r.time_s - mean).powi(2)).sum::<f64>() / n).sqrt();
-    let v = ok.iter().map(|r| r.v_eff_cmps).sum::<f64>() / n;
-    (Some(mean), Some(sd), Some(v))
-}
-
+/// (runs, successes, mean time of successful runs): the campaign's own group summary.
 fn stats(rs: &[&RunRecord]) -> (usize, usize, Option<f64>) {
-    let ok: Vec<f64> = rs.iter().filter(|r| r.success).map(|r| r.time_s).collect();
-    let mean = (!ok.is_empty()).then(|| ok.iter().sum::<f64>() / ok.len() as f64);
-    (rs.len(), ok.len(), mean)
+    let g = summarise(rs, [""; 4]);
+    (g.runs, g.successes, g.mean_time_s)
 }
 
-fn cell(v: Option<f64>, prec: usize) -> String {
+/// Formats an optional number, "-" when absent (also used by the trials table).
+pub(crate) fn cell(v: Option<f64>, prec: usize) -> String {
     v.map(|x| format!("{x:.prec$}")).unwrap_or_else(|| "-".into())
 }
 
@@ -120,9 +109,8 @@ pub fn comparison(table: PaperTable, records: &[RunRecord]) -> String {
                 );
             }
             let all: Vec<&RunRecord> = records.iter().collect();
-            let (n, ok, _) = stats(&all);
-            let veff: Vec<f64> = records.iter().filter(|r| r.success).map(|r| r.v_eff_cmps).collect();
-            let v = (!veff.is_empty()).then(|| veff.iter().sum::<f64>() / veff.len() as f64);
+            let g = summarise(&all, [""; 4]);
+            let (n, ok, v) = (g.runs, g.successes, g.v_eff_cmps);
             let _ = writeln!(
                 s,
                 "success {ok}/{n} = {:.0} % (paper 96 % of 48); effective velocity {} cm/s (paper 2.4)",
@@ -176,8 +164,8 @@ pub fn comparison(table: PaperTable, records: &[RunRecord]) -> String {
                 if rs.is_empty() {
                     continue;
                 }
-                let (n, ok, _) = stats(&rs);
-                let (mean, sd, v) = time_stats(&rs);
+                let g = summarise(&rs, [""; 4]);
+                let (n, ok, mean, sd, v) = (g.runs, g.successes, g.mean_time_s, g.sd_time_s, g.v_eff_cmps);
                 let paper = match paper {
                     Some((_, t, sd, v, rate)) => format!("{t:>15.2}  {sd:>5.2}  {v:>8.2}  {:>6.1} %", rate * 100.0),
                     None => format!("{:>15}  {:>5}  {:>8}  {:>6} %", "never docked", "-", "-", 0),

@@ -22,7 +22,7 @@ enum Phase {
     /// Select a state every tick (states 1–5 and the dead-zone exit).
     Servo,
     /// State 6 (latched).
-    Final { start: f64, arm: f64 },
+    Final { start: f64 },
     /// State 7 (latched): vision-tracked part of the first rotation.
     Rotate7 {
         plan: Region2Plan,
@@ -198,7 +198,8 @@ impl RaposaAgent {
         let Some(v) = p.view else {
             return self.hold(now);
         };
-        let area_root = (self.schema.geometry().reference_area_px() / (v.area_px as f64).max(1.0)).sqrt();
+        // √(A₁/A) is the area's distance estimate.
+        let area_root = self.schema.geometry().distance_from_area(v.area_px as f64);
         let speed = if far {
             self.law.far_speed
         } else {
@@ -219,10 +220,9 @@ impl RaposaAgent {
             ServoState::S3FarEllipse => self.approach(p, true, now),
             ServoState::S6Final => {
                 let dev = p.view.map_or(0.0, |v| v.dev_px[1]);
-                let arm = self.law.arm(dev);
-                self.aux.arm = Some(arm);
+                self.aux.arm = Some(self.law.arm(dev));
                 self.aux.lights = Some(true);
-                self.enter(Phase::Final { start: now, arm }, now);
+                self.enter(Phase::Final { start: now }, now);
                 self.approach(p, false, now)
             }
             ServoState::S2Align => {
@@ -231,6 +231,16 @@ impl RaposaAgent {
                 };
                 let start = robot_in_ball_frame(&view, alpha, self.camera_x);
                 let pl = plan(start, self.gains.region2_distance_m, self.half_length);
+                tracing::debug!(
+                    target: "marsupial::behavior",
+                    now,
+                    alpha_deg = alpha.to_degrees(),
+                    beta_deg = -pl.rotation.to_degrees(),
+                    d_m = pl.distance,
+                    phi_deg = pl.final_rotation.to_degrees(),
+                    reverse = pl.reverse,
+                    "region II: rotate −β, travel d, rotate φ"
+                );
                 self.manoeuvres += 1;
                 self.settling = false;
                 self.enter(
@@ -244,7 +254,6 @@ impl RaposaAgent {
                     now,
                 );
                 self.servo = ServoState::S7Rotate;
-                let _ = odo;
                 self.turn(self.vision_turn * pl.rotation.signum(), now)
             }
             ServoState::S4BlueOnly => {
@@ -290,6 +299,7 @@ impl RaposaAgent {
                 );
                 self.back_away(p, now)
             }
+            // State 7 is entered from state 2 above, never selected.
             ServoState::S7Rotate => self.hold(now),
         }
     }
@@ -320,7 +330,7 @@ impl RaposaAgent {
         match self.phase {
             Phase::Done => self.finish(Outcome::Failed(FailureReason::Timeout), now),
             Phase::Servo => self.servo_tick(&p, odo, now),
-            Phase::Final { start, .. } => {
+            Phase::Final { start } => {
                 if now - start < self.gains.final_time_s {
                     let omega = p.view.map_or(0.0, |v| self.law.turn(v.dev_px[0]));
                     return self.drive(self.law.twist(self.gains.final_speed_mps, omega), now);
@@ -408,12 +418,11 @@ impl RaposaAgent {
                 let cmd = search.act(t - 0.5);
                 Step::running(MotorOutput::drive(cmd).with_aux(self.aux), self.feedback(now))
             }
-            Phase::BackAway { from, distance, retry } => {
+            Phase::BackAway { from, distance, .. } => {
                 let moved = (odo.x - from.x).hypot(odo.y - from.y);
                 if moved >= distance {
                     self.phase = Phase::Servo;
                     self.schema.reset();
-                    let _ = retry;
                     return self.hold(now);
                 }
                 self.back_away(&p, now)
@@ -453,11 +462,13 @@ impl RaposaAgent {
         // Turning the camera by +Δ moves the ball's bearing by −Δ.
         let step = last_bearing - v.bearing;
         let rotated = rotated + step * dir;
-        // Predict the next frame from this frame's change (the control delay), and stop
-        // before the goal or the image edge is passed.
-        let predicted_rot = rotated + step.abs().max(last_step.abs());
-        let x_next = v.dev_px[0] - (step.abs().max(last_step.abs()) * self.schema.geometry().f_px) * -dir;
-        let near_edge = x_next.abs() > self.half_width_px - self.gains.fov_margin_px && x_next * dir > 0.0;
+        // Predict the next frame from the frame-to-frame change (the control delay), and
+        // stop before the goal or the image edge is passed. Turning the camera in `dir`
+        // moves the ellipse toward the image side `dir` (+1: right).
+        let per_frame = step.abs().max(last_step.abs());
+        let predicted_rot = rotated + per_frame;
+        let x_next = v.dev_px[0] + dir * per_frame * self.schema.geometry().f_px;
+        let near_edge = x_next * dir > self.half_width_px - self.gains.fov_margin_px;
         let done = predicted_rot >= want - self.ctrl.rotation_tolerance;
         if done || near_edge {
             // Reset the odometry origin with the angle rotated by vision.
