@@ -1,34 +1,46 @@
-//! The perceptual schema allocates nothing per frame in steady state: segmentation,
-//! labelling, pairing, adaptation and the fallback chain all reuse their buffers.
+//! The perceptual schemas allocate nothing per frame in steady state: segmentation,
+//! labelling, pairing, adaptation and the fallback chain (Bujold), HSV segmentation,
+//! ellipses, blue regions, pair filters and tracking (RAPOSA) all reuse their buffers.
 //! A counting global allocator (gated to this thread) proves it.
 
 mod common;
 
-use marsupial::perception::TwoBlockSchema;
+use marsupial::perception::{PyramidSchema, RgbImage, TwoBlockSchema};
 use marsupial::profile::Profile;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::path::Path;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 struct Counting;
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+// Both the switch and the count are per thread, so tests running in parallel neither
+// count nor reset each other's allocations.
 thread_local!(static COUNTING: Cell<bool> = const { Cell::new(false) });
+thread_local!(static ALLOCS: Cell<usize> = const { Cell::new(0) });
+
+fn count() {
+    if COUNTING.with(|c| c.get()) {
+        ALLOCS.with(|a| a.set(a.get() + 1));
+    }
+}
+
+fn allocs() -> usize {
+    ALLOCS.with(|a| a.get())
+}
+
+fn reset() {
+    ALLOCS.with(|a| a.set(0));
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        if COUNTING.with(|c| c.get()) {
-            ALLOCS.fetch_add(1, Ordering::SeqCst);
-        }
+        count();
         unsafe { System.alloc(l) }
     }
     unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
         unsafe { System.dealloc(p, l) }
     }
     unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        if COUNTING.with(|c| c.get()) {
-            ALLOCS.fetch_add(1, Ordering::SeqCst);
-        }
+        count();
         unsafe { System.realloc(p, l, n) }
     }
 }
@@ -49,7 +61,7 @@ fn steady_state_schema_does_not_allocate() {
         for (k, f) in frames.iter().enumerate() {
             schema.process(&f.view(), k as f64 * 0.1).unwrap(); // warm-up
         }
-        ALLOCS.store(0, Ordering::SeqCst);
+        reset();
         COUNTING.with(|c| c.set(true));
         let mut found = 0;
         let mut t = 1.0;
@@ -67,7 +79,7 @@ fn steady_state_schema_does_not_allocate() {
             }
         }
         COUNTING.with(|c| c.set(false));
-        assert_eq!(ALLOCS.load(Ordering::SeqCst), 0, "{w}×{h}: allocations in steady state");
+        assert_eq!(allocs(), 0, "{w}×{h}: allocations in steady state");
         assert_eq!(found, 120, "{w}×{h}: every fiducial frame detected");
     }
     // Control: the counter does see allocations.
@@ -75,5 +87,61 @@ fn steady_state_schema_does_not_allocate() {
     let v: Vec<u8> = Vec::with_capacity(std::hint::black_box(64));
     COUNTING.with(|c| c.set(false));
     drop(v);
-    assert!(ALLOCS.load(Ordering::SeqCst) >= 1);
+    assert!(allocs() >= 1);
+}
+
+/// A pyramid as the back camera sees it: blue square frame, orange ball in front.
+fn pyramid_frame(w: usize, h: usize, side: usize) -> RgbImage {
+    let mut im = common::background(w, h);
+    let (x0, y0) = (w / 2 - side / 2, h / 2 - side / 2);
+    let bar = (side / 7).max(1);
+    for y in y0..y0 + side {
+        for x in x0..x0 + side {
+            if x < x0 + bar || x >= x0 + side - bar || y < y0 + bar || y >= y0 + side - bar {
+                im.put(x, y, [20, 60, 220]);
+            }
+        }
+    }
+    let r = side as f64 * 0.35;
+    let (cx, cy) = (w as f64 / 2.0, h as f64 / 2.0);
+    for y in 0..h {
+        for x in 0..w {
+            if (x as f64 + 0.5 - cx).hypot(y as f64 + 0.5 - cy) <= r {
+                im.put(x, y, [235, 120, 20]);
+            }
+        }
+    }
+    im
+}
+
+#[test]
+fn steady_state_pyramid_schema_does_not_allocate() {
+    for (w, h) in [(160, 120), (640, 480)] {
+        let mut p = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml")).unwrap();
+        p.cameras[0].width_px = w;
+        p.cameras[0].height_px = h;
+        let mut schema = PyramidSchema::from_profile(&p, 0).unwrap();
+        let frames: Vec<_> = (0..4).map(|k| pyramid_frame(w, h, h / 6 + k * h / 10)).collect();
+        let empty = common::background(w, h);
+        for f in &frames {
+            schema.process(&f.view(), 0.0).unwrap(); // warm-up
+        }
+        reset();
+        COUNTING.with(|c| c.set(true));
+        let mut pairs = 0;
+        for round in 0..10 {
+            for f in &frames {
+                pairs += schema.process(&f.view(), 0.0).unwrap().detection.pair.is_some() as usize;
+            }
+            if round % 3 == 2 {
+                // Lost for a while: the tracking ball is dropped, then re-acquired.
+                for _ in 0..10 {
+                    schema.process(&empty.view(), 0.0).unwrap();
+                }
+            }
+        }
+        COUNTING.with(|c| c.set(false));
+        assert_eq!(allocs(), 0, "{w}×{h}: allocations in steady state");
+        assert_eq!(pairs, 40, "{w}×{h}: every pyramid frame paired");
+    }
 }

@@ -81,3 +81,20 @@ fn distance_and_alpha_track_the_true_pose() {
         }
     }
 }
+
+/// The paper's dead zone (grid points 1 and 3: 0.33 m from the socket, 70° off the axis):
+/// through the 25° window only the ball is seen, the blue edges are outside, so α cannot
+/// be estimated there.
+#[test]
+fn dead_zone_shows_the_ball_but_no_pair() {
+    let p = raposa();
+    let w = world::build(&p, &[], &[]).unwrap();
+    let inset = p.body.length_m / 2.0 + p.cameras[0].mount.x_m;
+    for a in [-70.0, 70.0] {
+        let im = render(&p, &w, &pose_at(&p, 0.33 + inset, a), 3);
+        let mut s = PyramidSchema::from_profile(&p, 0).unwrap();
+        let pc = s.process(&im.view(), 0.0).unwrap();
+        assert!(pc.view.is_some(), "ball seen at {a}°");
+        assert!(pc.detection.pair.is_none(), "no pair at {a}°");
+    }
+}
