@@ -64,9 +64,19 @@ impl AngleStats {
             min_l,
         }
     }
+}
 
-    /// Blends toward `new` with rate `beta` in (0, 1] (1 replaces).
-    pub fn blend(&self, new: &AngleStats, beta: f64) -> AngleStats {
+/// Colour statistics that adaptation can move toward a new measurement. The fallback
+/// chain of [`ColorModel`] is the same whatever the colour space; only the statistics and
+/// how they become a segmentation range differ (SCT angles here, HSV in
+/// [`HsvStats`](super::HsvStats)).
+pub trait Blend: Copy {
+    /// Moves toward `new` with rate `beta` in (0, 1] (1 replaces).
+    fn blend(&self, new: &Self, beta: f64) -> Self;
+}
+
+impl Blend for AngleStats {
+    fn blend(&self, new: &AngleStats, beta: f64) -> AngleStats {
         let mix = |a: f64, b: f64| a + beta * (b - a);
         AngleStats {
             mean_a: mix(self.mean_a, new.mean_a),
@@ -75,6 +85,12 @@ impl AngleStats {
             sd_b: mix(self.sd_b, new.sd_b),
             n: new.n,
         }
+    }
+}
+
+impl<T: Blend, const N: usize> Blend for [T; N] {
+    fn blend(&self, new: &Self, beta: f64) -> Self {
+        std::array::from_fn(|i| self[i].blend(&new[i], beta))
     }
 }
 
@@ -152,16 +168,18 @@ impl fmt::Display for ColorMode {
     }
 }
 
-/// Tuning of a [`ColorModel`].
+/// Tuning of a [`ColorModel`]. `sd_floor`, `sd_ceiling` and `min_l` shape the SCT ranges
+/// of [`ColorModel::ranges`]; HSV models carry their own limits
+/// ([`HsvLimits`](super::HsvLimits)).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ColorModelParams {
     /// Range half-width in SDs (paper: 4).
     pub n_sd: f64,
-    /// Smallest SD used, rad.
+    /// Smallest SD used, rad (SCT).
     pub sd_floor: f64,
-    /// Largest SD used, rad.
+    /// Largest SD used, rad (SCT).
     pub sd_ceiling: f64,
-    /// Brightness gate, L units (0–441.7).
+    /// Brightness gate, L units (0–441.7) (SCT).
     pub min_l: f64,
     /// Seconds without detection before adapted → imprinted.
     pub timeout1: f64,
@@ -173,22 +191,24 @@ pub struct ColorModelParams {
     pub adapt_rate: f64,
 }
 
-/// The per-colour statistics with the fallback chain. Two colours: index 0 is the block
-/// on the image's left, 1 the block on its right.
+/// The per-colour statistics with the fallback chain. `S` holds every colour's
+/// statistics: by default the SCT angles of two colours (index 0 is the block on the
+/// image's left, 1 the block on its right); RAPOSA's pyramid uses `[HsvStats; 2]`
+/// (orange, blue).
 #[derive(Debug, Clone, PartialEq)]
-pub struct ColorModel {
+pub struct ColorModel<S: Blend = [AngleStats; 2]> {
     params: ColorModelParams,
-    table: [AngleStats; 2],
-    imprinted: Option<[AngleStats; 2]>,
-    adapted: Option<[AngleStats; 2]>,
+    table: S,
+    imprinted: Option<S>,
+    adapted: Option<S>,
     mode: ColorMode,
     reference_time: Option<f64>,
     switches: u32,
 }
 
-impl ColorModel {
+impl<S: Blend> ColorModel<S> {
     /// Starts on the table defaults.
-    pub fn new(table: [AngleStats; 2], params: ColorModelParams) -> Self {
+    pub fn new(table: S, params: ColorModelParams) -> Self {
         Self {
             params,
             table,
@@ -216,12 +236,12 @@ impl ColorModel {
     }
 
     /// Imprinted statistics, if any.
-    pub fn imprinted(&self) -> Option<&[AngleStats; 2]> {
+    pub fn imprinted(&self) -> Option<&S> {
         self.imprinted.as_ref()
     }
 
     /// Statistics in use.
-    pub fn current(&self) -> &[AngleStats; 2] {
+    pub fn current(&self) -> &S {
         match self.mode {
             ColorMode::Adapted => self.adapted.as_ref().unwrap_or(&self.table),
             ColorMode::Imprinted => self.imprinted.as_ref().unwrap_or(&self.table),
@@ -229,19 +249,19 @@ impl ColorModel {
         }
     }
 
-    /// Segmentation ranges for the next frame.
-    pub fn ranges(&self) -> [SctRange; 2] {
-        let p = &self.params;
-        self.current()
-            .map(|s| s.range(p.n_sd, p.sd_floor, p.sd_ceiling, p.min_l))
-    }
-
     /// Installs imprinted statistics at time `now` and switches to them.
-    pub fn imprint(&mut self, stats: [AngleStats; 2], now: f64) {
+    pub fn imprint(&mut self, stats: S, now: f64) {
         self.imprinted = Some(stats);
         self.adapted = None;
         self.reference_time = Some(now);
         self.switch(ColorMode::Imprinted, now, "imprinted");
+    }
+
+    /// Restarts the timeout clock at `now`, as if the target had just been seen: for a
+    /// robot that looked away on purpose (a blind manoeuvre is not evidence that the
+    /// statistics drifted).
+    pub fn restart_clock(&mut self, now: f64) {
+        self.reference_time = Some(now);
     }
 
     /// Switches to adaptive or static segmentation.
@@ -259,14 +279,13 @@ impl ColorModel {
 
     /// Feeds one frame's result: `measured` holds the statistics of the accepted blocks'
     /// pixels when the fiducial was found, `None` otherwise.
-    pub fn update(&mut self, now: f64, measured: Option<[AngleStats; 2]>) {
+    pub fn update(&mut self, now: f64, measured: Option<S>) {
         let reference = *self.reference_time.get_or_insert(now);
         if let Some(m) = measured {
             self.reference_time = Some(now);
             if self.params.adaptive {
                 let beta = self.params.adapt_rate;
-                let base = *self.current();
-                self.adapted = Some([base[0].blend(&m[0], beta), base[1].blend(&m[1], beta)]);
+                self.adapted = Some(self.current().blend(&m, beta));
                 self.switch(ColorMode::Adapted, now, "fiducial found");
             }
             return;
@@ -286,6 +305,15 @@ impl ColorModel {
         if self.mode == ColorMode::Imprinted && waited > self.params.timeout2 {
             self.switch(ColorMode::Table, now, "timeout 2: imprint assumed at fault");
         }
+    }
+}
+
+impl ColorModel<[AngleStats; 2]> {
+    /// SCT segmentation ranges for the next frame.
+    pub fn ranges(&self) -> [SctRange; 2] {
+        let p = &self.params;
+        self.current()
+            .map(|s| s.range(p.n_sd, p.sd_floor, p.sd_ceiling, p.min_l))
     }
 }
 

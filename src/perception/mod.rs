@@ -8,8 +8,10 @@
 //! * [`segment`]: per-colour ranges into reusable [`Mask`]s (the SCT test is trig-free).
 //! * [`components`]: 8-connected labelling with per-component moments.
 //! * [`colour_model`]: imprinting, adaptation and the fallback chain of seed 004 Fig. 5.
+//! * [`hsv_stats`]: the HSV statistics that chain uses for RAPOSA's bands.
 //! * [`two_block`]: Bujold's two-block fiducial detector and its perceptual schema.
-//! * [`pyramid`] and [`pyramid_pose`]: RAPOSA's pyramid detector, its geometry and schema.
+//! * [`pyramid`], [`pyramid_pose`] and [`pyramid_schema`]: RAPOSA's pyramid detector, its
+//!   geometry, and its schema with fixed, imprinted or adapted HSV bands.
 //! * [`overlay`]: drawing a detection over its frame.
 
 pub mod camera_model;
@@ -17,21 +19,25 @@ pub mod colour_model;
 pub mod components;
 pub mod fastmath;
 pub mod hsv;
+pub mod hsv_stats;
 pub mod image;
 pub mod overlay;
 pub mod pyramid;
 pub mod pyramid_pose;
+pub mod pyramid_schema;
 pub mod sct;
 pub mod segment;
 pub mod two_block;
 pub mod two_block_pose;
 
-pub use colour_model::{AngleStats, ColorMode, ColorModel, ColorModelParams, Imprinter, StatsAccumulator};
+pub use colour_model::{AngleStats, Blend, ColorMode, ColorModel, ColorModelParams, Imprinter, StatsAccumulator};
 pub use components::{Component, Labeler, Run};
 pub use hsv::{Hsv, HsvPlanes, hsv_from_rgb};
+pub use hsv_stats::{HsvAccumulator, HsvLimits, HsvStats};
 pub use image::{ImageError, RgbImage, RgbView};
 pub use pyramid::{BlueRegion, Ellipse, PyramidDetection, PyramidDetector, PyramidPair, PyramidShape};
-pub use pyramid_pose::{PyramidGeometry, PyramidPercept, PyramidSchema, PyramidView};
+pub use pyramid_pose::{PyramidGeometry, PyramidPercept, PyramidView};
+pub use pyramid_schema::PyramidSchema;
 pub use sct::{Sct, SctPlanes, sct_from_rgb};
 pub use segment::{ColorRange, HsvRange, Mask, SctRange, Segmenter};
 pub use two_block::{Block, Pair, PairLimits, TwoBlockDetector, TwoBlockPercept, TwoBlockSchema};

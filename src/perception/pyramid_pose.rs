@@ -1,4 +1,4 @@
-//! RAPOSA's pyramid geometry (seed 001 §II.C.2) and the pyramid perceptual schema.
+//! RAPOSA's pyramid geometry (seed 001 §II.C.2) and what the pyramid schema reports.
 //!
 //! Pin-hole relations, with f the focal length in pixels:
 //!
@@ -18,12 +18,10 @@
 //! +y. Seen from +y the blue edges (behind the ball) appear to the right of the ball, so a
 //! ball left of the blue centre means α > 0.
 
-use super::image::RgbView;
-use super::pyramid::{PyramidDetection, PyramidDetector, PyramidPair, PyramidShape};
-use super::segment::HsvRange;
-use super::{VisionError, check_same_size};
+use super::VisionError;
+use super::pyramid::{PyramidDetection, PyramidPair, PyramidShape};
 use crate::profile::Profile;
-use crate::schemas::{Inputs, Percept, PerceptualSchema};
+use crate::schemas::Percept;
 use serde::Serialize;
 
 /// The largest angle the quadratic can return, atan(2m/h), rad.
@@ -214,84 +212,6 @@ impl Percept for PyramidPercept {
     /// Found when the orange guide is seen (blue alone is not the target).
     fn found(&self) -> bool {
         self.view.is_some()
-    }
-}
-
-/// The pyramid perceptual schema: detector + geometry for one camera.
-#[derive(Debug, Clone)]
-pub struct PyramidSchema {
-    camera: usize,
-    detector: PyramidDetector,
-    geometry: PyramidGeometry,
-}
-
-impl PyramidSchema {
-    /// Builds the schema for camera `camera` of a profile with a `[fiducial.pyramid]`;
-    /// bands and filters come from `[perception.pyramid]`.
-    ///
-    /// # Errors
-    /// [`VisionError::Profile`] when the profile lacks the fiducial or the camera.
-    pub fn from_profile(profile: &Profile, camera: usize) -> Result<Self, VisionError> {
-        let geometry = PyramidGeometry::from_profile(profile, camera)?;
-        let cam = &profile.cameras[camera];
-        Ok(Self {
-            camera,
-            detector: PyramidDetector::new(
-                cam.width_px,
-                cam.height_px,
-                &profile.perception.pyramid,
-                geometry.shape(),
-            ),
-            geometry,
-        })
-    }
-
-    /// The geometry constants.
-    pub fn geometry(&self) -> &PyramidGeometry {
-        &self.geometry
-    }
-
-    /// The detector (masks, tracking state).
-    pub fn detector(&self) -> &PyramidDetector {
-        &self.detector
-    }
-
-    /// Retunes the (orange, blue) HSV bands from the next frame on.
-    pub fn set_bands(&mut self, orange: HsvRange, blue: HsvRange) {
-        self.detector.set_bands(orange, blue);
-    }
-
-    /// Processes one frame.
-    ///
-    /// # Errors
-    /// [`VisionError::SizeMismatch`] for a frame of the wrong size.
-    pub fn process(&mut self, view: &RgbView<'_>, stamp: f64) -> Result<PyramidPercept, VisionError> {
-        check_same_size(self.detector.size(), (view.width(), view.height()))?;
-        let detection = self.detector.detect(view)?;
-        Ok(PyramidPercept {
-            stamp,
-            detection,
-            view: self.geometry.view(&detection),
-            image_size: self.detector.size(),
-        })
-    }
-}
-
-impl PerceptualSchema for PyramidSchema {
-    type Percept = PyramidPercept;
-
-    fn perceive(&mut self, inputs: &Inputs<'_>) -> PyramidPercept {
-        let size = self.detector.size();
-        match inputs.camera(self.camera) {
-            Some(cam) => self
-                .process(&cam.image, cam.stamp)
-                .unwrap_or_else(|_| PyramidPercept::not_found(cam.stamp, size)),
-            None => PyramidPercept::not_found(inputs.now, size),
-        }
-    }
-
-    fn reset(&mut self) {
-        self.detector.reset_tracking();
     }
 }
 

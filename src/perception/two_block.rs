@@ -314,6 +314,8 @@ pub struct TwoBlockSchema {
     model: ColorModel,
     imprinter: Imprinter,
     imprint_frames: u32,
+    /// `fixed` segmentation: imprints are not installed.
+    fixed: bool,
     last_pair: Option<Pair>,
 }
 
@@ -362,6 +364,7 @@ impl TwoBlockSchema {
                 p.min_brightness,
             ),
             imprint_frames: p.imprint.frames,
+            fixed: p.mode == SegmentationMode::Fixed,
             last_pair: None,
         })
     }
@@ -402,9 +405,10 @@ impl TwoBlockSchema {
     }
 
     /// Installs the imprint gathered so far; false (and no change) when too few bright
-    /// pixels were sampled. Resets the imprinter for the next departure.
+    /// pixels were sampled or the segmentation mode is `fixed` (table values only).
+    /// Resets the imprinter for the next departure.
     pub fn finish_imprint(&mut self, now: f64) -> bool {
-        let done = self.imprinter.finish();
+        let done = self.imprinter.finish().filter(|_| !self.fixed);
         self.imprinter.clear();
         match done {
             Some(stats) => {

@@ -4,7 +4,8 @@ use super::pyramid_perception::{PyramidPerceptionSpec, validate_pyramid_percepti
 use crate::config::Validator;
 use serde::{Deserialize, Serialize};
 
-/// Adaptive (imprint + adapt + fallback) or static (imprint only) segmentation.
+/// Adaptive (imprint + adapt + fallback), static (imprint only) or fixed (table values
+/// only) segmentation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SegmentationMode {
@@ -12,6 +13,9 @@ pub enum SegmentationMode {
     Adaptive,
     /// Imprint, never adapt (the paper's comparison, Table II).
     Static,
+    /// The table values alone: no imprint, no adaptation (RAPOSA's operator-tuned HSV
+    /// bands, seed 001 §II.D).
+    Fixed,
 }
 
 impl SegmentationMode {
@@ -20,6 +24,7 @@ impl SegmentationMode {
         match self {
             SegmentationMode::Adaptive => "adaptive",
             SegmentationMode::Static => "static",
+            SegmentationMode::Fixed => "fixed",
         }
     }
 }

@@ -66,6 +66,23 @@ pub struct PyramidPerceptionSpec {
     /// At most this many blobs per colour are considered (the largest), bounding time in
     /// clutter.
     pub max_candidates: u32,
+    /// Imprint/adapt (`perception.mode` = "adaptive" or "static"; seed 001's future work):
+    /// [floor, ceiling] of the hue SD, degrees. Bands are mean ± `perception.n_sd`·SD.
+    pub hue_sd_deg: [f64; 2],
+    /// [floor, ceiling] of the saturation and value SDs.
+    pub sv_sd: [f64; 2],
+    /// Learned bands never admit saturation below this (greys stay out).
+    pub min_s: f64,
+    /// Learned bands never admit value below this (black stays out).
+    pub min_v: f64,
+    /// Camera-to-ball distance at which the departing robot imprints, m.
+    pub imprint_distance_m: f64,
+    /// Frames imprinted.
+    pub imprint_frames: u32,
+    /// The imprint finds the pyramid with the table bands widened by this factor (hue
+    /// half-width ×, V lower bound ÷; saturation kept); only a pair where the departure
+    /// geometry puts it is sampled.
+    pub imprint_widen: f64,
 }
 
 impl Default for PyramidPerceptionSpec {
@@ -93,6 +110,13 @@ impl Default for PyramidPerceptionSpec {
             tracking_ball_px: 20.0,
             tracking_reset_frames: 5,
             max_candidates: 16,
+            hue_sd_deg: [1.5, 12.0],
+            sv_sd: [0.02, 0.12],
+            min_s: 0.2,
+            min_v: 0.06,
+            imprint_distance_m: 0.6,
+            imprint_frames: 5,
+            imprint_widen: 2.0,
         }
     }
 }
@@ -141,5 +165,21 @@ pub(crate) fn validate_pyramid_perception(p: &PyramidPerceptionSpec, v: &mut Val
     v.positive("perception.pyramid.tracking_ball_px", p.tracking_ball_px);
     v.require(p.max_candidates >= 1, "perception.pyramid.max_candidates", || {
         "expected a count ≥ 1".into()
+    });
+    for (name, r, hi) in [("hue_sd_deg", p.hue_sd_deg, 180.0), ("sv_sd", p.sv_sd, 1.0)] {
+        v.require(
+            r[0] > 0.0 && r[0] <= r[1] && r[1] <= hi,
+            &format!("perception.pyramid.{name}"),
+            || format!("expected [floor, ceiling] with 0 < floor ≤ ceiling ≤ {hi}, got {r:?}"),
+        );
+    }
+    v.range("perception.pyramid.min_s", p.min_s, 0.0, 1.0);
+    v.range("perception.pyramid.min_v", p.min_v, 0.0, 1.0);
+    v.positive("perception.pyramid.imprint_distance_m", p.imprint_distance_m);
+    v.require(p.imprint_frames >= 1, "perception.pyramid.imprint_frames", || {
+        "expected a count ≥ 1".into()
+    });
+    v.require(p.imprint_widen >= 1.0, "perception.pyramid.imprint_widen", || {
+        format!("expected a factor ≥ 1, got {}", p.imprint_widen)
     });
 }

@@ -209,6 +209,7 @@ mod tests {
         for m in [
             crate::profile::SegmentationMode::Adaptive,
             crate::profile::SegmentationMode::Static,
+            crate::profile::SegmentationMode::Fixed,
         ] {
             assert_eq!(serde_json::to_value(m).unwrap(), m.as_str());
         }

@@ -5,7 +5,7 @@ use super::states::{ServoState, select_state};
 use crate::behaviors::agent::{Agent, AgentStats, BuildError};
 use crate::geometry::{Pose2, Twist, wrap_angle};
 use crate::perception::{PyramidPercept, PyramidSchema};
-use crate::profile::{Profile, SevenStateGains};
+use crate::profile::{Profile, SegmentationMode, SevenStateGains};
 use crate::schemas::{
     Auxiliary, Behavior, DriveCommand, FailureReason, Feedback, Guides, Inputs, MotorOutput, Outcome, PerceptualSchema,
     PointController, SearchRotation, ServoLaw, Step,
@@ -42,6 +42,10 @@ enum Phase {
     /// Back away from the pyramid by odometry (dead-zone exit, retry after a failed
     /// final approach) to `distance` from `from`.
     BackAway { from: Pose2, distance: f64, retry: bool },
+    /// Departure: drive out of the pyramid, body forward, to `target` (odometry frame).
+    Depart { target: (f64, f64) },
+    /// Departure: stopped with the pyramid straight behind, imprinting its colours.
+    Imprint { frames: u32 },
     /// Finished.
     Done,
 }
@@ -58,6 +62,8 @@ impl Phase {
             Phase::Look { .. } => "state_2_look",
             Phase::BackAway { retry: false, .. } => "leave_dead_zone",
             Phase::BackAway { retry: true, .. } => "retreat",
+            Phase::Depart { .. } => "depart",
+            Phase::Imprint { .. } => "imprint",
             Phase::Done => "done",
         }
     }
@@ -89,6 +95,7 @@ pub struct RaposaAgent {
     settling: bool,
     aux: Auxiliary,
     manoeuvres: u32,
+    imprinted: bool,
 }
 
 impl RaposaAgent {
@@ -150,12 +157,23 @@ impl RaposaAgent {
             settling: false,
             aux: Auxiliary::default(),
             manoeuvres: 0,
+            imprinted: false,
         })
     }
 
     /// The perceptual schema (to retune its HSV bands live).
     pub fn schema_mut(&mut self) -> &mut PyramidSchema {
         &mut self.schema
+    }
+
+    /// The perceptual schema (colour model state, last detection).
+    pub fn schema(&self) -> &PyramidSchema {
+        &self.schema
+    }
+
+    /// True once a departure imprinted successfully.
+    pub fn imprinted(&self) -> bool {
+        self.imprinted
     }
 
     fn enter(&mut self, phase: Phase, now: f64) {
@@ -315,8 +333,40 @@ impl RaposaAgent {
     fn tick_inner(&mut self, inputs: &Inputs<'_>) -> Step {
         let now = inputs.now;
         self.run_start.get_or_insert(now);
-        let p = self.schema.perceive(inputs);
         let odo = inputs.odometry.map(|o| o.value.pose).unwrap_or_default();
+        match self.phase {
+            Phase::Depart { target } => {
+                return match self.ctrl.travel(&odo, target, false) {
+                    Some(t) => self.drive(t, now),
+                    None => {
+                        self.enter(Phase::Imprint { frames: 0 }, now);
+                        self.hold(now)
+                    }
+                };
+            }
+            Phase::Imprint { frames } => {
+                // The first frame after stopping may still be blurred by the motion.
+                if frames > 0
+                    && let Some(cam) = inputs.camera(0)
+                {
+                    let _ = self.schema.imprint_frame(&cam.image);
+                }
+                if frames >= self.schema.imprint_frames_wanted() {
+                    self.imprinted = self.schema.finish_imprint(now);
+                    return self.finish(Outcome::Completed, now);
+                }
+                self.phase = Phase::Imprint { frames: frames + 1 };
+                return self.hold(now);
+            }
+            _ => {}
+        }
+        // The blind part of region II looks away from the pyramid on purpose.
+        let blind = matches!(
+            self.phase,
+            Phase::RotateOdo { .. } | Phase::Travel { .. } | Phase::RotatePhi { .. }
+        );
+        self.schema.set_looking(!blind, now);
+        let p = self.schema.perceive(inputs);
         if p.view.is_some() || p.detection.blue.is_some() {
             self.unseen = 0;
         }
@@ -329,6 +379,8 @@ impl RaposaAgent {
         }
         match self.phase {
             Phase::Done => self.finish(Outcome::Failed(FailureReason::Timeout), now),
+            // Handled before perception above.
+            Phase::Depart { .. } | Phase::Imprint { .. } => self.hold(now),
             Phase::Servo => self.servo_tick(&p, odo, now),
             Phase::Final { start } => {
                 if now - start < self.gains.final_time_s {
@@ -508,8 +560,21 @@ impl Behavior for RaposaAgent {
 }
 
 impl Agent for RaposaAgent {
+    /// Departure (seed 001's robot leaves the pyramid to explore): drive straight out
+    /// until the camera is `imprint_distance_m` from the ball, stop, and imprint the
+    /// pyramid's colours. In `fixed` segmentation there is nothing to imprint and the
+    /// agent has no departure.
     fn begin_departure(&mut self) -> bool {
-        false
+        if self.schema.mode() == SegmentationMode::Fixed {
+            return false;
+        }
+        self.imprinted = false;
+        self.run_start = None;
+        // Odometry starts at the docked pose; the camera is then `socket_inset` from the
+        // ball, and the body's forward direction leads away from it.
+        let travel = (self.schema.imprint_distance() - self.socket_inset).max(0.0);
+        self.enter(Phase::Depart { target: (travel, 0.0) }, 0.0);
+        true
     }
 
     fn begin_docking(&mut self) {

@@ -1,0 +1,354 @@
+//! The pyramid perceptual schema: detector, geometry and the HSV colour model for one
+//! camera.
+//!
+//! The paper segments with HSV bands an operator tunes, and retunes live when the light
+//! changes (seed 001 §II.D); its future work is to replace that operator with the
+//! imprint/adapt method of seed 004. Both are here, chosen by `perception.mode`:
+//!
+//! * **fixed**: the profile's bands, changed only through [`PyramidSchema::set_bands`]
+//!   (the paper's method);
+//! * **static**: on departure the robot imprints the bands from the pyramid it is
+//!   leaving, and keeps them;
+//! * **adaptive**: imprint, then every frame with a pair re-measures both colours from
+//!   the accepted blobs and moves the bands toward them; the fallback chain of seed 004
+//!   Fig. 5 (adapted → imprinted → table on timeouts) recovers from drift.
+//!
+//! **Imprinting** happens where the geometry is known: the departing robot stops with the
+//! pyramid straight behind at `imprint_distance_m`. The detector runs with the table bands
+//! widened by `imprint_widen` (hue and value; saturation kept), and a pair is sampled only when its reading agrees with the
+//! known pose (|α| and bearing under 12°, ball distance within 35 %), so a wrong blob
+//! elsewhere cannot be imprinted. **Sampling** takes, for the ball, the segmented pixels
+//! inside 0.8 of the fitted ellipse (the middle, as seed 004 samples "the middle of each
+//! block"), and for the blue edges the segmented pixels of the region's box outside the
+//! ellipse. HSV statistics and bands are in [`HsvStats`].
+
+use super::colour_model::{ColorMode, ColorModel, ColorModelParams};
+use super::hsv::Hsv;
+use super::hsv_stats::{HsvAccumulator, HsvLimits, HsvStats};
+use super::image::RgbView;
+use super::pyramid::{PyramidDetector, PyramidPair};
+use super::pyramid_pose::{PyramidGeometry, PyramidPercept};
+use super::segment::{HsvRange, Mask};
+use super::{VisionError, check_same_size};
+use crate::profile::{Profile, SegmentationMode};
+use crate::schemas::{Inputs, PerceptualSchema};
+
+/// Largest |α| and |bearing| of a pair accepted for imprinting, rad (12°).
+const IMPRINT_ANGLE: f64 = 0.21;
+/// Largest relative error of the ball distance of a pair accepted for imprinting.
+const IMPRINT_DISTANCE_ERROR: f64 = 0.35;
+/// Fewest pixels per colour for statistics.
+const MIN_SAMPLES: u64 = 10;
+
+/// The pyramid perceptual schema. Allocates only in [`PyramidSchema::from_profile`].
+#[derive(Debug, Clone)]
+pub struct PyramidSchema {
+    camera: usize,
+    detector: PyramidDetector,
+    geometry: PyramidGeometry,
+    mode: SegmentationMode,
+    table: [HsvRange; 2],
+    model: ColorModel<[HsvStats; 2]>,
+    limits: HsvLimits,
+    imprint_distance: f64,
+    imprint_widen: f64,
+    imprint_frames: u32,
+    imprint_acc: [HsvAccumulator; 2],
+    imprinted_frames: u32,
+    looking: bool,
+}
+
+impl PyramidSchema {
+    /// Builds the schema for camera `camera` of a profile with a `[fiducial.pyramid]`;
+    /// bands, filters and imprint/adapt settings come from `[perception]` and
+    /// `[perception.pyramid]`.
+    ///
+    /// # Errors
+    /// [`VisionError::Profile`] when the profile lacks the fiducial or the camera.
+    pub fn from_profile(profile: &Profile, camera: usize) -> Result<Self, VisionError> {
+        let geometry = PyramidGeometry::from_profile(profile, camera)?;
+        let cam = &profile.cameras[camera];
+        let p = &profile.perception;
+        let spec = &p.pyramid;
+        let table = [spec.orange.range(), spec.blue.range()];
+        let params = ColorModelParams {
+            n_sd: p.n_sd,
+            sd_floor: p.sd_floor_deg.to_radians(),
+            sd_ceiling: p.sd_ceiling_deg.to_radians(),
+            min_l: p.min_brightness,
+            timeout1: p.timeout1_s,
+            timeout2: p.timeout2_s,
+            adaptive: p.mode == SegmentationMode::Adaptive,
+            adapt_rate: p.adapt_rate,
+        };
+        Ok(Self {
+            camera,
+            detector: PyramidDetector::new(cam.width_px, cam.height_px, spec, geometry.shape()),
+            geometry,
+            mode: p.mode,
+            table,
+            model: ColorModel::new(table.map(|b| HsvStats::from_band(&b, p.n_sd)), params),
+            limits: HsvLimits {
+                n_sd: p.n_sd,
+                hue_sd_deg: spec.hue_sd_deg,
+                sv_sd: spec.sv_sd,
+                min_s: spec.min_s,
+                min_v: spec.min_v,
+            },
+            imprint_distance: spec.imprint_distance_m,
+            imprint_widen: spec.imprint_widen,
+            imprint_frames: spec.imprint_frames,
+            imprint_acc: [HsvAccumulator::default(); 2],
+            imprinted_frames: 0,
+            looking: true,
+        })
+    }
+
+    /// The geometry constants.
+    pub fn geometry(&self) -> &PyramidGeometry {
+        &self.geometry
+    }
+
+    /// The detector (masks, tracking state).
+    pub fn detector(&self) -> &PyramidDetector {
+        &self.detector
+    }
+
+    /// The colour model (mode, imprinted and adapted statistics).
+    pub fn model(&self) -> &ColorModel<[HsvStats; 2]> {
+        &self.model
+    }
+
+    /// The segmentation mode.
+    pub fn mode(&self) -> SegmentationMode {
+        self.mode
+    }
+
+    /// The (orange, blue) bands the next frame is segmented with.
+    pub fn bands(&self) -> [HsvRange; 2] {
+        match self.model.mode() {
+            ColorMode::Table => self.table,
+            _ => self.model.current().map(|s| s.band(&self.limits)),
+        }
+    }
+
+    /// Retunes the (orange, blue) table bands from the next frame on, as the paper's
+    /// operator does; forgets any imprint and adaptation.
+    pub fn set_bands(&mut self, orange: HsvRange, blue: HsvRange) {
+        self.table = [orange, blue];
+        let n = self.limits.n_sd;
+        self.model = ColorModel::new(self.table.map(|b| HsvStats::from_band(&b, n)), *self.model.params());
+    }
+
+    /// Tells the schema whether the robot expects the pyramid in view. While it does not
+    /// (a blind manoeuvre such as RAPOSA's region-II travel), frames without the pyramid
+    /// do not count toward the fallback timeouts, and the clock restarts when looking
+    /// resumes at `now`: turning away must not discard a good imprint.
+    pub fn set_looking(&mut self, looking: bool, now: f64) {
+        if looking && !self.looking {
+            self.model.restart_clock(now);
+        }
+        self.looking = looking;
+    }
+
+    /// Camera-to-ball distance at which the departing robot should imprint, m.
+    pub fn imprint_distance(&self) -> f64 {
+        self.imprint_distance
+    }
+
+    /// Frames the profile asks to imprint on.
+    pub fn imprint_frames_wanted(&self) -> u32 {
+        self.imprint_frames
+    }
+
+    /// Samples one departure frame, taken with the pyramid straight behind at
+    /// [`imprint_distance`](Self::imprint_distance). Returns whether the frame held a pair
+    /// where the geometry says and was sampled.
+    ///
+    /// # Errors
+    /// [`VisionError::SizeMismatch`] for a frame of the wrong size.
+    pub fn imprint_frame(&mut self, view: &RgbView<'_>) -> Result<bool, VisionError> {
+        let [o, b] = self.table.map(|r| widen(&r, self.imprint_widen));
+        self.detector.set_bands(o, b);
+        let det = self.detector.detect(view);
+        self.detector.reset_tracking();
+        let det = det?;
+        let Some((pair, v)) = det.pair.zip(self.geometry.view(&det)) else {
+            return Ok(false);
+        };
+        let agrees = v.alpha.is_some_and(|a| a.abs() <= IMPRINT_ANGLE)
+            && v.bearing.abs() <= IMPRINT_ANGLE
+            && (v.ball_distance_m / self.imprint_distance - 1.0).abs() <= IMPRINT_DISTANCE_ERROR;
+        if agrees {
+            sample_pair(view, &pair, self.detector.masks(), &mut self.imprint_acc);
+            self.imprinted_frames += 1;
+        }
+        Ok(agrees)
+    }
+
+    /// Installs the imprint gathered so far and switches to it; false (and no change)
+    /// when no frame was sampled, either colour gave under 10 pixels, or the mode is
+    /// `fixed`. Resets the imprint for the next departure.
+    pub fn finish_imprint(&mut self, now: f64) -> bool {
+        let stats = match (self.imprint_acc[0].finish(), self.imprint_acc[1].finish()) {
+            (Some(o), Some(b)) if o.n >= MIN_SAMPLES && b.n >= MIN_SAMPLES && self.imprinted_frames > 0 => Some([o, b]),
+            _ => None,
+        };
+        self.imprint_acc.iter_mut().for_each(HsvAccumulator::clear);
+        self.imprinted_frames = 0;
+        match stats {
+            Some(s) if self.mode != SegmentationMode::Fixed => {
+                tracing::info!(
+                    target: "marsupial::perception",
+                    orange = ?s[0],
+                    blue = ?s[1],
+                    "pyramid colours imprinted"
+                );
+                self.model.imprint(s, now);
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// Processes one frame: segment with the current bands, detect, adapt.
+    ///
+    /// # Errors
+    /// [`VisionError::SizeMismatch`] for a frame of the wrong size.
+    pub fn process(&mut self, view: &RgbView<'_>, stamp: f64) -> Result<PyramidPercept, VisionError> {
+        check_same_size(self.detector.size(), (view.width(), view.height()))?;
+        let [o, b] = self.bands();
+        self.detector.set_bands(o, b);
+        let detection = self.detector.detect(view)?;
+        let measured = match (&detection.pair, self.mode) {
+            (Some(pair), SegmentationMode::Adaptive) => {
+                let mut acc = [HsvAccumulator::default(); 2];
+                sample_pair(view, pair, self.detector.masks(), &mut acc);
+                match (acc[0].finish(), acc[1].finish()) {
+                    (Some(o), Some(b)) if o.n >= MIN_SAMPLES && b.n >= MIN_SAMPLES => Some([o, b]),
+                    _ => None,
+                }
+            }
+            _ => None,
+        };
+        // A pair without enough pixels to measure still counts as seen for the timeouts.
+        match (measured, detection.pair.is_some()) {
+            (Some(m), _) => self.model.update(stamp, Some(m)),
+            (None, true) => {
+                let current = *self.model.current();
+                if self.mode == SegmentationMode::Adaptive {
+                    self.model.update(stamp, Some(current));
+                } else {
+                    self.model.update(stamp, None);
+                }
+            }
+            (None, false) if self.looking => self.model.update(stamp, None),
+            (None, false) => {}
+        }
+        Ok(PyramidPercept {
+            stamp,
+            detection,
+            view: self.geometry.view(&detection),
+            image_size: self.detector.size(),
+        })
+    }
+}
+
+/// `band` with its hue half-width multiplied and its V lower bound divided by `factor`
+/// (hue capped at the whole circle). Saturation is kept: it is what separates paint from
+/// a scene a coloured light tints (grey ground under dusk light and a daylight white
+/// balance reaches S ≈ 0.35 at an orange hue).
+fn widen(band: &HsvRange, factor: f64) -> HsvRange {
+    let stats = HsvStats::from_band(band, 1.0);
+    let half = f64::from(if band.h[0] <= band.h[1] {
+        band.h[1] - band.h[0]
+    } else {
+        band.h[1] + 360.0 - band.h[0]
+    }) / 2.0
+        * factor;
+    let h = if half >= 180.0 {
+        [0.0, 360.0]
+    } else {
+        [
+            (stats.mean_h_deg - half).rem_euclid(360.0),
+            (stats.mean_h_deg + half).rem_euclid(360.0),
+        ]
+    };
+    HsvRange {
+        h: h.map(|x| x as f32),
+        s: band.s,
+        v: [band.v[0] / factor as f32, band.v[1]],
+    }
+}
+
+/// Adds the pair's pixels to `acc`: (orange) segmented pixels inside 0.8 of the ellipse;
+/// (blue) segmented pixels of the blue box outside the ellipse.
+fn sample_pair(view: &RgbView<'_>, pair: &PyramidPair, masks: &[Mask; 2], acc: &mut [HsvAccumulator; 2]) {
+    let e = &pair.ellipse;
+    let (c, s) = (e.angle.cos(), e.angle.sin());
+    let inside = |x: usize, y: usize, scale: f64| {
+        let (dx, dy) = (x as f64 - e.centre[0], y as f64 - e.centre[1]);
+        let (u, v) = (dx * c + dy * s, -dx * s + dy * c);
+        let (a, b) = ((e.semi_major * scale).max(0.5), (e.semi_minor * scale).max(0.5));
+        (u / a).powi(2) + (v / b).powi(2) <= 1.0
+    };
+    let mut add = |k: usize, bbox: [u32; 4], keep: &dyn Fn(usize, usize) -> bool| {
+        for y in bbox[1] as usize..=bbox[3] as usize {
+            for x in bbox[0] as usize..=bbox[2] as usize {
+                if masks[k].get(x, y)
+                    && keep(x, y)
+                    && let Some(px) = view.get(x, y)
+                {
+                    acc[k].push(&Hsv::from_rgb(px));
+                }
+            }
+        }
+    };
+    add(0, e.bbox, &|x, y| inside(x, y, 0.8));
+    add(1, pair.blue.bbox, &|x, y| !inside(x, y, 1.0));
+}
+
+impl PerceptualSchema for PyramidSchema {
+    type Percept = PyramidPercept;
+
+    fn perceive(&mut self, inputs: &Inputs<'_>) -> PyramidPercept {
+        let size = self.detector.size();
+        match inputs.camera(self.camera) {
+            Some(cam) => self
+                .process(&cam.image, cam.stamp)
+                .unwrap_or_else(|_| PyramidPercept::not_found(cam.stamp, size)),
+            None => {
+                if self.looking {
+                    self.model.update(inputs.now, None);
+                }
+                PyramidPercept::not_found(inputs.now, size)
+            }
+        }
+    }
+
+    fn reset(&mut self) {
+        self.detector.reset_tracking();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn widen_scales_hue_and_lower_bounds() {
+        let b = HsvRange {
+            h: [200.0, 250.0],
+            s: [0.4, 1.0],
+            v: [0.12, 1.0],
+        };
+        let w = widen(&b, 2.0);
+        assert_eq!(w.h, [175.0, 275.0]);
+        assert_eq!(w.s, b.s);
+        assert!((w.v[0] - 0.06).abs() < 1e-6);
+        let red = widen(&HsvRange { h: [350.0, 30.0], ..b }, 2.0);
+        assert_eq!(red.h, [330.0, 50.0]);
+        assert_eq!(widen(&b, 10.0).h, [0.0, 360.0]);
+        assert_eq!(widen(&b, 1.0), b);
+    }
+}
