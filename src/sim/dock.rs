@@ -93,9 +93,13 @@ pub fn judge(
 fn judge_open(g: &DockGeometry, to: &Pose2, length: f64, width: f64) -> Contact {
     let (lx, ly) = to.to_local(0.0, 0.0);
     let rear = -length / 2.0;
-    // The target meets the socket's mouth (its front reaches the rear plane).
-    if lx >= rear - 0.05 && lx <= rear + g.depth && ly.abs() <= g.entrance_half {
-        let heading = crate::geometry::wrap_angle(to.theta);
+    let heading = crate::geometry::wrap_angle(to.theta);
+    // The target meets the socket's mouth: its front (radius `front` ahead of its centre)
+    // reaches the rear plane. Arriving at an angle, the front corners of its footprint
+    // reach the plane earlier, by up to the mouth's half-width × |sin heading|.
+    let front = g.target_extent.map_or(0.035, |e| e[1]);
+    let reach = front + g.entrance_half * heading.sin().abs() + 0.015;
+    if lx >= rear - reach && lx <= rear + g.depth && ly.abs() <= g.entrance_half {
         return if ly.abs() <= g.tol_lateral && heading.abs() <= g.tol_heading {
             Contact::Docked
         } else {
