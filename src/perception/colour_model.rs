@@ -23,6 +23,7 @@
 use super::image::RgbView;
 use super::sct::Sct;
 use super::segment::SctRange;
+use crate::profile::{PerceptionSpec, SegmentationMode};
 use serde::Serialize;
 use std::fmt;
 
@@ -189,6 +190,23 @@ pub struct ColorModelParams {
     pub adaptive: bool,
     /// Blend rate of adaptation in (0, 1]; 1 is the paper's (replace each frame).
     pub adapt_rate: f64,
+}
+
+impl ColorModelParams {
+    /// The parameters a profile's `[perception]` table sets (adaptive only in
+    /// `adaptive` mode).
+    pub fn from_spec(p: &PerceptionSpec) -> Self {
+        Self {
+            n_sd: p.n_sd,
+            sd_floor: p.sd_floor_deg.to_radians(),
+            sd_ceiling: p.sd_ceiling_deg.to_radians(),
+            min_l: p.min_brightness,
+            timeout1: p.timeout1_s,
+            timeout2: p.timeout2_s,
+            adaptive: p.mode == SegmentationMode::Adaptive,
+            adapt_rate: p.adapt_rate,
+        }
+    }
 }
 
 /// The per-colour statistics with the fallback chain. `S` holds every colour's

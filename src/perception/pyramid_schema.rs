@@ -15,9 +15,9 @@
 //!
 //! **Imprinting** happens where the geometry is known: the departing robot stops with the
 //! pyramid straight behind at `imprint_distance_m`. The detector runs with the table bands
-//! widened by `imprint_widen` (hue and value; saturation kept), and a pair is sampled only when its reading agrees with the
-//! known pose (|α| and bearing under 12°, ball distance within 35 %), so a wrong blob
-//! elsewhere cannot be imprinted. **Sampling** takes, for the ball, the segmented pixels
+//! widened by `imprint_widen` (hue and value; saturation kept), and a pair is sampled only
+//! when its reading agrees with the known pose (|α| and bearing under 12°, ball distance
+//! within 35 %), so a wrong blob elsewhere cannot be imprinted. **Sampling** takes, for the ball, the segmented pixels
 //! inside 0.8 of the fitted ellipse (the middle, as seed 004 samples "the middle of each
 //! block"), and for the blue edges the segmented pixels of the region's box outside the
 //! ellipse. HSV statistics and bands are in [`HsvStats`].
@@ -71,16 +71,7 @@ impl PyramidSchema {
         let p = &profile.perception;
         let spec = &p.pyramid;
         let table = [spec.orange.range(), spec.blue.range()];
-        let params = ColorModelParams {
-            n_sd: p.n_sd,
-            sd_floor: p.sd_floor_deg.to_radians(),
-            sd_ceiling: p.sd_ceiling_deg.to_radians(),
-            min_l: p.min_brightness,
-            timeout1: p.timeout1_s,
-            timeout2: p.timeout2_s,
-            adaptive: p.mode == SegmentationMode::Adaptive,
-            adapt_rate: p.adapt_rate,
-        };
+        let params = ColorModelParams::from_spec(p);
         Ok(Self {
             camera,
             detector: PyramidDetector::new(cam.width_px, cam.height_px, spec, geometry.shape()),

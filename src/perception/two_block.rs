@@ -344,16 +344,7 @@ impl TwoBlockSchema {
             AngleStats::nominal(img_left.rgb(), table_sd),
             AngleStats::nominal(img_right.rgb(), table_sd),
         ];
-        let params = ColorModelParams {
-            n_sd: p.n_sd,
-            sd_floor: p.sd_floor_deg.to_radians(),
-            sd_ceiling: p.sd_ceiling_deg.to_radians(),
-            min_l: p.min_brightness,
-            timeout1: p.timeout1_s,
-            timeout2: p.timeout2_s,
-            adaptive: p.mode == SegmentationMode::Adaptive,
-            adapt_rate: p.adapt_rate,
-        };
+        let params = ColorModelParams::from_spec(p);
         Ok(Self {
             camera,
             detector: TwoBlockDetector::new(cam.width_px, cam.height_px, PairLimits::from(p)),
