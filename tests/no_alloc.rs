@@ -1,12 +1,14 @@
 //! The perceptual schemas allocate nothing per frame in steady state: segmentation,
 //! labelling, pairing, adaptation and the fallback chain (Bujold), HSV segmentation,
 //! ellipses, blue regions, pair filters and tracking (RAPOSA) all reuse their buffers.
-//! A counting global allocator (gated to this thread) proves it.
+//! So does the per-tick camera list the simulator and the runtime build. A counting
+//! global allocator (gated to this thread) proves it.
 
 mod common;
 
 use marsupial::perception::{PyramidSchema, RgbImage, TwoBlockSchema};
-use marsupial::profile::Profile;
+use marsupial::profile::{Profile, SegmentationMode};
+use marsupial::schemas::{CameraInput, CameraInputs};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::path::Path;
@@ -116,10 +118,13 @@ fn pyramid_frame(w: usize, h: usize, side: usize) -> RgbImage {
 
 #[test]
 fn steady_state_pyramid_schema_does_not_allocate() {
-    for (w, h) in [(160, 120), (640, 480)] {
+    // Every segmentation mode: adaptive also samples each pair and moves its bands.
+    let modes = [SegmentationMode::Fixed, SegmentationMode::Static, SegmentationMode::Adaptive];
+    for ((w, h), mode) in [(160, 120), (640, 480)].into_iter().flat_map(|s| modes.map(|m| (s, m))) {
         let mut p = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml")).unwrap();
         p.cameras[0].width_px = w;
         p.cameras[0].height_px = h;
+        p.perception.mode = mode;
         let mut schema = PyramidSchema::from_profile(&p, 0).unwrap();
         let frames: Vec<_> = (0..4).map(|k| pyramid_frame(w, h, h / 6 + k * h / 10)).collect();
         let empty = common::background(w, h);
@@ -141,7 +146,26 @@ fn steady_state_pyramid_schema_does_not_allocate() {
             }
         }
         COUNTING.with(|c| c.set(false));
-        assert_eq!(allocs(), 0, "{w}×{h}: allocations in steady state");
-        assert_eq!(pairs, 40, "{w}×{h}: every pyramid frame paired");
+        assert_eq!(allocs(), 0, "{w}×{h} {mode:?}: allocations in steady state");
+        assert_eq!(pairs, 40, "{w}×{h} {mode:?}: every pyramid frame paired");
     }
+}
+
+#[test]
+fn a_ticks_camera_list_does_not_allocate() {
+    let frames: Vec<RgbImage> = (0..4).map(|_| RgbImage::new(8, 6)).collect();
+    reset();
+    COUNTING.with(|c| c.set(true));
+    let cams: CameraInputs<'_> = frames
+        .iter()
+        .map(|f| {
+            Some(CameraInput {
+                stamp: 0.0,
+                image: f.view(),
+            })
+        })
+        .collect();
+    COUNTING.with(|c| c.set(false));
+    assert_eq!(cams.len(), 4);
+    assert_eq!(allocs(), 0, "four cameras fit inline");
 }

@@ -13,7 +13,9 @@ use crate::geometry::Pose2;
 use crate::kinematics::Odometry;
 use crate::perception::RgbImage;
 use crate::robot::{HardwareError, Robot, WheelTravel};
-use crate::schemas::{CameraInput, Inputs, MotorOutput, OdometryReading, Outcome, Stamped, TetherReading};
+use crate::schemas::{
+    CameraInput, CameraInputs, Inputs, MotorOutput, OdometryReading, Outcome, Stamped, TetherReading,
+};
 use crossbeam::channel::{Receiver, Sender, TrySendError, bounded};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -345,7 +347,7 @@ pub fn run(robot: &mut Robot, lp: &mut ReactiveLoop, config: &RuntimeConfig, sto
             while let Ok(d) = dock_rx.try_recv() {
                 dock_contact = Some(d);
             }
-            let cams: Vec<Option<CameraInput<'_>>> = frames
+            let cams: CameraInputs<'_> = frames
                 .iter()
                 .map(|f| {
                     f.as_ref().map(|(stamp, im)| CameraInput {

@@ -14,6 +14,11 @@ pub struct CameraInput<'a> {
     pub image: RgbView<'a>,
 }
 
+/// The cameras of one tick, built fresh each tick (the frames they borrow change): inline
+/// up to four cameras, so building it allocates nothing for any robot this crate models
+/// (Axel's stereo pair is the most; `tests/no_alloc.rs`).
+pub type CameraInputs<'a> = smallvec::SmallVec<[Option<CameraInput<'a>>; 4]>;
+
 /// An odometry estimate: pose in the odometry frame plus the current body twist.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct OdometryReading {

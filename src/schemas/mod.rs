@@ -19,7 +19,7 @@ pub mod visual_servo;
 
 pub use behavior::{Behavior, FailureReason, Feedback, Outcome, Presence, SchemaBehavior, Status, Step};
 pub use goto_point::PointController;
-pub use inputs::{CameraInput, Inputs, OdometryReading, TetherReading};
+pub use inputs::{CameraInput, CameraInputs, Inputs, OdometryReading, TetherReading};
 pub use motor_output::{Auxiliary, DriveCommand, Guides, MotorOutput, Posture, TetherCommand};
 pub use percept::{Percept, Stamped};
 pub use potential_field::PotentialField;

@@ -21,7 +21,8 @@ use crate::perception::RgbImage;
 use crate::perception::camera_model::CameraModel;
 use crate::profile::Profile;
 use crate::schemas::{
-    Behavior, CameraInput, DriveCommand, Inputs, OdometryReading, Outcome, Posture, Stamped, TetherCommand,
+    Behavior, CameraInput, CameraInputs, DriveCommand, Inputs, OdometryReading, Outcome, Posture, Stamped,
+    TetherCommand,
 };
 
 /// How a phase of a run ended.
@@ -265,7 +266,7 @@ impl<'w> Sim<'w> {
             if let Some(h) = hook.as_mut() {
                 h(self.frame_count, self.t, &self.frames);
             }
-            let cams: Vec<Option<CameraInput<'_>>> = self
+            let cams: CameraInputs<'_> = self
                 .frames
                 .iter()
                 .map(|f| {
