@@ -119,7 +119,11 @@ fn pyramid_frame(w: usize, h: usize, side: usize) -> RgbImage {
 #[test]
 fn steady_state_pyramid_schema_does_not_allocate() {
     // Every segmentation mode: adaptive also samples each pair and moves its bands.
-    let modes = [SegmentationMode::Fixed, SegmentationMode::Static, SegmentationMode::Adaptive];
+    let modes = [
+        SegmentationMode::Fixed,
+        SegmentationMode::Static,
+        SegmentationMode::Adaptive,
+    ];
     for ((w, h), mode) in [(160, 120), (640, 480)].into_iter().flat_map(|s| modes.map(|m| (s, m))) {
         let mut p = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml")).unwrap();
         p.cameras[0].width_px = w;

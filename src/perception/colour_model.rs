@@ -222,6 +222,7 @@ pub struct ColorModel<S: Blend = [AngleStats; 2]> {
     mode: ColorMode,
     reference_time: Option<f64>,
     switches: u32,
+    looking: bool,
 }
 
 impl<S: Blend> ColorModel<S> {
@@ -235,6 +236,7 @@ impl<S: Blend> ColorModel<S> {
             mode: ColorMode::Table,
             reference_time: None,
             switches: 0,
+            looking: true,
         }
     }
 
@@ -275,11 +277,21 @@ impl<S: Blend> ColorModel<S> {
         self.switch(ColorMode::Imprinted, now, "imprinted");
     }
 
-    /// Restarts the timeout clock at `now`, as if the target had just been seen: for a
-    /// robot that looked away on purpose (a blind manoeuvre is not evidence that the
-    /// statistics drifted).
+    /// Restarts the timeout clock at `now`, as if the target had just been seen (e.g. a
+    /// detection too small to measure).
     pub fn restart_clock(&mut self, now: f64) {
         self.reference_time = Some(now);
+    }
+
+    /// Tells the model whether the robot expects the target in view. While it does not
+    /// (a blind manoeuvre such as RAPOSA's region-II travel), frames without the target
+    /// do not count toward the timeouts, and the clock restarts when looking resumes at
+    /// `now`: turning away on purpose is no evidence that the statistics drifted.
+    pub fn set_looking(&mut self, looking: bool, now: f64) {
+        if looking && !self.looking {
+            self.restart_clock(now);
+        }
+        self.looking = looking;
     }
 
     /// Switches to adaptive or static segmentation.
@@ -298,6 +310,9 @@ impl<S: Blend> ColorModel<S> {
     /// Feeds one frame's result: `measured` holds the statistics of the accepted blocks'
     /// pixels when the fiducial was found, `None` otherwise.
     pub fn update(&mut self, now: f64, measured: Option<S>) {
+        if measured.is_none() && !self.looking {
+            return;
+        }
         let reference = *self.reference_time.get_or_insert(now);
         if let Some(m) = measured {
             self.reference_time = Some(now);
@@ -514,6 +529,21 @@ mod tests {
         m.update(7.0, Some([stats(0.75), stats(0.85)]));
         assert_eq!(m.mode(), ColorMode::Adapted);
         assert_eq!(m.switches(), 5);
+    }
+
+    #[test]
+    fn looking_away_pauses_the_timeouts() {
+        let mut m = ColorModel::new(table(), params(true));
+        m.imprint([stats(0.7), stats(0.8)], 0.0);
+        m.update(1.0, Some([stats(0.71), stats(0.79)]));
+        m.set_looking(false, 1.5);
+        m.update(30.0, None);
+        assert_eq!(m.mode(), ColorMode::Adapted, "blind for 29 s: no fallback");
+        m.set_looking(true, 30.0);
+        m.update(31.9, None);
+        assert_eq!(m.mode(), ColorMode::Adapted, "the clock restarted at 30 s");
+        m.update(32.1, None);
+        assert_eq!(m.mode(), ColorMode::Imprinted);
     }
 
     #[test]

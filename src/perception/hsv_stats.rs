@@ -59,7 +59,8 @@ pub struct HsvLimits {
 /// A learned band admits value down to this fraction of its mean, whatever the SD.
 const V_DROP: f64 = 0.5;
 
-fn wrap_deg(h: f64) -> f64 {
+/// `h` wrapped into [0, 360).
+pub(crate) fn wrap_deg(h: f64) -> f64 {
     let w = h.rem_euclid(360.0);
     if w >= 360.0 { 0.0 } else { w }
 }

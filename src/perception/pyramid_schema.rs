@@ -24,7 +24,7 @@
 
 use super::colour_model::{ColorMode, ColorModel, ColorModelParams};
 use super::hsv::Hsv;
-use super::hsv_stats::{HsvAccumulator, HsvLimits, HsvStats};
+use super::hsv_stats::{HsvAccumulator, HsvLimits, HsvStats, wrap_deg};
 use super::image::RgbView;
 use super::pyramid::{PyramidDetector, PyramidPair};
 use super::pyramid_pose::{PyramidGeometry, PyramidPercept};
@@ -55,7 +55,6 @@ pub struct PyramidSchema {
     imprint_frames: u32,
     imprint_acc: [HsvAccumulator; 2],
     imprinted_frames: u32,
-    looking: bool,
 }
 
 impl PyramidSchema {
@@ -91,7 +90,6 @@ impl PyramidSchema {
             imprint_frames: spec.imprint_frames,
             imprint_acc: [HsvAccumulator::default(); 2],
             imprinted_frames: 0,
-            looking: true,
         })
     }
 
@@ -131,15 +129,10 @@ impl PyramidSchema {
         self.model = ColorModel::new(self.table.map(|b| HsvStats::from_band(&b, n)), *self.model.params());
     }
 
-    /// Tells the schema whether the robot expects the pyramid in view. While it does not
-    /// (a blind manoeuvre such as RAPOSA's region-II travel), frames without the pyramid
-    /// do not count toward the fallback timeouts, and the clock restarts when looking
-    /// resumes at `now`: turning away must not discard a good imprint.
+    /// Tells the colour model whether the robot expects the pyramid in view
+    /// ([`ColorModel::set_looking`]): turning away must not discard a good imprint.
     pub fn set_looking(&mut self, looking: bool, now: f64) {
-        if looking && !self.looking {
-            self.model.restart_clock(now);
-        }
-        self.looking = looking;
+        self.model.set_looking(looking, now);
     }
 
     /// Camera-to-ball distance at which the departing robot should imprint, m.
@@ -181,10 +174,7 @@ impl PyramidSchema {
     /// when no frame was sampled, either colour gave under 10 pixels, or the mode is
     /// `fixed`. Resets the imprint for the next departure.
     pub fn finish_imprint(&mut self, now: f64) -> bool {
-        let stats = match (self.imprint_acc[0].finish(), self.imprint_acc[1].finish()) {
-            (Some(o), Some(b)) if o.n >= MIN_SAMPLES && b.n >= MIN_SAMPLES && self.imprinted_frames > 0 => Some([o, b]),
-            _ => None,
-        };
+        let stats = finish_both(&self.imprint_acc).filter(|_| self.imprinted_frames > 0);
         self.imprint_acc.iter_mut().for_each(HsvAccumulator::clear);
         self.imprinted_frames = 0;
         match stats {
@@ -215,26 +205,15 @@ impl PyramidSchema {
             (Some(pair), SegmentationMode::Adaptive) => {
                 let mut acc = [HsvAccumulator::default(); 2];
                 sample_pair(view, pair, self.detector.masks(), &mut acc);
-                match (acc[0].finish(), acc[1].finish()) {
-                    (Some(o), Some(b)) if o.n >= MIN_SAMPLES && b.n >= MIN_SAMPLES => Some([o, b]),
-                    _ => None,
-                }
+                finish_both(&acc)
             }
             _ => None,
         };
-        // A pair without enough pixels to measure still counts as seen for the timeouts.
-        match (measured, detection.pair.is_some()) {
-            (Some(m), _) => self.model.update(stamp, Some(m)),
-            (None, true) => {
-                let current = *self.model.current();
-                if self.mode == SegmentationMode::Adaptive {
-                    self.model.update(stamp, Some(current));
-                } else {
-                    self.model.update(stamp, None);
-                }
-            }
-            (None, false) if self.looking => self.model.update(stamp, None),
-            (None, false) => {}
+        match (&detection.pair, measured) {
+            (_, Some(m)) => self.model.update(stamp, Some(m)),
+            // A pair too small to measure still counts as seen for the timeouts.
+            (Some(_), None) => self.model.restart_clock(stamp),
+            (None, _) => self.model.update(stamp, None),
         }
         Ok(PyramidPercept {
             stamp,
@@ -245,25 +224,24 @@ impl PyramidSchema {
     }
 }
 
+/// Both colours' statistics, when each has at least [`MIN_SAMPLES`] pixels.
+fn finish_both(acc: &[HsvAccumulator; 2]) -> Option<[HsvStats; 2]> {
+    let [o, b] = [acc[0].finish()?, acc[1].finish()?];
+    (o.n >= MIN_SAMPLES && b.n >= MIN_SAMPLES).then_some([o, b])
+}
+
 /// `band` with its hue half-width multiplied and its V lower bound divided by `factor`
 /// (hue capped at the whole circle). Saturation is kept: it is what separates paint from
 /// a scene a coloured light tints (grey ground under dusk light and a daylight white
 /// balance reaches S ≈ 0.35 at an orange hue).
 fn widen(band: &HsvRange, factor: f64) -> HsvRange {
-    let stats = HsvStats::from_band(band, 1.0);
-    let half = f64::from(if band.h[0] <= band.h[1] {
-        band.h[1] - band.h[0]
-    } else {
-        band.h[1] + 360.0 - band.h[0]
-    }) / 2.0
-        * factor;
+    // With one SD per half-width, the statistics' hue SD is the band's half-width.
+    let hue = HsvStats::from_band(band, 1.0);
+    let half = hue.sd_h_deg * factor;
     let h = if half >= 180.0 {
         [0.0, 360.0]
     } else {
-        [
-            (stats.mean_h_deg - half).rem_euclid(360.0),
-            (stats.mean_h_deg + half).rem_euclid(360.0),
-        ]
+        [wrap_deg(hue.mean_h_deg - half), wrap_deg(hue.mean_h_deg + half)]
     };
     HsvRange {
         h: h.map(|x| x as f32),
@@ -309,9 +287,7 @@ impl PerceptualSchema for PyramidSchema {
                 .process(&cam.image, cam.stamp)
                 .unwrap_or_else(|_| PyramidPercept::not_found(cam.stamp, size)),
             None => {
-                if self.looking {
-                    self.model.update(inputs.now, None);
-                }
+                self.model.update(inputs.now, None);
                 PyramidPercept::not_found(inputs.now, size)
             }
         }
