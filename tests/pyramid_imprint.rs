@@ -1,8 +1,9 @@
 //! Imprinting and adapting RAPOSA's HSV bands on rendered frames: a ball repainted red is
 //! invisible to the operator's orange bands, and imprinting at the departure pose learns
 //! it under lab and dusk light; imprinting refuses a pyramid that is not where the
-//! departure geometry puts it; `fixed` segmentation never imprints; adaptation keeps the
-//! pair through a light change.
+//! departure geometry puts it; `fixed` segmentation never imprints; adaptation narrows
+//! the bands, keeps the pair from other poses and falls back to the table when the
+//! pyramid is gone; a failed departure imprint is recorded as failed.
 
 use marsupial::geometry::Pose2;
 use marsupial::perception::camera_model::CameraModel;
@@ -150,4 +151,27 @@ fn adaptation_follows_the_target_and_falls_back_when_lost() {
     }
     assert_eq!(s.model().mode(), ColorMode::Table);
     assert_eq!(s.bands(), table);
+}
+
+#[test]
+fn a_failed_imprint_is_recorded_as_failed() {
+    use marsupial::sim::campaign::{self, CampaignOptions};
+    use marsupial::sim::scenario::Scenario;
+    // The pyramid hidden from the departure pose (bands that match nothing): the run
+    // record must say the imprint failed, not that the departure completed.
+    let dir = std::env::temp_dir().join(format!("marsupial-imprint-fail-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut profile =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml")).unwrap();
+    profile = profile.replace(
+        "orange = { h_deg = [8.0, 45.0], s = [0.45, 1.0], v = [0.25, 1.0] }",
+        "orange = { h_deg = [100.0, 110.0], s = [0.95, 1.0], v = [0.9, 1.0] }",
+    );
+    std::fs::write(dir.join("p.toml"), profile).unwrap();
+    let sc = "name = \"f\"\ndescription = \"f\"\nprofile = \"p.toml\"\nseed = 1\ntrials = 1\ntimeout_s = 5\n[starts]\npoints = [{ distance_m = 1.0, angle_deg = 0.0 }]\n[axes]\nsegmentation = [\"static\"]\n";
+    std::fs::write(dir.join("s.toml"), sc).unwrap();
+    let p = campaign::prepare(Scenario::load(&dir.join("s.toml")).unwrap()).unwrap();
+    let (runs, _) = campaign::run_campaign(&p, &marsupial::behaviors::agent_for, &CampaignOptions::default()).unwrap();
+    assert_eq!(runs.len(), 1);
+    assert_eq!(runs[0].imprinted, Some(false));
 }

@@ -353,7 +353,13 @@ impl RaposaAgent {
                 }
                 if frames >= self.schema.imprint_frames_wanted() {
                     self.imprinted = self.schema.finish_imprint(now);
-                    return self.finish(Outcome::Completed, now);
+                    // As Bujold's departure: a failed imprint ends the departure failed.
+                    let outcome = if self.imprinted {
+                        Outcome::Completed
+                    } else {
+                        Outcome::Failed(FailureReason::TargetNeverDetected)
+                    };
+                    return self.finish(outcome, now);
                 }
                 self.phase = Phase::Imprint { frames: frames + 1 };
                 return self.hold(now);
