@@ -170,11 +170,15 @@ pub fn run_one(
         sim.set_lighting(dep_light.0, dep_light.1);
         let inside = Pose2::new(-p.world.dock.depth + profile.body.length_m / 2.0, 0.0, 0.0);
         let open = p.world.dock.open;
-        // An open dock (a target on the ground) is left from just outside the socket's
+        // An open dock (a target on the ground) is left from 1 cm outside the socket's
         // mouth zone, where the dock judge would count the robot as docked again.
         sim.place(
             if open {
-                Pose2::new(profile.body.length_m / 2.0 + 0.06, 0.0, 0.0)
+                Pose2::new(
+                    profile.body.length_m / 2.0 + p.world.dock.mouth_reach(0.0) + 0.01,
+                    0.0,
+                    0.0,
+                )
             } else {
                 inside
             },

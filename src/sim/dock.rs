@@ -94,12 +94,8 @@ fn judge_open(g: &DockGeometry, to: &Pose2, length: f64, width: f64) -> Contact 
     let (lx, ly) = to.to_local(0.0, 0.0);
     let rear = -length / 2.0;
     let heading = crate::geometry::wrap_angle(to.theta);
-    // The target meets the socket's mouth: its front (radius `front` ahead of its centre)
-    // reaches the rear plane. Arriving at an angle, the front corners of its footprint
-    // reach the plane earlier, by up to the mouth's half-width × |sin heading|.
-    let front = g.target_extent.map_or(0.035, |e| e[1]);
-    let reach = front + g.entrance_half * heading.sin().abs() + 0.015;
-    if lx >= rear - reach && lx <= rear + g.depth && ly.abs() <= g.entrance_half {
+    // The target meets the socket's mouth (DockGeometry::mouth_reach).
+    if lx >= rear - g.mouth_reach(heading) && lx <= rear + g.depth && ly.abs() <= g.entrance_half {
         return if ly.abs() <= g.tol_lateral && heading.abs() <= g.tol_heading {
             Contact::Docked
         } else {
@@ -255,6 +251,29 @@ mod tests {
             ),
             Contact::Free
         );
+    }
+
+    #[test]
+    fn open_dock_mouth_reaches_further_for_angled_arrivals() {
+        // The ball 6 cm behind the rear plane (rear 0.4 m behind the centre), on the axis.
+        let at = |theta: f64| {
+            let (c, s) = (theta.cos(), theta.sin());
+            judge(
+                &open(),
+                false,
+                &Pose2::default(),
+                &Pose2::new(0.46 * c, 0.46 * s, theta),
+                0.8,
+                0.4,
+                false,
+            )
+        };
+        assert!((open().mouth_reach(0.0) - 0.05).abs() < 1e-12);
+        // Aligned, the ball's front is still 2.5 cm short of the plane: free.
+        assert_eq!(at(0.0), Contact::Free);
+        // At 16° (within the 20° tolerance) the footprint's front corner reaches the plane
+        // first: that is the target meeting the mouth, so it docks, not a collision.
+        assert_eq!(at(-16f64.to_radians()), Contact::Docked);
     }
 
     #[test]

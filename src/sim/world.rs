@@ -75,6 +75,18 @@ pub struct DockGeometry {
     pub target_extent: Option<[f64; 4]>,
 }
 
+impl DockGeometry {
+    /// How far behind the robot's rear plane an open dock's target centre counts as
+    /// meeting the socket's mouth, arriving at `heading` (rad): the target's front
+    /// (radius ahead of its centre) reaches the plane, earlier by up to the mouth's
+    /// half-width × |sin heading| when the footprint's front corners arrive first, plus
+    /// 1.5 cm of contact slack.
+    pub fn mouth_reach(&self, heading: f64) -> f64 {
+        let front = self.target_extent.map_or(0.035, |e| e[1]);
+        front + self.entrance_half * heading.sin().abs() + 0.015
+    }
+}
+
 /// A built world.
 #[derive(Debug, Clone)]
 pub struct World {
