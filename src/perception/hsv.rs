@@ -127,15 +127,7 @@ mod tests {
     fn frame_error_is_bounded_over_the_cube() {
         // Quantised planes are within half a step of the exact values: 1° of hue (with
         // wrap-around), 0.5/255 of saturation and value.
-        let vals: Vec<u8> = (0..=255).step_by(7).collect();
-        let mut im = crate::perception::RgbImage::new(vals.len() * vals.len(), vals.len());
-        for (i, &r) in vals.iter().enumerate() {
-            for (j, &g) in vals.iter().enumerate() {
-                for (k, &b) in vals.iter().enumerate() {
-                    im.put(i * vals.len() + j, k, [r, g, b]);
-                }
-            }
-        }
+        let im = crate::perception::image::rgb_cube(7);
         let mut p = HsvPlanes::new(im.width(), im.height());
         hsv_from_rgb(&im.view(), &mut p).unwrap();
         for (n, px) in im.as_bytes().chunks_exact(3).enumerate() {

@@ -176,6 +176,24 @@ impl<'a> RgbView<'a> {
     }
 }
 
+/// Every RGB value on a grid of `step` per channel, for tests against per-pixel
+/// references: R and G vary along x (R slowest), B along y; n² × n pixels with
+/// n = ⌈256 / step⌉.
+#[cfg(test)]
+pub(crate) fn rgb_cube(step: usize) -> RgbImage {
+    let vals: Vec<u8> = (0..=255).step_by(step).collect();
+    let n = vals.len();
+    let mut im = RgbImage::new(n * n, n);
+    for (i, &r) in vals.iter().enumerate() {
+        for (j, &g) in vals.iter().enumerate() {
+            for (k, &b) in vals.iter().enumerate() {
+                im.put(i * n + j, k, [r, g, b]);
+            }
+        }
+    }
+    im
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -566,17 +566,8 @@ mod tests {
     #[test]
     fn segmentation_matches_the_reference_over_the_cube() {
         let spec = PyramidPerceptionSpec::default();
-        let vals: Vec<u8> = (0..=255).step_by(5).collect();
-        let n = vals.len();
-        let mut im = RgbImage::new(n * n, n);
-        for (i, &r) in vals.iter().enumerate() {
-            for (j, &g) in vals.iter().enumerate() {
-                for (k, &b) in vals.iter().enumerate() {
-                    im.put(i * n + j, k, [r, g, b]);
-                }
-            }
-        }
-        let mut d = PyramidDetector::new(n * n, n, &spec, shape());
+        let im = crate::perception::image::rgb_cube(5);
+        let mut d = PyramidDetector::new(im.width(), im.height(), &spec, shape());
         d.detect(&im.view()).unwrap();
         let [o, b] = d.masks();
         for (idx, px) in im.as_bytes().chunks_exact(3).enumerate() {

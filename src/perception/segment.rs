@@ -447,22 +447,14 @@ mod tests {
                 min_l: 1.0,
             },
         ];
-        let vals: Vec<u8> = (0..=255).step_by(3).collect();
-        let n = vals.len();
-        let mut im = RgbImage::new(n, n * n);
-        for (i, &r) in vals.iter().enumerate() {
-            for (j, &g) in vals.iter().enumerate() {
-                for (k, &b) in vals.iter().enumerate() {
-                    im.put(k, i * n + j, [r, g, b]);
-                }
-            }
-        }
+        let im = crate::perception::image::rgb_cube(3);
+        let (w, h) = (im.width(), im.height());
         let cr: Vec<ColorRange> = ranges.iter().map(|r| ColorRange::Sct(*r)).collect();
-        let mut masks: Vec<Mask> = (0..cr.len()).map(|_| Mask::new(n, n * n)).collect();
+        let mut masks: Vec<Mask> = (0..cr.len()).map(|_| Mask::new(w, h)).collect();
         Segmenter::new().segment(&im.view(), &cr, &mut masks).unwrap();
         for (range, mask) in ranges.iter().zip(&masks) {
-            for y in 0..n * n {
-                for x in 0..n {
+            for y in 0..h {
+                for x in 0..w {
                     let px = im.view().get(x, y).unwrap();
                     let exact = range.contains(px);
                     if mask.get(x, y) != exact {
@@ -540,17 +532,8 @@ mod tests {
                 v: [0.12, 1.0],
             }),
         ];
-        let vals: Vec<u8> = (0..=255).step_by(5).collect();
-        let n = vals.len();
-        let mut im = RgbImage::new(n * n, n);
-        for (i, &r) in vals.iter().enumerate() {
-            for (j, &g) in vals.iter().enumerate() {
-                for (k, &b) in vals.iter().enumerate() {
-                    im.put(i * n + j, k, [r, g, b]);
-                }
-            }
-        }
-        let mut masks: Vec<Mask> = ranges.iter().map(|_| Mask::new(n * n, n)).collect();
+        let im = crate::perception::image::rgb_cube(5);
+        let mut masks: Vec<Mask> = ranges.iter().map(|_| Mask::new(im.width(), im.height())).collect();
         Segmenter::new().segment(&im.view(), &ranges, &mut masks).unwrap();
         for (idx, px) in im.as_bytes().chunks_exact(3).enumerate() {
             let rgb = [px[0], px[1], px[2]];
