@@ -107,26 +107,17 @@ fn same_seed_same_runs_jsonl_whatever_the_job_count_and_resume_works() {
     let p = prepared(body);
     let out1 = std::env::temp_dir().join(format!("marsupial-sim-out1-{}", std::process::id()));
     let out2 = std::env::temp_dir().join(format!("marsupial-sim-out2-{}", std::process::id()));
-    campaign::run_campaign(
-        &p,
-        &factory,
-        &CampaignOptions {
-            out: Some(out1.clone()),
-            jobs: 1,
+    let run = |out: &PathBuf, jobs: usize, resume: bool| {
+        let opts = CampaignOptions {
+            out: Some(out.clone()),
+            jobs,
+            resume,
             ..Default::default()
-        },
-    )
-    .unwrap();
-    campaign::run_campaign(
-        &p,
-        &factory,
-        &CampaignOptions {
-            out: Some(out2.clone()),
-            jobs: 2,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+        };
+        campaign::run_campaign(&p, &factory, &opts).unwrap();
+    };
+    run(&out1, 1, false);
+    run(&out2, 2, false);
     let a = std::fs::read_to_string(out1.join("runs.jsonl")).unwrap();
     let b = std::fs::read_to_string(out2.join("runs.jsonl")).unwrap();
     assert_eq!(a.lines().count(), 8);
@@ -138,17 +129,7 @@ fn same_seed_same_runs_jsonl_whatever_the_job_count_and_resume_works() {
         format!("{}\n{}\n{}\n{{\"index\":3,", lines[0], lines[1], lines[2]),
     )
     .unwrap();
-    campaign::run_campaign(
-        &p,
-        &factory,
-        &CampaignOptions {
-            out: Some(out2.clone()),
-            jobs: 2,
-            resume: true,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    run(&out2, 2, true);
     assert_eq!(std::fs::read_to_string(out2.join("runs.jsonl")).unwrap(), a);
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out2.join("summary.json")).unwrap()).unwrap();
