@@ -124,6 +124,13 @@ fn bench_pyramid(c: &mut Criterion, w: usize, h: usize) {
     g.bench_function("whole_schema", |b| {
         b.iter(|| black_box(schema.process(black_box(&view), 0.0).expect("frame")))
     });
+    // Adaptive mode also samples the pair's pixels and moves the bands every frame.
+    let mut adaptive_profile = p.clone();
+    adaptive_profile.perception.mode = marsupial::profile::SegmentationMode::Adaptive;
+    let mut adaptive = PyramidSchema::from_profile(&adaptive_profile, 0).expect("schema");
+    g.bench_function("whole_schema_adaptive", |b| {
+        b.iter(|| black_box(adaptive.process(black_box(&view), 0.0).expect("frame")))
+    });
     let bands = schema.detector().bands();
     let cr = [ColorRange::Hsv(bands[0]), ColorRange::Hsv(bands[1])];
     let mut seg = Segmenter::new();
