@@ -79,6 +79,12 @@ const CASES: &[(&str, &str, Option<usize>, &str)] = &[
         Some(23),
         "needs `hfov_deg` or an `intrinsics` table",
     ),
+    (
+        "chroma_gate_too_wide.toml",
+        "perception.min_chroma_deg",
+        Some(71),
+        "expected a number in [0, 30], got 45",
+    ),
     ("empty.toml", "", None, "missing field `name`"),
 ];
 

@@ -22,7 +22,7 @@
 
 use super::image::RgbView;
 use super::sct::Sct;
-use super::segment::SctRange;
+use super::segment::{SctRange, chroma};
 use crate::profile::{PerceptionSpec, SegmentationMode};
 use serde::Serialize;
 use std::fmt;
@@ -55,14 +55,16 @@ impl AngleStats {
         }
     }
 
-    /// The segmentation range mean ± n·SD, with each SD clamped to [floor, ceiling].
-    pub fn range(&self, n_sd: f64, sd_floor: f64, sd_ceiling: f64, min_l: f64) -> SctRange {
-        let sa = self.sd_a.clamp(sd_floor, sd_ceiling) * n_sd;
-        let sb = self.sd_b.clamp(sd_floor, sd_ceiling) * n_sd;
+    /// The segmentation range mean ± `p.n_sd`·SD, with each SD clamped to
+    /// [`p.sd_floor`, `p.sd_ceiling`], and the brightness and chroma gates of `p`.
+    pub fn range(&self, p: &ColorModelParams) -> SctRange {
+        let sa = self.sd_a.clamp(p.sd_floor, p.sd_ceiling) * p.n_sd;
+        let sb = self.sd_b.clamp(p.sd_floor, p.sd_ceiling) * p.n_sd;
         SctRange {
             a: [self.mean_a - sa, self.mean_a + sa],
             b: [self.mean_b - sb, self.mean_b + sb],
-            min_l,
+            min_l: p.min_l,
+            min_chroma: p.min_chroma,
         }
     }
 }
@@ -169,7 +171,7 @@ impl fmt::Display for ColorMode {
     }
 }
 
-/// Tuning of a [`ColorModel`]. `sd_floor`, `sd_ceiling` and `min_l` shape the SCT ranges
+/// Tuning of a [`ColorModel`]. `sd_floor`, `sd_ceiling`, `min_l` and `min_chroma` shape the SCT ranges
 /// of [`ColorModel::ranges`]; HSV models carry their own limits
 /// ([`HsvLimits`](super::HsvLimits)).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -182,6 +184,9 @@ pub struct ColorModelParams {
     pub sd_ceiling: f64,
     /// Brightness gate, L units (0–441.7) (SCT).
     pub min_l: f64,
+    /// Chroma gate, rad: pixels nearer the grey axis are never classified (SCT; see
+    /// [`SctRange::min_chroma`]).
+    pub min_chroma: f64,
     /// Seconds without detection before adapted → imprinted.
     pub timeout1: f64,
     /// Seconds without detection before imprinted → table.
@@ -201,6 +206,7 @@ impl ColorModelParams {
             sd_floor: p.sd_floor_deg.to_radians(),
             sd_ceiling: p.sd_ceiling_deg.to_radians(),
             min_l: p.min_brightness,
+            min_chroma: p.min_chroma_deg.to_radians(),
             timeout1: p.timeout1_s,
             timeout2: p.timeout2_s,
             adaptive: p.mode == SegmentationMode::Adaptive,
@@ -345,8 +351,7 @@ impl ColorModel<[AngleStats; 2]> {
     /// SCT segmentation ranges for the next frame.
     pub fn ranges(&self) -> [SctRange; 2] {
         let p = &self.params;
-        self.current()
-            .map(|s| s.range(p.n_sd, p.sd_floor, p.sd_ceiling, p.min_l))
+        self.current().map(|s| s.range(p))
     }
 }
 
@@ -357,18 +362,22 @@ pub struct Imprinter {
     rects: [[f64; 4]; 2],
     sample_frac: f64,
     min_l: f64,
+    min_chroma: f64,
     acc: [StatsAccumulator; 2],
     frames: u32,
 }
 
 impl Imprinter {
     /// `rects` are (x0, y0, x1, y1) as fractions of the image size for the left and right
-    /// block; the middle `sample_frac` of each (by side length) is sampled.
-    pub fn new(rects: [[f64; 4]; 2], sample_frac: f64, min_l: f64) -> Self {
+    /// block; the middle `sample_frac` of each (by side length) is sampled. Pixels darker
+    /// than `min_l` or within `min_chroma` (rad) of grey are skipped, as the segmenter
+    /// skips them, so a misaligned departure cannot imprint on the mother's grey body.
+    pub fn new(rects: [[f64; 4]; 2], sample_frac: f64, min_l: f64, min_chroma: f64) -> Self {
         Self {
             rects,
             sample_frac,
             min_l,
+            min_chroma,
             acc: [StatsAccumulator::default(); 2],
             frames: 0,
         }
@@ -401,7 +410,7 @@ impl Imprinter {
                 for x in x0..x1 {
                     if let Some(px) = view.get(x, y) {
                         let s = Sct::from_rgb(px);
-                        if s.l >= self.min_l {
+                        if s.l >= self.min_l && chroma(px) >= self.min_chroma {
                             self.acc[i].push(s.a, s.b);
                         }
                     }
@@ -451,6 +460,7 @@ mod tests {
             sd_floor: 0.01,
             sd_ceiling: 0.2,
             min_l: 20.0,
+            min_chroma: 0.05,
             timeout1: 2.0,
             timeout2: 5.0,
             adaptive,
@@ -499,10 +509,15 @@ mod tests {
             sd_b: 5.0,
             n: 3,
         }
-        .range(4.0, 0.01, 0.1, 30.0);
+        .range(&ColorModelParams {
+            sd_ceiling: 0.1,
+            min_l: 30.0,
+            ..params(true)
+        });
         assert!((r.a[0] - 0.96).abs() < 1e-12 && (r.a[1] - 1.04).abs() < 1e-12);
         assert!((r.b[0] - 0.1).abs() < 1e-12 && (r.b[1] - 0.9).abs() < 1e-12);
         assert_eq!(r.min_l, 30.0);
+        assert_eq!(r.min_chroma, 0.05);
     }
 
     #[test]
@@ -579,7 +594,7 @@ mod tests {
             }
         }
         // Rectangles a bit larger than the blocks: sampling their middle half stays inside.
-        let mut imp = Imprinter::new([[0.15, 0.2, 0.5, 0.8], [0.5, 0.2, 0.85, 0.8]], 0.5, 20.0);
+        let mut imp = Imprinter::new([[0.15, 0.2, 0.5, 0.8], [0.5, 0.2, 0.85, 0.8]], 0.5, 20.0, 0.05);
         assert!(imp.finish().is_none());
         imp.add_frame(&im.view());
         imp.add_frame(&im.view());

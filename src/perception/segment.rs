@@ -35,6 +35,11 @@ pub struct SctRange {
     /// Smallest L (0–441.7) a pixel needs to be classified at all (dark pixels carry no
     /// usable chromaticity). Values below 1 are treated as 1, so black never matches.
     pub min_l: f64,
+    /// Smallest chroma a pixel needs: the angle between its colour vector and the grey
+    /// axis r = g = b, radians (0 disables). B is undefined on the grey axis and swings
+    /// by several degrees with one level of noise near it, so a range stretched toward a
+    /// washed-out colour would otherwise swallow grey walls, floor and sky.
+    pub min_chroma: f64,
 }
 
 /// A box in HSV space. Hue in degrees; `h[0] > h[1]` wraps through 0 (e.g. [340, 20] for
@@ -62,8 +67,24 @@ impl SctRange {
     /// Reference classification with `f64` trigonometry (slow; for tests and tools).
     pub fn contains(&self, rgb: [u8; 3]) -> bool {
         let s = Sct::from_rgb(rgb);
-        s.l >= self.min_l.max(1.0) && s.a >= self.a[0] && s.a <= self.a[1] && s.b >= self.b[0] && s.b <= self.b[1]
+        s.l >= self.min_l.max(1.0)
+            && s.a >= self.a[0]
+            && s.a <= self.a[1]
+            && s.b >= self.b[0]
+            && s.b <= self.b[1]
+            && chroma(rgb) >= self.min_chroma
     }
+}
+
+/// Angle between an RGB colour vector and the grey axis r = g = b, radians (0 for grey
+/// and black, at most acos(1/√3) ≈ 54.7° for a primary).
+pub fn chroma(rgb: [u8; 3]) -> f64 {
+    let [r, g, b] = rgb.map(f64::from);
+    let l = (r * r + g * g + b * b).sqrt();
+    if l == 0.0 {
+        return 0.0;
+    }
+    ((r + g + b) / (3f64.sqrt() * l)).clamp(-1.0, 1.0).acos()
 }
 
 impl HsvRange {
@@ -191,6 +212,9 @@ struct SctThresholds {
     rg2_min: [u32; 256],
     /// Largest r² + g² passing A ≤ a₁, per b.
     rg2_max: [u32; 256],
+    /// Chroma ≥ c₀ ⇔ (r + g + b)² ≤ k·(r² + g² + b²) with k = 3·cos² c₀ (k = 3 passes
+    /// everything, by Cauchy–Schwarz).
+    chroma_k: f64,
 }
 
 impl SctThresholds {
@@ -202,6 +226,11 @@ impl SctThresholds {
             r_min: [256; 256],
             rg2_min: [u32::MAX; 256],
             rg2_max: [0; 256],
+            chroma_k: if r.min_chroma > 0.0 {
+                3.0 * r.min_chroma.min(FRAC_PI_2).cos().powi(2)
+            } else {
+                3.0
+            },
         };
         if !(a0 <= a1 && b0 <= b1) || a0 > FRAC_PI_2 || b0 > FRAC_PI_2 || a1 < 0.0 || b1 < 0.0 {
             return t; // matches nothing
@@ -375,11 +404,13 @@ impl Segmenter {
             return;
         }
         let rg2 = (r * r + g * g) as u32;
+        let sum = (r + g + b) as f64;
+        let l2 = (rg2 + (b * b) as u32) as f64;
         while bits != 0 {
             let bit = bits.trailing_zeros() as usize;
             bits &= bits - 1;
             let t = &self.thresholds[bit];
-            if rg2 >= t.rg2_min[b] && rg2 <= t.rg2_max[b] {
+            if rg2 >= t.rg2_min[b] && rg2 <= t.rg2_max[b] && sum * sum <= t.chroma_k * l2 {
                 masks[self.sct_index[bit]].data[i] = 1;
             }
         }
@@ -401,11 +432,13 @@ mod tests {
             a: [deg(35.0), deg(55.0)],
             b: [deg(75.0), deg(90.0)],
             min_l: 30.0,
+            min_chroma: 0.0,
         });
         let magenta = ColorRange::Sct(SctRange {
             a: [deg(35.0), deg(55.0)],
             b: [deg(0.0), deg(15.0)],
             min_l: 30.0,
+            min_chroma: 0.0,
         });
         let im = RgbImage::from_raw(4, 1, vec![0, 200, 210, 190, 10, 200, 5, 5, 5, 128, 128, 128]).unwrap();
         let mut masks = [Mask::new(4, 1), Mask::new(4, 1)];
@@ -425,26 +458,31 @@ mod tests {
                 a: [0.3, 1.1],
                 b: [0.2, 0.9],
                 min_l: 20.0,
+                min_chroma: 0.1,
             },
             SctRange {
                 a: [0.0, 0.7],
                 b: [0.0, 0.4],
                 min_l: 0.0,
+                min_chroma: 0.0,
             },
             SctRange {
                 a: [0.9, FRAC_PI_2],
                 b: [1.0, FRAC_PI_2],
                 min_l: 5.0,
+                min_chroma: 0.3,
             },
             SctRange {
                 a: [-1.0, 3.0],
                 b: [-1.0, 3.0],
                 min_l: 1.0,
+                min_chroma: 0.0,
             },
             SctRange {
                 a: [0.8, 0.7],
                 b: [0.0, 1.0],
                 min_l: 1.0,
+                min_chroma: 0.0,
             },
         ];
         let im = crate::perception::image::rgb_cube(3);
@@ -459,9 +497,16 @@ mod tests {
                     let exact = range.contains(px);
                     if mask.get(x, y) != exact {
                         let s = Sct::from_rgb(px);
-                        let near = [range.a[0] - s.a, range.a[1] - s.a, range.b[0] - s.b, range.b[1] - s.b]
-                            .iter()
-                            .any(|d| d.abs() < 1e-5);
+                        let c = chroma(px);
+                        let near = [
+                            range.a[0] - s.a,
+                            range.a[1] - s.a,
+                            range.b[0] - s.b,
+                            range.b[1] - s.b,
+                            range.min_chroma - c,
+                        ]
+                        .iter()
+                        .any(|d| d.abs() < 1e-5);
                         assert!(near, "{px:?} {s:?} {range:?}: fast {} exact {exact}", mask.get(x, y));
                     }
                 }
@@ -472,11 +517,37 @@ mod tests {
     }
 
     #[test]
+    fn chroma_floor_keeps_greys_out_of_a_range_stretched_toward_them() {
+        // A range wide enough to hold a washed-out cyan also holds a bluish grey; the
+        // chroma floor separates them.
+        let mut r = SctRange {
+            a: [40f64.to_radians(), 56f64.to_radians()],
+            b: [45.5f64.to_radians(), 80f64.to_radians()],
+            min_l: 30.0,
+            min_chroma: 0.0,
+        };
+        let (pale_cyan, bluish_grey) = ([138, 255, 255], [87, 90, 93]);
+        assert!(r.contains(pale_cyan) && r.contains(bluish_grey));
+        r.min_chroma = 5f64.to_radians();
+        assert!(r.contains(pale_cyan) && !r.contains(bluish_grey));
+        assert!((chroma(pale_cyan).to_degrees() - 14.3).abs() < 0.1);
+        assert_eq!(chroma([0, 0, 0]), 0.0);
+        assert!((chroma([255, 0, 0]) - (1.0 / 3f64.sqrt()).acos()).abs() < 1e-12);
+        let im = RgbImage::from_raw(2, 1, [pale_cyan, bluish_grey].concat()).unwrap();
+        let mut m = [Mask::new(2, 1)];
+        Segmenter::new()
+            .segment(&im.view(), &[ColorRange::Sct(r)], &mut m)
+            .unwrap();
+        assert_eq!(m[0].data(), &[1, 0]);
+    }
+
+    #[test]
     fn pure_blue_has_b_zero() {
         let r = SctRange {
             a: [0.0, 0.5],
             b: [0.3, 1.0],
             min_l: 1.0,
+            min_chroma: 0.0,
         };
         let im = RgbImage::from_raw(1, 1, vec![0, 0, 200]).unwrap();
         let mut m = [Mask::new(1, 1)];
@@ -525,6 +596,7 @@ mod tests {
                 a: [0.5, 1.0],
                 b: [0.0, 1.0],
                 min_l: 20.0,
+                min_chroma: 0.0,
             }),
             ColorRange::Hsv(HsvRange {
                 h: [200.0, 250.0],

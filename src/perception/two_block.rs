@@ -353,6 +353,7 @@ impl TwoBlockSchema {
                 [p.imprint.left_rect, p.imprint.right_rect],
                 p.imprint.sample_frac,
                 p.min_brightness,
+                params.min_chroma,
             ),
             imprint_frames: p.imprint.frames,
             fixed: p.mode == SegmentationMode::Fixed,
@@ -403,6 +404,17 @@ impl TwoBlockSchema {
         self.imprinter.clear();
         match done {
             Some(stats) => {
+                tracing::debug!(
+                    target: "marsupial::perception",
+                    now,
+                    left_a_deg = stats[0].mean_a.to_degrees(),
+                    left_b_deg = stats[0].mean_b.to_degrees(),
+                    left_sd_deg = stats[0].sd_a.max(stats[0].sd_b).to_degrees(),
+                    right_a_deg = stats[1].mean_a.to_degrees(),
+                    right_b_deg = stats[1].mean_b.to_degrees(),
+                    right_sd_deg = stats[1].sd_a.max(stats[1].sd_b).to_degrees(),
+                    "imprinted"
+                );
                 self.model.imprint(stats, now);
                 true
             }

@@ -57,6 +57,10 @@ pub struct PerceptionSpec {
     pub min_component_px: u32,
     /// Pixels darker than this L (0–441.7) are not classified.
     pub min_brightness: f64,
+    /// Pixels whose colour lies within this angle of the grey axis (r = g = b) are not
+    /// classified, degrees: they carry no usable hue (SCT's B is undefined on the axis).
+    /// Keeps a range that adapted toward a washed-out fiducial off grey walls and floor.
+    pub min_chroma_deg: f64,
     /// Gap allowed between the blocks, as a fraction of their mean height (allows roll).
     pub max_gap_frac: f64,
     /// Extra gap allowed in pixels (for tiny, distant blocks).
@@ -92,6 +96,7 @@ impl Default for PerceptionSpec {
             mode: SegmentationMode::Adaptive,
             min_component_px: 20,
             min_brightness: 30.0,
+            min_chroma_deg: 5.0,
             max_gap_frac: 0.5,
             gap_slack_px: 3.0,
             max_vertical_frac: 0.5,
@@ -126,6 +131,7 @@ pub(crate) fn validate_perception(p: &PerceptionSpec, v: &mut Validator<'_>) {
         "expected a count ≥ 1".into()
     });
     v.range("perception.min_brightness", p.min_brightness, 0.0, 441.0);
+    v.range("perception.min_chroma_deg", p.min_chroma_deg, 0.0, 30.0);
     v.non_negative("perception.max_gap_frac", p.max_gap_frac);
     v.non_negative("perception.gap_slack_px", p.gap_slack_px);
     v.positive("perception.max_vertical_frac", p.max_vertical_frac);

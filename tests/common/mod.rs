@@ -15,11 +15,13 @@ pub fn ranges() -> [SctRange; 2] {
             a: [d(30.0), d(60.0)],
             b: [d(70.0), d(90.0)],
             min_l: 30.0,
+            min_chroma: 0.0,
         },
         SctRange {
             a: [d(30.0), d(60.0)],
             b: [d(0.0), d(20.0)],
             min_l: 30.0,
+            min_chroma: 0.0,
         },
     ]
 }
