@@ -22,7 +22,7 @@
 
 use super::image::RgbView;
 use super::sct::Sct;
-use super::segment::{SctRange, chroma};
+use super::segment::{ChromaGate, SctRange};
 use crate::profile::{PerceptionSpec, SegmentationMode};
 use serde::Serialize;
 use std::fmt;
@@ -362,7 +362,7 @@ pub struct Imprinter {
     rects: [[f64; 4]; 2],
     sample_frac: f64,
     min_l: f64,
-    min_chroma: f64,
+    chroma: ChromaGate,
     acc: [StatsAccumulator; 2],
     frames: u32,
 }
@@ -377,7 +377,7 @@ impl Imprinter {
             rects,
             sample_frac,
             min_l,
-            min_chroma,
+            chroma: ChromaGate::new(min_chroma),
             acc: [StatsAccumulator::default(); 2],
             frames: 0,
         }
@@ -410,7 +410,7 @@ impl Imprinter {
                 for x in x0..x1 {
                     if let Some(px) = view.get(x, y) {
                         let s = Sct::from_rgb(px);
-                        if s.l >= self.min_l && chroma(px) >= self.min_chroma {
+                        if s.l >= self.min_l && self.chroma.passes_rgb(px) {
                             self.acc[i].push(s.a, s.b);
                         }
                     }
@@ -604,5 +604,19 @@ mod tests {
         assert!((s[0].mean_a - cyan.a).abs() < 1e-9 && (s[0].mean_b - cyan.b).abs() < 1e-9 && s[0].sd_a < 1e-9);
         assert!((s[1].mean_a - magenta.a).abs() < 1e-9 && (s[1].mean_b - magenta.b).abs() < 1e-9);
         assert_eq!(imp.frames(), 2);
+    }
+
+    #[test]
+    fn imprinter_skips_grey_pixels() {
+        // A misaligned departure looking at the mother's bluish-grey body imprints nothing.
+        let mut im = crate::perception::RgbImage::new(40, 20);
+        im.fill([87, 90, 93]);
+        let rects = [[0.15, 0.2, 0.5, 0.8], [0.5, 0.2, 0.85, 0.8]];
+        let mut imp = Imprinter::new(rects, 0.5, 20.0, 5f64.to_radians());
+        imp.add_frame(&im.view());
+        assert!(imp.finish().is_none());
+        let mut open = Imprinter::new(rects, 0.5, 20.0, 0.0);
+        open.add_frame(&im.view());
+        assert!(open.finish().is_some(), "without the gate the grey is imprinted");
     }
 }

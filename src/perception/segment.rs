@@ -87,6 +87,40 @@ pub fn chroma(rgb: [u8; 3]) -> f64 {
     ((r + g + b) / (3f64.sqrt() * l)).clamp(-1.0, 1.0).acos()
 }
 
+/// The chroma floor `min_chroma` (rad) as the trig-free test the segmenter and the
+/// imprinter run per pixel: chroma ≥ c₀ ⇔ (r + g + b)² ≤ k·(r² + g² + b²) with
+/// k = 3·cos² c₀. A floor ≤ 0 gives k = 3, which passes everything (Cauchy–Schwarz).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ChromaGate {
+    k: f64,
+}
+
+impl ChromaGate {
+    pub(crate) fn new(min_chroma: f64) -> Self {
+        Self {
+            k: if min_chroma > 0.0 {
+                3.0 * min_chroma.min(FRAC_PI_2).cos().powi(2)
+            } else {
+                3.0
+            },
+        }
+    }
+
+    /// True when a pixel with channel sum `sum` and squared length `l2` has enough chroma.
+    #[inline]
+    pub(crate) fn passes(&self, sum: u32, l2: u32) -> bool {
+        let s = sum as f64;
+        s * s <= self.k * l2 as f64
+    }
+
+    /// [`ChromaGate::passes`] for one pixel.
+    #[inline]
+    pub(crate) fn passes_rgb(&self, rgb: [u8; 3]) -> bool {
+        let [r, g, b] = rgb.map(u32::from);
+        self.passes(r + g + b, r * r + g * g + b * b)
+    }
+}
+
 impl HsvRange {
     /// True when the pixel falls in the box.
     #[inline]
@@ -212,9 +246,8 @@ struct SctThresholds {
     rg2_min: [u32; 256],
     /// Largest r² + g² passing A ≤ a₁, per b.
     rg2_max: [u32; 256],
-    /// Chroma ≥ c₀ ⇔ (r + g + b)² ≤ k·(r² + g² + b²) with k = 3·cos² c₀ (k = 3 passes
-    /// everything, by Cauchy–Schwarz).
-    chroma_k: f64,
+    /// The range's chroma floor.
+    chroma: ChromaGate,
 }
 
 impl SctThresholds {
@@ -226,11 +259,7 @@ impl SctThresholds {
             r_min: [256; 256],
             rg2_min: [u32::MAX; 256],
             rg2_max: [0; 256],
-            chroma_k: if r.min_chroma > 0.0 {
-                3.0 * r.min_chroma.min(FRAC_PI_2).cos().powi(2)
-            } else {
-                3.0
-            },
+            chroma: ChromaGate::new(r.min_chroma),
         };
         if !(a0 <= a1 && b0 <= b1) || a0 > FRAC_PI_2 || b0 > FRAC_PI_2 || a1 < 0.0 || b1 < 0.0 {
             return t; // matches nothing
@@ -404,13 +433,12 @@ impl Segmenter {
             return;
         }
         let rg2 = (r * r + g * g) as u32;
-        let sum = (r + g + b) as f64;
-        let l2 = (rg2 + (b * b) as u32) as f64;
+        let (sum, l2) = ((r + g + b) as u32, rg2 + (b * b) as u32);
         while bits != 0 {
             let bit = bits.trailing_zeros() as usize;
             bits &= bits - 1;
             let t = &self.thresholds[bit];
-            if rg2 >= t.rg2_min[b] && rg2 <= t.rg2_max[b] && sum * sum <= t.chroma_k * l2 {
+            if rg2 >= t.rg2_min[b] && rg2 <= t.rg2_max[b] && t.chroma.passes(sum, l2) {
                 masks[self.sct_index[bit]].data[i] = 1;
             }
         }
