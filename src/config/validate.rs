@@ -141,8 +141,37 @@ impl<'a> Validator<'a> {
         });
     }
 
+    /// `value` must lie in (0, 1] (a rate, factor or fraction where 0 would switch
+    /// the thing off).
+    pub fn fraction(&mut self, path: &str, value: f64) {
+        self.require(value > 0.0 && value <= 1.0, path, || {
+            format!("expected a number in (0, 1], got {value}")
+        });
+    }
+
     /// A count must be ≥ 1.
     pub fn nonzero(&mut self, path: &str, value: usize) {
         self.require(value >= 1, path, || format!("expected an integer ≥ 1, got {value}"));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fraction_accepts_the_half_open_unit_interval() {
+        let mut v = Validator::new("", None);
+        for ok in [1e-9, 0.5, 1.0] {
+            v.fraction("f", ok);
+        }
+        assert!(v.into_problems().is_empty());
+        let mut v = Validator::new("", None);
+        for bad in [0.0, -0.1, 1.01, f64::NAN, f64::INFINITY] {
+            v.fraction("f", bad);
+        }
+        let problems = v.into_problems();
+        assert_eq!(problems.len(), 5);
+        assert!(problems[0].message.contains("expected a number in (0, 1], got 0"));
     }
 }

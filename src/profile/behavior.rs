@@ -264,9 +264,7 @@ pub(crate) fn validate_behavior(b: &BehaviorSpec, v: &mut Validator<'_>) {
                 v.require(g.search_sweep_deg < 360.0, &n("search_sweep_deg"), || {
                     format!("expected a first sweep under 360°, got {}", g.search_sweep_deg)
                 });
-                v.require(g.lost_frames >= 1, &n("lost_frames"), || {
-                    "expected at least 1 frame".into()
-                });
+                v.nonzero(&n("lost_frames"), g.lost_frames as usize);
                 v.require(
                     g.dead_zone_exit_m > g.distance_threshold_m,
                     &n("dead_zone_exit_m"),

@@ -127,9 +127,7 @@ impl Default for ImprintSpec {
 }
 
 pub(crate) fn validate_perception(p: &PerceptionSpec, v: &mut Validator<'_>) {
-    v.require(p.min_component_px >= 1, "perception.min_component_px", || {
-        "expected a count ≥ 1".into()
-    });
+    v.nonzero("perception.min_component_px", p.min_component_px as usize);
     v.range("perception.min_brightness", p.min_brightness, 0.0, 441.0);
     v.range("perception.min_chroma_deg", p.min_chroma_deg, 0.0, 30.0);
     v.non_negative("perception.max_gap_frac", p.max_gap_frac);
@@ -148,11 +146,7 @@ pub(crate) fn validate_perception(p: &PerceptionSpec, v: &mut Validator<'_>) {
         );
     }
     v.positive("perception.table_sd_deg", p.table_sd_deg);
-    v.require(
-        p.adapt_rate > 0.0 && p.adapt_rate <= 1.0,
-        "perception.adapt_rate",
-        || format!("expected a rate in (0, 1], got {}", p.adapt_rate),
-    );
+    v.fraction("perception.adapt_rate", p.adapt_rate);
     v.positive("perception.timeout1_s", p.timeout1_s);
     v.positive("perception.timeout2_s", p.timeout2_s);
     if p.timeout1_s > 0.0 && p.timeout2_s <= p.timeout1_s {
@@ -164,9 +158,7 @@ pub(crate) fn validate_perception(p: &PerceptionSpec, v: &mut Validator<'_>) {
             ),
         );
     }
-    v.require(p.max_candidates >= 1, "perception.max_candidates", || {
-        "expected a count ≥ 1".into()
-    });
+    v.nonzero("perception.max_candidates", p.max_candidates as usize);
     for (name, r) in [("left_rect", p.imprint.left_rect), ("right_rect", p.imprint.right_rect)] {
         let path = format!("perception.imprint.{name}");
         v.require(
@@ -175,13 +167,7 @@ pub(crate) fn validate_perception(p: &PerceptionSpec, v: &mut Validator<'_>) {
             || format!("expected (x0, y0, x1, y1) fractions in [0, 1] with x0 < x1 and y0 < y1, got {r:?}"),
         );
     }
-    v.require(
-        p.imprint.sample_frac > 0.0 && p.imprint.sample_frac <= 1.0,
-        "perception.imprint.sample_frac",
-        || format!("expected a fraction in (0, 1], got {}", p.imprint.sample_frac),
-    );
-    v.require(p.imprint.frames >= 1, "perception.imprint.frames", || {
-        "expected a count ≥ 1".into()
-    });
+    v.fraction("perception.imprint.sample_frac", p.imprint.sample_frac);
+    v.nonzero("perception.imprint.frames", p.imprint.frames as usize);
     validate_pyramid_perception(&p.pyramid, v);
 }

@@ -146,14 +146,8 @@ pub(crate) fn validate_pyramid_perception(p: &PyramidPerceptionSpec, v: &mut Val
         format!("expected a ratio ≥ 1, got {}", p.max_axis_ratio)
     });
     v.range("perception.pyramid.min_fill", p.min_fill, 0.0, 1.0);
-    v.require(p.min_blue_px >= 1, "perception.pyramid.min_blue_px", || {
-        "expected at least 1 px".into()
-    });
-    v.require(
-        p.tighten > 0.0 && p.tighten <= 1.0,
-        "perception.pyramid.tighten",
-        || format!("expected a factor in (0, 1], got {}", p.tighten),
-    );
+    v.nonzero("perception.pyramid.min_blue_px", p.min_blue_px as usize);
+    v.fraction("perception.pyramid.tighten", p.tighten);
     v.positive("perception.pyramid.max_size_dev", p.max_size_dev);
     v.positive("perception.pyramid.max_vertical_dev", p.max_vertical_dev);
     v.non_negative("perception.pyramid.max_horizontal_dev", p.max_horizontal_dev);
@@ -163,9 +157,7 @@ pub(crate) fn validate_pyramid_perception(p: &PyramidPerceptionSpec, v: &mut Val
         || format!("expected 0 < lo < hi, got {:?}", p.area_ratio),
     );
     v.positive("perception.pyramid.tracking_ball_px", p.tracking_ball_px);
-    v.require(p.max_candidates >= 1, "perception.pyramid.max_candidates", || {
-        "expected a count ≥ 1".into()
-    });
+    v.nonzero("perception.pyramid.max_candidates", p.max_candidates as usize);
     for (name, r, hi) in [("hue_sd_deg", p.hue_sd_deg, 180.0), ("sv_sd", p.sv_sd, 1.0)] {
         v.require(
             r[0] > 0.0 && r[0] <= r[1] && r[1] <= hi,
@@ -176,9 +168,7 @@ pub(crate) fn validate_pyramid_perception(p: &PyramidPerceptionSpec, v: &mut Val
     v.range("perception.pyramid.min_s", p.min_s, 0.0, 1.0);
     v.range("perception.pyramid.min_v", p.min_v, 0.0, 1.0);
     v.positive("perception.pyramid.imprint_distance_m", p.imprint_distance_m);
-    v.require(p.imprint_frames >= 1, "perception.pyramid.imprint_frames", || {
-        "expected a count ≥ 1".into()
-    });
+    v.nonzero("perception.pyramid.imprint_frames", p.imprint_frames as usize);
     v.require(p.imprint_widen >= 1.0, "perception.pyramid.imprint_widen", || {
         format!("expected a factor ≥ 1, got {}", p.imprint_widen)
     });
