@@ -199,58 +199,28 @@ mod tests {
 
     #[test]
     fn open_dock_docks_aligned_and_collides_otherwise() {
-        // Rear (0.4 m behind centre) reaching the ball at the origin, aligned.
-        assert_eq!(
+        // Rear 0.4 m behind the centre of a 0.8 m robot, the ball at the origin.
+        let at = |x: f64, y: f64, theta: f64| {
             judge(
                 &open(),
                 false,
                 &Pose2::default(),
-                &Pose2::new(0.405, 0.01, 0.1),
+                &Pose2::new(x, y, theta),
                 0.8,
                 0.4,
-                false
-            ),
-            Contact::Docked
+                false,
+            )
+        };
+        assert_eq!(at(0.405, 0.01, 0.1), Contact::Docked, "reaching the ball, aligned");
+        assert!(
+            matches!(at(0.405, 0.0, 0.52), Contact::Stuck { .. }),
+            "same place, heading 30°"
         );
-        // Same place, heading 30°: stuck.
-        assert!(matches!(
-            judge(
-                &open(),
-                false,
-                &Pose2::default(),
-                &Pose2::new(0.405, 0.0, 0.52),
-                0.8,
-                0.4,
-                false
-            ),
-            Contact::Stuck { .. }
-        ));
-        // Driving over the pyramid sideways: stuck.
-        assert!(matches!(
-            judge(
-                &open(),
-                false,
-                &Pose2::default(),
-                &Pose2::new(-0.1, 0.1, 1.57),
-                0.8,
-                0.4,
-                false
-            ),
-            Contact::Stuck { .. }
-        ));
-        // Far away: free.
-        assert_eq!(
-            judge(
-                &open(),
-                false,
-                &Pose2::default(),
-                &Pose2::new(1.0, 0.0, 0.0),
-                0.8,
-                0.4,
-                false
-            ),
-            Contact::Free
+        assert!(
+            matches!(at(-0.1, 0.1, 1.57), Contact::Stuck { .. }),
+            "driving over the pyramid sideways"
         );
+        assert_eq!(at(1.0, 0.0, 0.0), Contact::Free, "far away");
     }
 
     #[test]
