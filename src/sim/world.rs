@@ -112,9 +112,18 @@ fn yaw(v: Vector3<f64>, deg: f64) -> Vector3<f64> {
     Vector3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z)
 }
 
+/// A painted surface of a named colour: the pigment's reflectance (85 % at its peak) plus a
+/// white floor of [`PAINT_FLOOR`] at every wavelength. No real paint or ink is a pure sRGB
+/// primary: the binder's surface reflects about 4 % of all light (Fresnel at n ≈ 1.5) and
+/// pigments leak a few per cent outside their band, so a cyan flap still returns some
+/// red. Without the floor a rendered cyan sits exactly on SCT's B = 90° edge when unlit by
+/// glare and jumps by 10–20° when a faint highlight adds white, which no camera sees.
 fn paint(c: NamedColor) -> [f32; 3] {
-    albedo(c.rgb(), 0.85)
+    albedo(c.rgb(), 0.85 - PAINT_FLOOR).map(|v| v + PAINT_FLOOR)
 }
+
+/// Reflectance every paint returns at every wavelength (see [`paint`]).
+const PAINT_FLOOR: f32 = 0.04;
 
 /// Builds the world for `profile` with `clutter` and optional backdrop photos.
 ///
@@ -380,6 +389,22 @@ fn add_clutter(prims: &mut Vec<Prim>, c: &ClutterSpec, profile: &Profile) {
                     Tag::Clutter,
                 ));
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paints_reflect_a_little_of_every_colour() {
+        for c in [NamedColor::Cyan, NamedColor::Magenta, NamedColor::Yellow] {
+            let a = paint(c);
+            let lo = a.iter().copied().fold(f32::MAX, f32::min);
+            let hi = a.iter().copied().fold(f32::MIN, f32::max);
+            assert!((lo - PAINT_FLOOR).abs() < 1e-6, "{c:?}: {a:?}");
+            assert!((hi - 0.85).abs() < 1e-6, "{c:?}: {a:?}");
         }
     }
 }
