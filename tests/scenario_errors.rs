@@ -92,6 +92,13 @@ fn malformed_scenarios_are_reported_precisely() {
             Some(7),
             "expected a number in [0, 1], got 2",
         ),
+        (
+            "bad_highlight_clip.toml",
+            "[starts]\ngrid = \"paper16\"\n[sensor]\nhighlight_clip_frac = 1.5\n",
+            "sensor.highlight_clip_frac",
+            Some(6),
+            "expected a number in [0, 1], got 1.5",
+        ),
     ];
     for (file, body, path, line, text) in cases {
         let (p, l, m) = problem(&write(file, body));

@@ -258,3 +258,37 @@ fn flashers_modulate_the_target_periodically() {
     let b = light.at(1.5).irradiance_at(&n, &at, Tag::Target)[0];
     assert!((a - b).abs() < 1e-4);
 }
+
+/// Fraction of pixels with any channel at 255 after `frames` frames of auto-exposure.
+fn clipped_after_settling(highlight_clip: f32) -> f64 {
+    let p = bujold();
+    let cam = &p.cameras[0];
+    // A bright patch filling about 3 % of a black view: mean metering alone would raise
+    // the exposure until the patch burns out.
+    let scene = marker_scene(Point3::new(0.0, 0.0, 0.2), 0.07);
+    let mut r = Renderer::new(CameraModel::from_spec(cam), cam.width_px, cam.height_px, 1);
+    let mut out = RgbImage::default();
+    let sensor = SensorParams {
+        read_noise: 0.0,
+        shot_noise: 0.0,
+        auto_exposure: true,
+        highlight_clip,
+        ..SensorParams::default()
+    };
+    let pose = camera_pose(&Pose2::new(0.6, 0.0, 0.0), &cam.mount);
+    for k in 0..20 {
+        r.render(&scene, &pose, &LightState::uniform(1.0), &sensor, k, &mut out);
+    }
+    let n = (out.width() * out.height()) as f64;
+    let lit = out.as_bytes().chunks_exact(3).filter(|p| p[1] > 20).count() as f64;
+    assert!(lit / n > 0.02, "the patch is in view: {lit} px");
+    out.as_bytes().chunks_exact(3).filter(|p| p.contains(&255)).count() as f64 / n
+}
+
+#[test]
+fn highlight_protection_keeps_a_bright_target_from_burning_out() {
+    let protected = clipped_after_settling(0.01);
+    let mean_metered = clipped_after_settling(1.0);
+    assert!(protected <= 0.01, "{protected}");
+    assert!(mean_metered > 0.02, "mean metering burns the patch out: {mean_metered}");
+}

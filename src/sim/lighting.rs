@@ -134,7 +134,9 @@ pub struct LightingSpec {
     /// Sun azimuth, degrees (0 = along +x, behind an approaching robot).
     #[serde(default)]
     pub sun_azimuth_deg: Option<f64>,
-    /// Specular glare strength on glossy targets.
+    /// Multiplier on the physically based highlight of glossy targets: 1 is a painted or
+    /// laminated surface (Fresnel reflectance 4 %); larger values model wet or lacquered
+    /// surfaces, 0 turns highlights off.
     #[serde(default)]
     pub glare: Option<f64>,
     /// Relative light change per hour of session time (dusk < 0, dawn > 0).
@@ -198,7 +200,7 @@ impl LightingSpec {
                 ambient: 1.0,
                 sun: 0.0,
                 sun_dir: sun_vector(70.0, 0.0),
-                glare: 0.15,
+                glare: 1.0,
                 change_per_hour: 0.0,
                 session_s: 0.0,
                 flashers: Vec::new(),
@@ -212,7 +214,7 @@ impl LightingSpec {
                 ambient: 0.35,
                 sun: 1.0,
                 sun_dir: sun_vector(65.0, 20.0),
-                glare: 1.2,
+                glare: 1.0,
                 change_per_hour: 0.0,
                 session_s: 7200.0,
                 flashers: Vec::new(),
@@ -233,7 +235,7 @@ impl LightingSpec {
                 ambient: 0.45,
                 sun: 0.6,
                 sun_dir: sun_vector(6.0, -30.0),
-                glare: 0.8,
+                glare: 1.0,
                 change_per_hour: -0.55,
                 session_s: 5400.0,
                 flashers: Vec::new(),
@@ -254,7 +256,7 @@ impl LightingSpec {
                 ambient: 0.35,
                 sun: 1.0,
                 sun_dir: sun_vector(50.0, 10.0),
-                glare: 0.8,
+                glare: 1.0,
                 change_per_hour: 0.0,
                 session_s: 7200.0,
                 flashers: Vec::new(),
@@ -271,7 +273,7 @@ impl LightingSpec {
                 ambient: 0.5,
                 sun: 0.5,
                 sun_dir: sun_vector(4.0, 160.0),
-                glare: 0.5,
+                glare: 1.0,
                 change_per_hour: 0.8,
                 session_s: 0.0,
                 flashers: Vec::new(),
@@ -568,12 +570,14 @@ impl LightState {
         self.sun_dir
     }
 
-    /// Colour of highlights.
+    /// Colour of highlights: the illuminant at the current level (the key light's own
+    /// strength is in [`glare_strength`](Self::glare_strength)).
     pub fn key_colour(&self) -> [f32; 3] {
-        [0, 1, 2].map(|c| self.illum[c] * self.level * 4.0)
+        [0, 1, 2].map(|c| self.illum[c] * self.level)
     }
 
-    /// Glare multiplier.
+    /// The key light's level times the programme's glare multiplier: the sun outdoors, and
+    /// at least 0.3 (ceiling fixtures indoors, bright overcast under cloud).
     pub fn glare_strength(&self) -> f32 {
         self.glare
     }

@@ -39,6 +39,10 @@ pub struct SensorParams {
     pub gain: f32,
     /// Per-channel white-balance multipliers (1, 1, 1 is neutral).
     pub white_balance: [f32; 3],
+    /// Highlight protection of auto-exposure: the largest fraction of pixels allowed to
+    /// clip in any channel (1 = plain mean metering, which burns out a bright target in
+    /// front of a dark body).
+    pub highlight_clip: f32,
 }
 
 impl Default for SensorParams {
@@ -51,6 +55,7 @@ impl Default for SensorParams {
             target_level: 0.18,
             gain: 1.0,
             white_balance: [1.0; 3],
+            highlight_clip: 0.01,
         }
     }
 }
@@ -103,6 +108,25 @@ pub struct Renderer {
     to_srgb: Vec<u8>,
     sd_out: Vec<i32>,
     exposure: f32,
+    /// Histogram of sampled pixels' brightest channel, by [`octave_bin`].
+    highlights: [u32; HIGHLIGHT_BINS],
+}
+
+/// Bins of the highlight histogram: sixteen per octave, from 2⁻¹² to 2⁴ of full scale.
+const HIGHLIGHT_BINS: usize = 256;
+
+/// Highlight-histogram bin of a linear level `v` > 0: the float's exponent and top four
+/// mantissa bits (sixteen equal steps per octave, none wider than 6.25 %), offset so 2⁻¹²
+/// is bin 0. No `log2` call: it runs on every sampled pixel.
+#[inline]
+fn octave_bin(v: f32) -> usize {
+    let code = (v.max(1e-30).to_bits() >> 19) as i64 - ((127 - 12) << 4);
+    code.clamp(0, HIGHLIGHT_BINS as i64 - 1) as usize
+}
+
+/// The upper edge (linear level) of highlight bin `b`.
+fn octave_bin_top(b: usize) -> f32 {
+    f32::from_bits((((b as u32) + 1 + ((127 - 12) << 4)) << 19).min(0x7f7f_ffff))
 }
 
 const LUT_BITS: usize = 12;
@@ -146,6 +170,7 @@ impl Renderer {
             to_srgb,
             sd_out: vec![0; 256],
             exposure: 1.0,
+            highlights: [0; HIGHLIGHT_BINS],
         }
     }
 
@@ -443,7 +468,8 @@ impl Renderer {
                     let h = [key[0] - r[0], key[1] - r[1], key[2] - r[2]];
                     let hl = dot(h, h).sqrt().max(1e-6);
                     let nh = (dot(n, h) / hl).max(0.0);
-                    let s = prim.gloss * light.glare_strength() * shade * nh.powi(64);
+                    let lit = dot(n, key).max(0.0);
+                    let s = prim.gloss * light.glare_strength() * shade * SPECULAR_PEAK * lit * nh.powi(SPECULAR_EXP);
                     let kc = light.key_colour();
                     for c in 0..3 {
                         col[c] += s * kc[c];
@@ -463,15 +489,33 @@ impl Renderer {
         let (w, h) = (self.width, self.height);
         out.resize(w, h);
         if sensor.auto_exposure {
-            // Mean green level, subsampled; adapt partly toward the target (camera lag).
+            // Mean green level, subsampled, and a histogram of each sample's brightest
+            // white-balanced channel: the exposure aims the mean at the target unless that
+            // would clip more than `highlight_clip` of the pixels, then it protects the
+            // highlights. It adapts partly toward the aim each frame (camera lag).
             let mut sum = 0.0f32;
-            let mut n = 0.0f32;
+            let mut n = 0u32;
+            self.highlights.fill(0);
+            let wbn = sensor.white_balance;
             for px in self.radiance.iter().step_by(7) {
                 sum += px[1];
-                n += 1.0;
+                n += 1;
+                let m = (px[0] * wbn[0]).max(px[1] * wbn[1]).max(px[2] * wbn[2]);
+                self.highlights[octave_bin(m)] += 1;
             }
-            let mean = (sum / n.max(1.0)).max(1e-4);
-            let want = sensor.target_level / mean;
+            let mean = (sum / n.max(1) as f32).max(1e-4);
+            let mut want = sensor.target_level / mean;
+            let allowed = (sensor.highlight_clip.clamp(0.0, 1.0) * n as f32) as u32;
+            if allowed < n {
+                let mut above = 0u32;
+                for b in (0..HIGHLIGHT_BINS).rev() {
+                    above += self.highlights[b];
+                    if above > allowed {
+                        want = want.min(1.0 / (octave_bin_top(b) * sensor.gain.max(1e-6)));
+                        break;
+                    }
+                }
+            }
             self.exposure *= (want / self.exposure).powf(0.5);
             self.exposure = self.exposure.clamp(1e-3, 1e3);
         } else {
@@ -523,6 +567,17 @@ impl Renderer {
         }
     }
 }
+
+/// Blinn–Phong exponent of glossy targets' highlights (a lobe about 17° wide at half
+/// height in the viewing direction).
+const SPECULAR_EXP: i32 = 64;
+
+/// Peak of the energy-normalised Blinn–Phong lobe for a dielectric surface, in the units
+/// of diffuse albedo × irradiance: Fresnel reflectance at normal incidence (F0 = 0.04 for
+/// paint, plastic or lamination, n ≈ 1.5) times the normalisation (n + 8) / 8. With a
+/// perfectly glossy surface (gloss 1) under a sun of irradiance E, the highlight's centre
+/// is 0.36·E, against 0.85·E for a white paper; a pure mirror would blind the camera.
+const SPECULAR_PEAK: f32 = 0.04 * (SPECULAR_EXP as f32 + 8.0) / 8.0;
 
 /// Ray–primitive intersection with analytic coverage: (coverage, a, b, t, n·r).
 #[inline]
@@ -625,5 +680,24 @@ fn sample(m: &Material, a: f32, b: f32, fp: f32, half: [f32; 2]) -> [f32; 3] {
             let k = 1.0 + contrast * n * fade;
             [base[0] * k, base[1] * k, base[2] * k]
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn octave_bins_bracket_their_values() {
+        for k in 0..2000 {
+            let v = 2f32.powf(-11.5 + k as f32 * 0.0075);
+            let b = octave_bin(v);
+            assert!(octave_bin_top(b) >= v, "{v}: bin {b} tops at {}", octave_bin_top(b));
+            assert!(b == 0 || octave_bin_top(b - 1) <= v, "{v}: bin {b}");
+            // Sixteen steps per octave, none wider than 6.25 %.
+            assert!(octave_bin_top(b) <= v * 1.0625 * 1.0001);
+        }
+        assert_eq!(octave_bin(0.0), 0);
+        assert_eq!(octave_bin(1e9), HIGHLIGHT_BINS - 1);
     }
 }

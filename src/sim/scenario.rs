@@ -125,6 +125,9 @@ pub struct SensorSpec {
     pub auto_exposure: bool,
     /// White balance for this illuminant (`None`: balanced for each run's illuminant).
     pub white_balance_for: Option<super::lighting::Illuminant>,
+    /// Auto-exposure's highlight protection: the largest fraction of pixels it lets clip
+    /// (0–1; 1 meters the mean alone and lets a sunlit target burn out).
+    pub highlight_clip_frac: f64,
 }
 
 impl Default for SensorSpec {
@@ -134,6 +137,7 @@ impl Default for SensorSpec {
             shot_noise: 0.35,
             auto_exposure: true,
             white_balance_for: None,
+            highlight_clip_frac: 0.01,
         }
     }
 }
@@ -333,6 +337,7 @@ impl Validate for Scenario {
         }
         v.non_negative("sensor.read_noise", self.sensor.read_noise);
         v.non_negative("sensor.shot_noise", self.sensor.shot_noise);
+        v.range("sensor.highlight_clip_frac", self.sensor.highlight_clip_frac, 0.0, 1.0);
         v.non_negative("motion.latency_s", self.motion.latency_s);
         v.positive("motion.accel_mps2", self.motion.accel_mps2);
         v.positive("motion.yaw_accel_dps2", self.motion.yaw_accel_dps2);
@@ -443,6 +448,7 @@ impl Scenario {
             shot_noise: self.sensor.shot_noise as f32,
             auto_exposure: self.sensor.auto_exposure,
             white_balance: illum.map(|c| 1.0 / c),
+            highlight_clip: self.sensor.highlight_clip_frac as f32,
             ..SensorParams::default()
         }
     }

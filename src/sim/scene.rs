@@ -108,7 +108,8 @@ pub struct Prim {
     pub shape: Shape,
     /// Appearance.
     pub material: Material,
-    /// Specular strength (0 = matte).
+    /// Fraction of the surface's Fresnel reflection that goes into a specular highlight
+    /// (0 = matte, where it is diffuse; 1 = polished or laminated).
     pub gloss: f32,
     /// Seen from both sides (otherwise only from the side the normal points to).
     pub two_sided: bool,
