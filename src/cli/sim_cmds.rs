@@ -20,6 +20,11 @@ pub struct DockOptions {
     /// Explicit start: x,y,heading (metres, metres, degrees) in the dock frame.
     #[arg(long, value_name = "X,Y,HEADING", value_parser = parse_at)]
     pub at: Option<(f64, f64, f64)>,
+    /// Run exactly run N of the scenario's campaign (the `index` field of `trials`'
+    /// runs.jsonl): same start, trial, lighting, segmentation, terrain and seeds, so a
+    /// failed campaign run can be replayed with --out and logging.
+    #[arg(long, value_name = "N", conflicts_with_all = ["start", "at", "seed"])]
+    pub index: Option<usize>,
     /// Seed (default: the scenario's).
     #[arg(long, value_name = "K")]
     pub seed: Option<u64>,
@@ -67,9 +72,15 @@ pub fn dock(opts: &DockOptions, out: &mut dyn Write) -> Result<RunRecord, SimErr
         }];
     }
     let prepared = campaign::prepare(loaded)?;
-    let spec = match &opts.start {
-        None => prepared.runs.first(),
-        Some(label) => prepared
+    let spec = match (&opts.start, opts.index) {
+        (_, Some(i)) => Some(prepared.runs.get(i).ok_or_else(|| {
+            SimError::Unsupported(format!(
+                "no run {i} in the scenario: its campaign has runs 0–{}",
+                prepared.runs.len().saturating_sub(1)
+            ))
+        })?),
+        (None, None) => prepared.runs.first(),
+        (Some(label), None) => prepared
             .runs
             .iter()
             .find(|r| &r.start.label == label || r.start.label == format!("p{label}")),

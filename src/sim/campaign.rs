@@ -119,6 +119,17 @@ pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
     Ok(Prepared { loaded, world, runs })
 }
 
+/// A frame hook that saves every `every`th frame as `DIR/{prefix}-{tick:05}-cam{i}.png`.
+fn frame_saver<'a>(dir: &'a Path, every: u32, prefix: &'a str) -> impl FnMut(u64, f64, &[RgbImage]) + 'a {
+    move |n: u64, _t: f64, fr: &[RgbImage]| {
+        if n.is_multiple_of(every as u64) {
+            for (i, f) in fr.iter().enumerate() {
+                let _ = crate::cli::image_io::save_png(&dir.join(format!("{prefix}-{n:05}-cam{i}.png")), f);
+            }
+        }
+    }
+}
+
 /// Runs one run of a prepared campaign. `frames` (folder, every N) records camera frames.
 ///
 /// # Errors
@@ -184,7 +195,13 @@ pub fn run_one(
             },
             !open,
         );
-        let end = sim.run_phase(agent.as_mut(), 90.0, None);
+        let end = match frames {
+            Some((dir, every)) if every > 0 => {
+                let mut hook = frame_saver(dir, every, "depart");
+                sim.run_phase(agent.as_mut(), 90.0, Some(&mut hook))
+            }
+            _ => sim.run_phase(agent.as_mut(), 90.0, None),
+        };
         imprinted = Some(matches!(end, PhaseEnd::Finished(Outcome::Completed)));
         let mut light = run_light;
         light.advance_session(sc.imprint.sleep_s);
@@ -199,13 +216,7 @@ pub fn run_one(
     agent.begin_docking();
     let end = match frames {
         Some((dir, every)) if every > 0 => {
-            let mut hook = |n: u64, _t: f64, fr: &[RgbImage]| {
-                if n.is_multiple_of(every as u64) {
-                    for (i, f) in fr.iter().enumerate() {
-                        let _ = crate::cli::image_io::save_png(&dir.join(format!("frame-{n:05}-cam{i}.png")), f);
-                    }
-                }
-            };
+            let mut hook = frame_saver(dir, every, "frame");
             sim.run_phase(agent.as_mut(), sc.timeout_s, Some(&mut hook))
         }
         _ => sim.run_phase(agent.as_mut(), sc.timeout_s, None),
