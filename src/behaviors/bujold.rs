@@ -102,8 +102,64 @@ pub struct BujoldAgent {
     samples_distance: f64,
     /// Low-passed viewing angle (rad): single-frame estimates are noisy at range.
     alpha_filtered: Option<f64>,
-    /// Reliable frames folded into `alpha_filtered` since the last (re)start.
-    settled: u32,
+    /// The last raw viewing angles of reliable frames, for the repositioning decision.
+    alpha_window: MedianWindow,
+}
+
+/// Reliable frames the repositioning decision looks back over (1.6 s at 10 Hz: longer
+/// than a rotating beacon's period, so a flash that brightens one block for part of a turn
+/// cannot fake an off-axis view).
+const ALPHA_WINDOW: usize = 16;
+
+/// The last [`ALPHA_WINDOW`] samples in a fixed ring, with their median: a robust
+/// summary that ignores the minority of frames a flash, a shadow edge or a glare notch
+/// biases, where a low-pass filter would follow them part of the way.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct MedianWindow {
+    values: [f64; ALPHA_WINDOW],
+    len: usize,
+    next: usize,
+}
+
+impl MedianWindow {
+    const fn new() -> Self {
+        Self {
+            values: [0.0; ALPHA_WINDOW],
+            len: 0,
+            next: 0,
+        }
+    }
+
+    fn clear(&mut self) {
+        self.len = 0;
+        self.next = 0;
+    }
+
+    fn push(&mut self, v: f64) {
+        self.values[self.next] = v;
+        self.next = (self.next + 1) % ALPHA_WINDOW;
+        self.len = (self.len + 1).min(ALPHA_WINDOW);
+    }
+
+    fn is_full(&self) -> bool {
+        self.len == ALPHA_WINDOW
+    }
+
+    /// Median of the samples held (`None` when empty); an even count averages the middle two.
+    fn median(&self) -> Option<f64> {
+        if self.len == 0 {
+            return None;
+        }
+        let mut v = self.values;
+        let v = &mut v[..self.len];
+        v.sort_by(f64::total_cmp);
+        let m = self.len / 2;
+        Some(if self.len % 2 == 1 {
+            v[m]
+        } else {
+            0.5 * (v[m - 1] + v[m])
+        })
+    }
 }
 
 /// Distance from the dock the robot drives to on departure, m.
@@ -206,7 +262,7 @@ impl BujoldAgent {
             imprinted: false,
             samples_distance: 0.0,
             alpha_filtered: None,
-            settled: 0,
+            alpha_window: MedianWindow::new(),
         })
     }
 
@@ -400,7 +456,7 @@ impl Behavior for BujoldAgent {
             };
             self.alpha_filtered = Some(a);
             if v.height_px >= RELIABLE_HEIGHT_PX {
-                self.settled += 1;
+                self.alpha_window.push(v.alpha);
             }
             // Planning (repositioning, the final decision) uses the filtered estimate;
             // steering uses it scaled by its trust.
@@ -516,17 +572,20 @@ impl Behavior for BujoldAgent {
                     self.hold(now)
                 }
                 Some(_)
-                    if self.settled >= 10
+                    if self.alpha_window.is_full()
+                        && self.retries < self.max_retries
                         && planning.is_some_and(|p| {
-                            p.height_px >= RELIABLE_HEIGHT_PX
-                                && (p.distance * p.alpha.sin()).abs() > REPOSITION_LATERAL_M
-                        })
-                        && self.retries < self.max_retries =>
+                            let a = self.alpha_window.median().unwrap_or(p.alpha);
+                            p.height_px >= RELIABLE_HEIGHT_PX && (p.distance * a.sin()).abs() > REPOSITION_LATERAL_M
+                        }) =>
                 {
-                    // Close enough to trust the viewing angle and clearly off the axis:
-                    // creeping in would only arrive misaligned.
+                    // Close enough to trust the viewing angle and clearly off the axis for
+                    // most of the last 1.6 s: creeping in would only arrive misaligned. The
+                    // plan starts from the window's median angle.
                     self.retries += 1;
-                    if let Some(p) = planning {
+                    if let Some(mut p) = planning {
+                        p.alpha = self.alpha_window.median().unwrap_or(p.alpha);
+                        p.heading = crate::geometry::wrap_angle(p.alpha - p.bearing);
                         self.reposition(&p, now, odo);
                     }
                     self.hold(now)
@@ -667,7 +726,7 @@ impl Behavior for BujoldAgent {
                         let err = crate::geometry::wrap_angle(target.theta - odo.theta);
                         if err.abs() < tol {
                             self.alpha_filtered = None;
-                            self.settled = 0;
+                            self.alpha_window.clear();
                             self.enter(Phase::Approach, now, odo);
                             self.hold(now)
                         } else {
@@ -719,7 +778,7 @@ impl Agent for BujoldAgent {
     fn begin_docking(&mut self) {
         self.run_start = None;
         self.alpha_filtered = None;
-        self.settled = 0;
+        self.alpha_window.clear();
         self.retries = 0;
         self.ever_seen = false;
         self.last_seen = None;
@@ -731,6 +790,28 @@ impl Agent for BujoldAgent {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn median_window_ignores_a_minority_of_outliers_and_forgets_the_oldest() {
+        let mut w = MedianWindow::new();
+        assert_eq!(w.median(), None);
+        w.push(3.0);
+        w.push(1.0);
+        assert_eq!(w.median(), Some(2.0));
+        // A steady 0.1 rad with a third of the frames pushed to 0.5 by a flash.
+        w.clear();
+        for k in 0..ALPHA_WINDOW {
+            w.push(if k % 3 == 0 { 0.5 } else { 0.1 });
+        }
+        assert!(w.is_full());
+        assert_eq!(w.median(), Some(0.1));
+        // A full window of new values replaces the old ones entirely.
+        for _ in 0..ALPHA_WINDOW {
+            w.push(-0.2);
+        }
+        assert_eq!(w.median(), Some(-0.2));
+        assert_eq!(w.len, ALPHA_WINDOW);
+    }
 
     fn view(alpha_deg: f64, heading_deg: f64) -> FiducialView {
         FiducialView {
