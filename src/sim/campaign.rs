@@ -18,7 +18,7 @@ use crate::behaviors::{Agent, BuildError};
 use crate::geometry::Pose2;
 use crate::perception::RgbImage;
 use crate::profile::Profile;
-use crate::schemas::Outcome;
+use crate::schemas::{Behavior, Outcome};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -119,14 +119,27 @@ pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
     Ok(Prepared { loaded, world, runs })
 }
 
-/// A frame hook that saves every `every`th frame as `DIR/{prefix}-{tick:05}-cam{i}.png`.
-fn frame_saver<'a>(dir: &'a Path, every: u32, prefix: &'a str) -> impl FnMut(u64, f64, &[RgbImage]) + 'a {
-    move |n: u64, _t: f64, fr: &[RgbImage]| {
-        if n.is_multiple_of(every as u64) {
-            for (i, f) in fr.iter().enumerate() {
-                let _ = crate::cli::image_io::save_png(&dir.join(format!("{prefix}-{n:05}-cam{i}.png")), f);
-            }
+/// Runs one phase of a run, saving every Nth frame as `DIR/{prefix}-{tick:05}-cam{i}.png`
+/// when `frames` is (DIR, N) with N > 0.
+fn run_recorded(
+    sim: &mut Sim<'_>,
+    behavior: &mut dyn Behavior,
+    max_s: f64,
+    frames: Option<(&Path, u32)>,
+    prefix: &str,
+) -> PhaseEnd {
+    match frames {
+        Some((dir, every)) if every > 0 => {
+            let mut hook = |n: u64, _t: f64, fr: &[RgbImage]| {
+                if n.is_multiple_of(every as u64) {
+                    for (i, f) in fr.iter().enumerate() {
+                        let _ = crate::cli::image_io::save_png(&dir.join(format!("{prefix}-{n:05}-cam{i}.png")), f);
+                    }
+                }
+            };
+            sim.run_phase(behavior, max_s, Some(&mut hook))
         }
+        _ => sim.run_phase(behavior, max_s, None),
     }
 }
 
@@ -195,13 +208,7 @@ pub fn run_one(
             },
             !open,
         );
-        let end = match frames {
-            Some((dir, every)) if every > 0 => {
-                let mut hook = frame_saver(dir, every, "depart");
-                sim.run_phase(agent.as_mut(), 90.0, Some(&mut hook))
-            }
-            _ => sim.run_phase(agent.as_mut(), 90.0, None),
-        };
+        let end = run_recorded(&mut sim, agent.as_mut(), 90.0, frames, "depart");
         imprinted = Some(matches!(end, PhaseEnd::Finished(Outcome::Completed)));
         let mut light = run_light;
         light.advance_session(sc.imprint.sleep_s);
@@ -214,13 +221,7 @@ pub fn run_one(
     let jt = pair.normal() * sc.starts.heading_jitter_deg.to_radians();
     sim.place(Pose2::new(s.pose.x + jx, s.pose.y + jy, s.pose.theta + jt), false);
     agent.begin_docking();
-    let end = match frames {
-        Some((dir, every)) if every > 0 => {
-            let mut hook = frame_saver(dir, every, "frame");
-            sim.run_phase(agent.as_mut(), sc.timeout_s, Some(&mut hook))
-        }
-        _ => sim.run_phase(agent.as_mut(), sc.timeout_s, None),
-    };
+    let end = run_recorded(&mut sim, agent.as_mut(), sc.timeout_s, frames, "frame");
     let success = sim.docked();
     let outcome = match end {
         PhaseEnd::Docked => "docked".to_string(),
