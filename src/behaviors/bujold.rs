@@ -325,6 +325,17 @@ impl BujoldAgent {
 
     /// Starts a repositioning to the staging point on the dock axis, from the estimated
     /// pose in the dock frame (`view`) and the current odometry pose.
+    /// The planning view with the median viewing angle of the last [`ALPHA_WINDOW`]
+    /// reliable frames, when that window is full, the blocks are tall enough to trust and
+    /// the robot is more than [`REPOSITION_LATERAL_M`] off the axis; `None` otherwise.
+    fn off_axis_view(&self, planning: &FiducialView) -> Option<FiducialView> {
+        if !self.alpha_window.is_full() || planning.height_px < RELIABLE_HEIGHT_PX {
+            return None;
+        }
+        let alpha = self.alpha_window.median()?;
+        ((planning.distance * alpha.sin()).abs() > REPOSITION_LATERAL_M).then(|| planning.with_alpha(alpha))
+    }
+
     fn reposition(&mut self, view: &FiducialView, now: f64, odo: Pose2) {
         // Robot centre in the dock frame: the camera sits `rear_behind_camera − L/2` ahead
         // of the rear; near enough to treat the camera as the centre here.
@@ -458,15 +469,10 @@ impl Behavior for BujoldAgent {
             if v.height_px >= RELIABLE_HEIGHT_PX {
                 self.alpha_window.push(v.alpha);
             }
-            // Planning (repositioning, the final decision) uses the filtered estimate;
-            // steering uses it scaled by its trust.
-            planning = Some(FiducialView {
-                alpha: a,
-                heading: crate::geometry::wrap_angle(a - v.bearing),
-                ..*v
-            });
-            v.alpha = a * trust;
-            v.heading = crate::geometry::wrap_angle(v.alpha - v.bearing);
+            // The final decision uses the filtered estimate (repositioning the median of
+            // `alpha_window`, see `off_axis_view`); steering uses it scaled by its trust.
+            planning = Some(v.with_alpha(a));
+            *v = v.with_alpha(a * trust);
         }
         if percept.found() {
             self.ever_seen = true;
@@ -498,6 +504,11 @@ impl Behavior for BujoldAgent {
             let near = matches!(self.phase, Phase::Decide | Phase::BackIn | Phase::Approach);
             return Some(self.fail(FailureReason::Timeout, now, odo, near));
         }
+        // Repositioning is decided on the median viewing angle, not the filtered one.
+        let off_axis = match (&self.phase, &planning) {
+            (Phase::Approach, Some(p)) if self.retries < self.max_retries => self.off_axis_view(p),
+            _ => None,
+        };
         let step = match self.phase {
             Phase::Idle | Phase::Done => return None,
             // ---- departure ----
@@ -566,32 +577,20 @@ impl Behavior for BujoldAgent {
                     )
                 }
             }
-            Phase::Approach => match view {
-                Some(v) if v.total_px as f64 >= self.steering.dock_total_px => {
+            Phase::Approach => match (view, off_axis) {
+                (Some(v), _) if v.total_px as f64 >= self.steering.dock_total_px => {
                     self.enter(Phase::Decide, now, odo);
                     self.hold(now)
                 }
-                Some(_)
-                    if self.alpha_window.is_full()
-                        && self.retries < self.max_retries
-                        && planning.is_some_and(|p| {
-                            let a = self.alpha_window.median().unwrap_or(p.alpha);
-                            p.height_px >= RELIABLE_HEIGHT_PX && (p.distance * a.sin()).abs() > REPOSITION_LATERAL_M
-                        }) =>
-                {
+                (Some(_), Some(off)) => {
                     // Close enough to trust the viewing angle and clearly off the axis for
-                    // most of the last 1.6 s: creeping in would only arrive misaligned. The
-                    // plan starts from the window's median angle.
+                    // most of the last 1.6 s: creeping in would only arrive misaligned.
                     self.retries += 1;
-                    if let Some(mut p) = planning {
-                        p.alpha = self.alpha_window.median().unwrap_or(p.alpha);
-                        p.heading = crate::geometry::wrap_angle(p.alpha - p.bearing);
-                        self.reposition(&p, now, odo);
-                    }
+                    self.reposition(&off, now, odo);
                     self.hold(now)
                 }
-                Some(v) => Step::running(self.approach_command(&v).with_aux(raised()), self.feedback(now)),
-                None => {
+                (Some(v), _) => Step::running(self.approach_command(&v).with_aux(raised()), self.feedback(now)),
+                (None, _) => {
                     if self.last_seen.is_none_or(|t| now - t > 1.5) {
                         self.enter(Phase::Search, now, odo);
                     }

@@ -86,6 +86,16 @@ impl FiducialView {
         )
     }
 
+    /// The same view with viewing angle `alpha` (rad) and the heading that follows from
+    /// it and the bearing: what a filter or a robust summary of α hands to the planners.
+    pub fn with_alpha(self, alpha: f64) -> Self {
+        Self {
+            alpha,
+            heading: crate::geometry::wrap_angle(alpha - self.bearing),
+            ..self
+        }
+    }
+
     /// Estimates the view from a found percept (`None` when not found or degenerate).
     pub fn from_percept(p: &TwoBlockPercept, g: &TwoBlockGeometry) -> Option<Self> {
         if !p.found || p.total_px == 0 {
