@@ -65,6 +65,17 @@ pub(crate) fn wrap_deg(h: f64) -> f64 {
     if w >= 360.0 { 0.0 } else { w }
 }
 
+/// The hue band centred on `mean` (degrees) with half-width `half`, wrapping through red;
+/// the whole circle once the half-width reaches 180°.
+pub(crate) fn hue_band(mean: f64, half: f64) -> [f32; 2] {
+    let h = if half >= 180.0 {
+        [0.0, 360.0]
+    } else {
+        [wrap_deg(mean - half), wrap_deg(mean + half)]
+    };
+    h.map(|x| x as f32)
+}
+
 /// Signed shortest hue difference `to − from`, degrees in [−180, 180).
 fn hue_diff(from: f64, to: f64) -> f64 {
     (to - from + 180.0).rem_euclid(360.0) - 180.0
@@ -98,17 +109,12 @@ impl HsvStats {
     pub fn band(&self, limits: &HsvLimits) -> HsvRange {
         let n = limits.n_sd;
         let half_h = self.sd_h_deg.clamp(limits.hue_sd_deg[0], limits.hue_sd_deg[1]) * n;
-        let h = if half_h >= 180.0 {
-            [0.0, 360.0]
-        } else {
-            [wrap_deg(self.mean_h_deg - half_h), wrap_deg(self.mean_h_deg + half_h)]
-        };
         let lower = |mean: f64, sd: f64| mean - sd.clamp(limits.sv_sd[0], limits.sv_sd[1]) * n;
         // Brightness follows the light, not the paint: a passing cloud can halve it
         // faster than auto-exposure recovers, so V admits at least half its mean.
         let v_lo = lower(self.mean_v, self.sd_v).min(self.mean_v * V_DROP);
         HsvRange {
-            h: h.map(|x| x as f32),
+            h: hue_band(self.mean_h_deg, half_h),
             s: [lower(self.mean_s, self.sd_s).clamp(limits.min_s, 1.0) as f32, 1.0],
             v: [v_lo.clamp(limits.min_v, 1.0) as f32, 1.0],
         }

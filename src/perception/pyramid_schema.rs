@@ -17,14 +17,14 @@
 //! pyramid straight behind at `imprint_distance_m`. The detector runs with the table bands
 //! widened by `imprint_widen` (hue and value; saturation kept), and a pair is sampled only
 //! when its reading agrees with the known pose (|α| and bearing under 12°, ball distance
-//! within 35 %), so a wrong blob elsewhere cannot be imprinted. **Sampling** takes, for the ball, the segmented pixels
-//! inside 0.8 of the fitted ellipse (the middle, as seed 004 samples "the middle of each
-//! block"), and for the blue edges the segmented pixels of the region's box outside the
-//! ellipse. HSV statistics and bands are in [`HsvStats`].
+//! within 35 %), so a wrong blob elsewhere cannot be imprinted. **Sampling** takes, for
+//! the ball, the segmented pixels inside 0.8 of the fitted ellipse (the middle, as seed
+//! 004 samples "the middle of each block"), and for the blue edges the segmented pixels
+//! of the region's box outside the ellipse. HSV statistics and bands are in [`HsvStats`].
 
 use super::colour_model::{ColorMode, ColorModel, ColorModelParams};
 use super::hsv::Hsv;
-use super::hsv_stats::{HsvAccumulator, HsvLimits, HsvStats, wrap_deg};
+use super::hsv_stats::{HsvAccumulator, HsvLimits, HsvStats, hue_band};
 use super::image::RgbView;
 use super::pyramid::{PyramidDetector, PyramidPair};
 use super::pyramid_pose::{PyramidGeometry, PyramidPercept};
@@ -237,14 +237,8 @@ fn finish_both(acc: &[HsvAccumulator; 2]) -> Option<[HsvStats; 2]> {
 fn widen(band: &HsvRange, factor: f64) -> HsvRange {
     // With one SD per half-width, the statistics' hue SD is the band's half-width.
     let hue = HsvStats::from_band(band, 1.0);
-    let half = hue.sd_h_deg * factor;
-    let h = if half >= 180.0 {
-        [0.0, 360.0]
-    } else {
-        [wrap_deg(hue.mean_h_deg - half), wrap_deg(hue.mean_h_deg + half)]
-    };
     HsvRange {
-        h: h.map(|x| x as f32),
+        h: hue_band(hue.mean_h_deg, hue.sd_h_deg * factor),
         s: band.s,
         v: [band.v[0] / factor as f32, band.v[1]],
     }

@@ -352,7 +352,7 @@ impl TwoBlockSchema {
             imprinter: Imprinter::new(
                 [p.imprint.left_rect, p.imprint.right_rect],
                 p.imprint.sample_frac,
-                p.min_brightness,
+                params.min_l,
                 params.min_chroma,
             ),
             imprint_frames: p.imprint.frames,
