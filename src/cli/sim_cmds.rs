@@ -34,6 +34,10 @@ pub struct DockOptions {
     /// Output folder (trajectory CSV, frames).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// With --out, save every Nth camera frame (departure included), overriding the
+    /// scenario's `[record] frames_every`; 0 saves none.
+    #[arg(long, value_name = "N", requires = "out")]
+    pub frames_every: Option<u32>,
 }
 
 /// Parses `--at x,y,heading`.
@@ -99,7 +103,9 @@ pub fn dock(opts: &DockOptions, out: &mut dyn Write) -> Result<RunRecord, SimErr
             source,
         })?;
     }
-    let every = prepared.loaded.scenario.record.frames_every;
+    let every = opts
+        .frames_every
+        .unwrap_or(prepared.loaded.scenario.record.frames_every);
     let rec = campaign::run_one(&prepared, &spec, &agent_for, frames_dir.as_deref().map(|d| (d, every)))?;
     if let Some(d) = &opts.out {
         let p = d.join("trajectory.csv");

@@ -1,0 +1,56 @@
+//! `marsupial dock`: `--index` replays exactly one run of the campaign (its start, trial,
+//! lighting and segmentation) and names the valid range when out of it; `--out` with
+//! `--frames-every` writes the departure's and the docking's frames.
+
+use marsupial::cli::sim_cmds::{DockOptions, dock};
+use marsupial::sim::campaign;
+use marsupial::sim::scenario::Scenario;
+use std::path::{Path, PathBuf};
+
+fn scenario() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/bujold-yellow.toml")
+}
+
+fn opts(index: Option<usize>, out: Option<PathBuf>, frames_every: Option<u32>) -> DockOptions {
+    DockOptions {
+        scenario: scenario(),
+        start: None,
+        at: None,
+        index,
+        seed: None,
+        json: false,
+        out,
+        frames_every,
+    }
+}
+
+#[test]
+fn index_replays_that_campaign_run_and_writes_its_frames() {
+    let prepared = campaign::prepare(Scenario::load(&scenario()).unwrap()).unwrap();
+    let want = prepared.runs[5].clone();
+    let dir = std::env::temp_dir().join(format!("marsupial-dock-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut text = Vec::new();
+    let rec = dock(&opts(Some(5), Some(dir.clone()), Some(50)), &mut text).unwrap();
+    assert_eq!(rec.index, 5);
+    assert_eq!(
+        (rec.start.as_str(), rec.trial, rec.seed),
+        (want.start.label.as_str(), want.trial, want.seed)
+    );
+    assert_eq!(rec.lighting, want.lighting);
+    let names: Vec<String> = std::fs::read_dir(dir.join("frames"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(names.iter().any(|n| n.starts_with("depart-")), "{names:?}");
+    assert!(names.iter().any(|n| n.starts_with("frame-")), "{names:?}");
+    assert!(dir.join("trajectory.csv").exists());
+}
+
+#[test]
+fn an_index_past_the_campaign_names_the_range() {
+    let e = dock(&opts(Some(999), None, None), &mut Vec::new())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no run 999") && e.contains("runs 0–7"), "{e}");
+}
