@@ -1,14 +1,15 @@
 //! The renderer checked geometrically and photometrically: a known point lands where the
 //! camera model projects it, the fiducial's pixel area falls with the square of distance,
-//! Bujold's 180° roll turns the image upside down, sub-pixel motion changes the image, and
-//! the lighting presets move colour statistics in the intended direction.
+//! Bujold's 180° roll turns the image upside down, sub-pixel motion changes the image, the
+//! lighting presets move colour statistics in the intended direction, a glossy highlight
+//! peaks at a dielectric's Fresnel reflection, and auto-exposure protects highlights.
 
 use marsupial::geometry::Pose2;
 use marsupial::perception::camera_model::CameraModel;
 use marsupial::perception::{RgbImage, TwoBlockSchema};
 use marsupial::profile::{Mount, Profile};
 use marsupial::sim::camera::camera_pose;
-use marsupial::sim::lighting::{LightState, LightingPreset, LightingRun, LightingSpec};
+use marsupial::sim::lighting::{Illuminant, LightState, LightingPreset, LightingRun, LightingSpec};
 use marsupial::sim::render::{Renderer, SensorParams};
 use marsupial::sim::rng::Rng;
 use marsupial::sim::scene::{Material, Prim, Scene, Shape, Tag};
@@ -291,4 +292,60 @@ fn highlight_protection_keeps_a_bright_target_from_burning_out() {
     let mean_metered = clipped_after_settling(1.0);
     assert!(protected <= 0.01, "{protected}");
     assert!(mean_metered > 0.02, "mean metering burns the patch out: {mean_metered}");
+}
+
+#[test]
+fn a_glossy_highlight_peaks_at_a_dielectrics_fresnel_reflection() {
+    // A black, fully glossy plate facing +x, lit by a sun alone (no ambient) 10° up, seen
+    // from exactly the mirror direction: all the plate returns is the highlight, whose
+    // centre is F0·(n + 8)/8 = 0.04·72/8 = 0.36 of the sun's irradiance on it.
+    let elev = 10f64.to_radians();
+    let spec = LightingSpec {
+        preset: Some(LightingPreset::Dusk),
+        intensity: Some(1.0),
+        illuminant: Some(Illuminant::Daylight),
+        ambient: Some(0.0),
+        sun: Some(1.0),
+        sun_elevation_deg: Some(elev.to_degrees()),
+        sun_azimuth_deg: Some(0.0),
+        glare: Some(1.0),
+        change_per_hour: Some(0.0),
+        session_s: Some(0.0),
+        shadows: Some(Vec::new()),
+        ..Default::default()
+    };
+    let light = LightingRun::new(spec.resolve(), &mut Rng::new(1), 10.0).at(0.0);
+    let p = bujold();
+    let cam = &p.cameras[0];
+    let pose = camera_pose(&Pose2::new(0.6, 0.0, 0.0), &cam.mount);
+    // The plate sits where the sun's mirror ray through the camera meets x = 0.
+    let eye = pose.position;
+    let d = eye.x / elev.cos();
+    let centre = Point3::new(0.0, eye.y, eye.z + d * elev.sin());
+    let mut plate = Prim::new(
+        Shape::Rect {
+            centre,
+            u: Vector3::y(),
+            v: Vector3::z(),
+            half: [0.1, 0.1],
+        },
+        Material::Solid([0.0; 3]),
+        Tag::Target,
+    );
+    plate.gloss = 1.0;
+    let scene = Scene {
+        prims: vec![plate],
+        ground: Material::Solid([0.0; 3]),
+        sky: [0.0; 3],
+    };
+    let mut r = Renderer::new(CameraModel::from_spec(cam), cam.width_px, cam.height_px, 1);
+    let mut out = RgbImage::default();
+    r.render(&scene, &pose, &light, &quiet(), 0, &mut out);
+    let peak = out.as_bytes().iter().copied().max().unwrap();
+    let peak = f64::from(marsupial::sim::scene::srgb_to_linear(f32::from(peak) / 255.0));
+    let expected = 0.36 * elev.cos();
+    assert!(
+        peak > 0.95 * expected && peak < 1.01 * expected,
+        "peak {peak:.4}, expected {expected:.4}"
+    );
 }

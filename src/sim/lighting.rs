@@ -23,7 +23,9 @@ pub enum LightingPreset {
     /// Lab light plus two rotating orange emergency lights 1.5 m from the fiducial, 0.5 m
     /// either side (seed 004 §VI.B).
     Flashers,
-    /// Outdoors at noon: high sun, hard shadow band, glare.
+    /// Outdoors at noon: high sun, a hard moving shadow band, the robot's own shadow. (The
+    /// 65° sun's highlight on an upright target reflects toward the ground, not a low
+    /// camera.)
     Noon,
     /// Outdoors 90 min before sunset until dark: low warm sun, falling light.
     Dusk,

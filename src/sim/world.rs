@@ -116,8 +116,9 @@ fn yaw(v: Vector3<f64>, deg: f64) -> Vector3<f64> {
 /// white floor of [`PAINT_FLOOR`] at every wavelength. No real paint or ink is a pure sRGB
 /// primary: the binder's surface reflects about 4 % of all light (Fresnel at n ≈ 1.5) and
 /// pigments leak a few per cent outside their band, so a cyan flap still returns some
-/// red. Without the floor a rendered cyan sits exactly on SCT's B = 90° edge when unlit by
-/// glare and jumps by 10–20° when a faint highlight adds white, which no camera sees.
+/// red. Without the floor a rendered cyan sits exactly on SCT's B = 90° edge wherever no
+/// highlight reaches it, and a faint highlight moved it 12° (to B 78°) in the dusk
+/// departure frames we measured: an edge no real paint sits on.
 fn paint(c: NamedColor) -> [f32; 3] {
     albedo(c.rgb(), 0.85 - PAINT_FLOOR).map(|v| v + PAINT_FLOOR)
 }
