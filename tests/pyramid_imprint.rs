@@ -63,7 +63,12 @@ fn schema(p: &Profile, mode: SegmentationMode) -> PyramidSchema {
 
 #[test]
 fn imprint_learns_a_repainted_ball() {
-    let red = load("scenarios/raposa-red-profile.toml");
+    let red = marsupial::sim::scenario::Scenario::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/raposa-repaint.toml"),
+    )
+    .unwrap()
+    .profile;
+    assert_eq!(red.name, "raposa-red");
     for preset in [LightingPreset::Lab, LightingPreset::Dusk] {
         let mut s = schema(&red, SegmentationMode::Static);
         let d = s.imprint_distance();

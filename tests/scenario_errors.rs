@@ -133,6 +133,54 @@ fn missing_profile_and_backdrop_name_the_files() {
 }
 
 #[test]
+fn profile_patches_apply_and_bad_ones_name_the_patch() {
+    let starts = "[starts]\ngrid = \"paper16\"\n";
+    let ok = write(
+        "patch_ok.toml",
+        &format!("{starts}[profile_patch.fiducial.two_block]\nright_color = \"yellow\"\n"),
+    );
+    let loaded = Scenario::load(&ok).unwrap();
+    let fid = loaded.profile.fiducial.two_block.unwrap();
+    assert_eq!(format!("{:?}", fid.right_color), "Yellow");
+    assert_eq!(
+        format!("{:?}", fid.left_color),
+        "Cyan",
+        "unpatched keys follow the profile"
+    );
+    let cases: &[(&str, &str, &str, &str)] = &[
+        (
+            "patch_typo.toml",
+            "[profile_patch.behavior]\naproach = \"potential_field\"\n",
+            "behavior",
+            "unknown field `aproach`",
+        ),
+        (
+            "patch_range.toml",
+            "[profile_patch.success]\nlateral_tolerance_m = -0.02\n",
+            "success.lateral_tolerance_m",
+            "expected a positive number",
+        ),
+        (
+            "patch_shape.toml",
+            "[profile_patch.name]\nx = 1\n",
+            "profile_patch",
+            "`name` is not a table",
+        ),
+    ];
+    for (file, body, path, text) in cases {
+        let e = Scenario::load(&write(file, &format!("{starts}{body}"))).unwrap_err();
+        let shown = e.to_string();
+        assert!(shown.contains("as patched by [profile_patch]"), "{file}: {shown}");
+        let ConfigError::Invalid { problems, .. } = e else {
+            panic!("{file}: {e:?}")
+        };
+        assert!(problems[0].path.starts_with(path), "{file}: {:?}", problems[0]);
+        assert_eq!(problems[0].line, None, "{file}: lines of the merged text would mislead");
+        assert!(problems[0].message.contains(text), "{file}: {}", problems[0].message);
+    }
+}
+
+#[test]
 fn shipped_scenarios_are_valid_and_check_accepts_them() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
     let mut n = 0;

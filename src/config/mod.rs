@@ -6,6 +6,7 @@
 //! at once, not just the first.
 
 pub mod error;
+pub mod patch;
 pub mod validate;
 
 pub use error::{ConfigError, Problem};

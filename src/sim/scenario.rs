@@ -211,6 +211,12 @@ pub struct Scenario {
     pub description: String,
     /// Profile path (relative to the scenario file).
     pub profile: PathBuf,
+    /// Changes to the profile for this experiment only, merged key by key into the
+    /// profile's TOML before it is parsed and validated (see [`crate::config::patch`]):
+    /// `[profile_patch.fiducial.two_block] right_color = "yellow"` repaints one block and
+    /// leaves every other setting following the profile file.
+    #[serde(default)]
+    pub profile_patch: Option<toml::Table>,
     /// Campaign seed.
     #[serde(default)]
     pub seed: u64,
@@ -399,15 +405,53 @@ pub struct Loaded {
     pub profile: Profile,
 }
 
+/// Loads `profile_file` with a scenario's `[profile_patch]` merged in. Problems are
+/// reported against "the profile as patched by the scenario", without line numbers (the
+/// merged text exists only in memory).
+fn load_patched(profile_file: &Path, patch: &toml::Table, scenario_file: &Path) -> Result<Profile, ConfigError> {
+    let src = std::fs::read_to_string(profile_file).map_err(|e| ConfigError::Io {
+        file: profile_file.to_path_buf(),
+        source: std::sync::Arc::new(e),
+    })?;
+    let shown = PathBuf::from(format!(
+        "{} as patched by [profile_patch] in {}",
+        profile_file.display(),
+        scenario_file.display()
+    ));
+    let text = crate::config::patch::patched(&src, patch).map_err(|message| ConfigError::Invalid {
+        file: shown.clone(),
+        problems: vec![config::Problem {
+            path: "profile_patch".into(),
+            line: None,
+            message,
+        }],
+    })?;
+    Profile::parse(&text, &shown).map_err(|e| match e {
+        ConfigError::Invalid { file, problems } => ConfigError::Invalid {
+            file,
+            problems: problems
+                .into_iter()
+                .map(|p| config::Problem { line: None, ..p })
+                .collect(),
+        },
+        other => other,
+    })
+}
+
 impl Scenario {
-    /// Loads and validates a scenario and the profile it names.
+    /// Loads and validates a scenario and the profile it names (with its
+    /// `[profile_patch]`, if any).
     ///
     /// # Errors
     /// [`ConfigError`] for the scenario or its profile.
     pub fn load(path: &Path) -> Result<Loaded, ConfigError> {
         let scenario: Scenario = config::load(path)?;
         let dir = path.parent().unwrap_or(Path::new("."));
-        let profile = Profile::load(&dir.join(&scenario.profile))?;
+        let profile_file = dir.join(&scenario.profile);
+        let profile = match &scenario.profile_patch {
+            None => Profile::load(&profile_file)?,
+            Some(patch) => load_patched(&profile_file, patch, path)?,
+        };
         for (i, b) in scenario.backgrounds.iter().enumerate() {
             let p = dir.join(b);
             if !p.is_file() {
