@@ -7,26 +7,89 @@ use marsupial::sim::campaign;
 use marsupial::sim::scenario::Scenario;
 use std::path::Path;
 
-#[test]
-fn docks_from_starts_across_the_approach_zone() {
-    let dir = std::env::temp_dir().join(format!("marsupial-closed-loop-{}", std::process::id()));
+/// Runs the campaign of a scenario on `profiles/bujold.toml` whose text after the
+/// `profile` line is `rest`.
+fn run_bujold(name: &str, rest: &str) -> (Vec<campaign::RunRecord>, campaign::Summary) {
+    let dir = std::env::temp_dir().join(format!("marsupial-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let profile = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/bujold.toml");
     let s = dir.join("s.toml");
     std::fs::write(
         &s,
-        format!(
-            "name = \"closed-loop\"\nprofile = \"{}\"\nseed = 11\ntrials = 1\n[starts]\ngrid = \"paper16\"\nselect = [2, 5, 6, 8, 9, 14]\nposition_jitter_m = 0.02\nheading_jitter_deg = 3.0\n",
-            profile.display()
-        ),
+        format!("name = \"{name}\"\nprofile = \"{}\"\n{rest}", profile.display()),
     )
     .unwrap();
     let p = campaign::prepare(Scenario::load(&s).unwrap()).unwrap();
-    let (records, summary) = campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap();
+    campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap()
+}
+
+#[test]
+fn docks_from_starts_across_the_approach_zone() {
+    let (records, summary) = run_bujold(
+        "closed-loop",
+        "seed = 11\ntrials = 1\n[starts]\ngrid = \"paper16\"\nselect = [2, 5, 6, 8, 9, 14]\nposition_jitter_m = 0.02\nheading_jitter_deg = 3.0\n",
+    );
     for r in &records {
         assert!(r.success, "start {}: {} after {:.1} s", r.start, r.outcome, r.time_s);
         assert_eq!(r.imprinted, Some(true));
         assert!(r.entrance_lateral_m.unwrap().abs() <= 0.02 && r.entrance_heading_deg.unwrap().abs() <= 5.0);
     }
     assert_eq!(summary.overall.successes, 6);
+}
+
+/// The potential-field approach (`scenarios/bujold-potential.toml`) from the wings of the
+/// grid, where the coercive zone's tangential pull would turn the camera off the flap
+/// without the keep-in-view clamp, and from far on the axis.
+#[test]
+fn potential_field_approach_docks_from_the_wings() {
+    let mut loaded =
+        Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/bujold-potential.toml")).unwrap();
+    assert_eq!(
+        loaded.profile.behavior.approach,
+        marsupial::profile::ApproachKind::PotentialField
+    );
+    loaded.scenario.trials = 1;
+    loaded.scenario.starts.select = Some(vec![1, 4, 7, 12, 14, 16]);
+    let p = campaign::prepare(loaded).unwrap();
+    let (records, summary) = campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap();
+    for r in &records {
+        assert!(r.success, "start {}: {} after {:.1} s", r.start, r.outcome, r.time_s);
+        assert!(r.entrance_lateral_m.unwrap().abs() <= 0.02 && r.entrance_heading_deg.unwrap().abs() <= 5.0);
+    }
+    assert_eq!(summary.overall.successes, 6);
+}
+
+/// Placed beside the gate facing away from the flap, the robot must search, and a turn in
+/// place there sweeps a corner into the mother's body: the tracks spin, the view does not
+/// move. The frame-change cue notices, the robot turns back, drives out and searches the
+/// other way (`Phase::Unjam`); without it these runs time out against the body.
+#[test]
+fn a_search_jammed_against_the_body_gets_free_and_docks() {
+    let (records, summary) = run_bujold(
+        "jam",
+        "seed = 4\ntrials = 2\n[starts]\nposition_jitter_m = 0.01\nheading_jitter_deg = 3.0\npoints = [ { x_m = 0.2, y_m = -0.51, heading_deg = 45.0 }, { x_m = 0.2, y_m = 0.51, heading_deg = -45.0 } ]\n",
+    );
+    for r in &records {
+        assert!(r.success, "start {}: {} after {:.1} s", r.start, r.outcome, r.time_s);
+    }
+    assert_eq!(summary.overall.successes, 4);
+}
+
+/// The whole docking behavior (`scenarios/bujold-ballistic.toml`): from 3–4 m, facing
+/// anywhere, told the dock's location a priori with 15 cm and 5° of error, the robot drives
+/// to the approach zone by odometry, acquires the flap and close-docks.
+#[test]
+fn ballistic_go_to_then_close_dock_from_beyond_sight() {
+    let mut loaded =
+        Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/bujold-ballistic.toml")).unwrap();
+    assert!(loaded.scenario.ballistic.enabled && loaded.scenario.ballistic.error_m > 0.0);
+    loaded.scenario.trials = 1;
+    let p = campaign::prepare(loaded).unwrap();
+    assert!(p.runs.len() >= 5 && p.runs.iter().all(|r| r.start.distance >= 3.0));
+    let (records, summary) = campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap();
+    for r in &records {
+        assert!(r.success, "start {}: {} after {:.1} s", r.start, r.outcome, r.time_s);
+        assert!(r.path_m > 2.5, "start {}: drove only {:.2} m", r.start, r.path_m);
+    }
+    assert_eq!(summary.overall.successes, records.len());
 }

@@ -54,3 +54,16 @@ fn an_index_past_the_campaign_names_the_range() {
         .to_string();
     assert!(e.contains("no run 999") && e.contains("runs 0–7"), "{e}");
 }
+
+#[test]
+fn a_start_inside_the_mothers_body_is_refused() {
+    // Beside the gate with its rear 10 cm into the body (whatever the proctor's 2 cm and
+    // 3° of jitter): a robot placed there could never move, so the run is refused rather
+    // than timed out.
+    let mut o = opts(None, None, None);
+    o.at = Some((0.1, -0.3, 0.0));
+    let e = dock(&o, &mut Vec::new()).unwrap_err().to_string();
+    assert!(e.contains("overlapping the dock's body"), "{e}");
+    o.at = Some((0.9, 0.0, 0.0));
+    assert!(dock(&o, &mut Vec::new()).is_ok());
+}

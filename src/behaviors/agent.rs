@@ -11,6 +11,12 @@ pub trait Agent: Behavior {
     fn begin_departure(&mut self) -> bool;
     /// Switches to the docking phase; the robot may have been moved since departure.
     fn begin_docking(&mut self);
+    /// An a-priori estimate of the dock's pose (entrance, +x out along its axis) in the
+    /// odometry frame the next docking starts in: from GPS, or remembered from the
+    /// departure. With one, docking starts with a ballistic drive to the dock's approach
+    /// zone; without (`None`, the default), the robot is taken to be placed within sight
+    /// of the dock. Agents that cannot use it ignore it.
+    fn set_dock_hint(&mut self, _hint: Option<crate::geometry::Pose2>) {}
     /// Counters of the current docking run (for campaign records).
     fn stats(&self) -> AgentStats {
         AgentStats::default()

@@ -6,11 +6,19 @@
 //!
 //! Docking (the paper's "close dock" within the whole docking behavior):
 //!
+//! 0. **ballistic** (only when given the dock's location a priori, [`Agent::set_dock_hint`]):
+//!    turn, drive and turn by odometry to [`BALLISTIC_STAGING_M`] out on the dock axis,
+//!    facing along it (the repositioning manoeuvre), then look;
 //! 1. **search**: rotate in place until the fiducial is acquired (toward the side it was
-//!    last seen), bounded by `search_timeout_s`;
+//!    last seen), bounded by `search_timeout_s`. A turn that does not change the view for
+//!    1.5 s is jammed against the body (the tracks spin, the camera sees it): **unjam** by
+//!    turning back to the heading docking began with, driving out 20 cm front first, and
+//!    searching the other way, at most three times;
 //! 2. **approach**: ratio steering ([`RatioSteering`]) or potential fields
-//!    ([`PotentialField`]) on the fiducial's relative pose, speed falling with the summed
-//!    pixel count; the fiducial lost for 1.5 s sends the robot back to search;
+//!    ([`PotentialField`], realised through the ratio-steering schema's dead band,
+//!    understeer and turn-or-drive alternation) on the fiducial's relative pose, speed
+//!    falling with the summed pixel count; the fiducial lost for 1.5 s sends the robot back
+//!    to search;
 //! 3. **decide** at `dock_total_px`: stop, average five frames; balanced and centred
 //!    (estimated lateral and heading errors within the profile's tolerances) → back in;
 //!    otherwise **move away** 35 cm and retry, up to `max_retries`;
@@ -22,6 +30,7 @@
 use super::agent::{Agent, BuildError};
 use crate::geometry::Pose2;
 use crate::perception::TwoBlockSchema;
+use crate::perception::frame_change::FrameChange;
 use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
 use crate::profile::{ApproachKind, Profile};
 use crate::schemas::{
@@ -38,6 +47,11 @@ enum Phase {
     },
     DriveOut,
     Search,
+    /// The search rotation is jammed against the body: turn back to the heading docking
+    /// began with (stage 0), drive out front first (stage 1), search the other way.
+    Unjam {
+        stage: u8,
+    },
     Approach,
     Decide,
     BackIn,
@@ -60,6 +74,7 @@ impl Phase {
             Phase::Imprint { .. } => "imprint",
             Phase::DriveOut => "drive_out",
             Phase::Search => "search",
+            Phase::Unjam { .. } => "unjam",
             Phase::Approach => "approach",
             Phase::Decide => "decide",
             Phase::BackIn => "back_in",
@@ -104,6 +119,19 @@ pub struct BujoldAgent {
     alpha_filtered: Option<f64>,
     /// The last raw viewing angles of reliable frames, for the repositioning decision.
     alpha_window: MedianWindow,
+    /// How much the view changes from frame to frame: a turn that does not change it is
+    /// jammed.
+    frame_change: FrameChange,
+    /// Since when the view has been still while the search turns.
+    still_since: Option<f64>,
+    /// Unjamming manoeuvres this docking attempt.
+    unjams: u32,
+    /// Odometry heading when docking began (the robot was placed facing the dock, so its
+    /// front pointed away from it), rad.
+    start_heading: Option<f64>,
+    /// The a-priori dock pose in the odometry frame of the next docking (see
+    /// [`Agent::set_dock_hint`]).
+    dock_hint: Option<Pose2>,
 }
 
 /// Reliable frames the repositioning decision looks back over (1.6 s at 10 Hz: longer
@@ -170,12 +198,24 @@ pub const DEPARTURE_SPEED_MPS: f64 = 0.06;
 pub const MOVE_AWAY_M: f64 = 0.35;
 /// Staging distance on the dock axis for repositioning, m.
 pub const STAGING_X_M: f64 = 0.75;
+/// Where on the dock axis the ballistic drive to an a-priori dock location ends, m: far
+/// enough that an a-priori error of a few decimetres still leaves the flap in view.
+pub const BALLISTIC_STAGING_M: f64 = 1.2;
 /// Lateral error (m) above which a reliable view triggers repositioning.
 pub const REPOSITION_LATERAL_M: f64 = 0.08;
 /// Closer to the body than this (m along the axis) the robot drives out before turning.
 pub const CLEARANCE_X_M: f64 = 0.45;
 /// Blocks at least this tall (px) give a viewing angle good enough to plan on.
 pub const RELIABLE_HEIGHT_PX: f64 = 40.0;
+/// A view changing less than this (mean 8-bit levels per frame, see [`FrameChange`]) is
+/// still: sensor noise reads 0.1–0.3, a turn tens of levels.
+pub const STILL_LEVELS: f32 = 1.0;
+/// The search turn jammed: the view still for this long while turning, s.
+pub const JAMMED_AFTER_S: f64 = 1.5;
+/// How far an unjamming manoeuvre drives out, front first, m.
+pub const UNJAM_M: f64 = 0.2;
+/// Unjamming manoeuvres allowed per docking attempt (the search stays bounded).
+pub const MAX_UNJAMS: u32 = 3;
 
 impl BujoldAgent {
     /// Builds the agent from a profile with a `[fiducial.two_block]` and
@@ -213,6 +253,10 @@ impl BujoldAgent {
                     coercive_attraction: p.coercive_attraction,
                     gain: p.gain,
                     k_theta: p.k_theta,
+                    // The camera looks along the motion: keep the flap as far inside the
+                    // image as ratio steering's aim point does.
+                    max_off_sight: crate::schemas::ratio_steering::MAX_AIM_RAD,
+                    final_radius: p.final_radius_m,
                 })
             }
             _ => None,
@@ -263,6 +307,11 @@ impl BujoldAgent {
             samples_distance: 0.0,
             alpha_filtered: None,
             alpha_window: MedianWindow::new(),
+            frame_change: FrameChange::new(),
+            still_since: None,
+            unjams: 0,
+            start_heading: None,
+            dock_hint: None,
         })
     }
 
@@ -282,6 +331,7 @@ impl BujoldAgent {
         self.phase_start = now;
         self.odo_mark = odo;
         self.samples.clear();
+        self.still_since = None;
     }
 
     fn travelled(&self, odo: &Pose2) -> f64 {
@@ -359,27 +409,34 @@ impl BujoldAgent {
         );
     }
 
+    /// True when the search has turned for [`JAMMED_AFTER_S`] without the view changing
+    /// (and unjams are left). `change` is this frame's [`FrameChange`] cue.
+    fn search_jammed(&mut self, change: Option<f32>, now: f64) -> bool {
+        match change {
+            Some(c) if c < STILL_LEVELS => {
+                let since = *self.still_since.get_or_insert(now);
+                now - since >= JAMMED_AFTER_S && self.unjams < MAX_UNJAMS
+            }
+            _ => {
+                self.still_since = None;
+                false
+            }
+        }
+    }
+
     fn approach_command(&self, view: &FiducialView) -> MotorOutput {
         match &self.field {
             None => self.steering.act(view),
-            Some(pf) => {
-                let t = pf.twist(&view.dock_pose(), self.geometry.drive_dir);
-                let cmd = if self.steering.restricted {
-                    // Turn OR drive: turn while the heading error exceeds the dead band.
-                    if (t.omega * self.steering.tick_s).abs() > self.steering.dead_band * 0.5 {
-                        DriveCommand::Turn {
-                            omega: t.omega.clamp(-self.steering.turn_rate, self.steering.turn_rate),
-                        }
-                    } else {
-                        DriveCommand::Straight {
-                            v: self.steering.speed_for(view.total_px as f64),
-                        }
-                    }
-                } else {
-                    DriveCommand::Twist(t)
-                };
-                MotorOutput::drive(cmd)
+            // The field gives a heading error; the ratio-steering schema realises it with
+            // the same dead band, understeer and turn-or-drive alternation.
+            Some(pf) if self.steering.restricted => {
+                let error = pf.body_vector(&view.dock_pose(), self.geometry.drive_dir).angle();
+                self.steering
+                    .steer(error, self.steering.speed_for(view.total_px as f64))
             }
+            Some(pf) => MotorOutput::drive(DriveCommand::Twist(
+                pf.twist(&view.dock_pose(), self.geometry.drive_dir),
+            )),
         }
     }
 }
@@ -387,8 +444,10 @@ impl BujoldAgent {
 /// The at-dock decision (seed 004 §V): "if the ratio of left to right pixel counts is close
 /// to one and the fiducial is centred, back in; otherwise move away and retry", made
 /// metric: average the views, predict the lateral error where the rear will reach the
-/// entrance (backing a distance s at heading θ shifts the robot by −s·sin θ), and back in
-/// only if that and the heading are within 80 % of the profile's tolerances.
+/// entrance, and back in only if that and the heading are within 80 % of the profile's
+/// tolerances. The rear sits `rear_behind_camera` behind the camera along the heading θ
+/// and backs a further `to_go` to the entrance, so its lateral error there is the
+/// camera's, d·sin α, less (rear_behind_camera + to_go)·sin θ.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Decision {
     /// Back in now.
@@ -415,7 +474,7 @@ pub fn at_dock_decision(
     let heading = samples.iter().map(|s| s.heading).sum::<f64>() / n;
     let distance = samples.iter().map(|s| s.distance).sum::<f64>() / n;
     let to_go = (distance - rear_behind_camera).max(0.0);
-    let lateral_at_entrance = distance * alpha.sin() - to_go * heading.sin();
+    let lateral_at_entrance = distance * alpha.sin() - (rear_behind_camera + to_go) * heading.sin();
     Decision {
         back_in: !samples.is_empty()
             && lateral_at_entrance.abs() <= 0.8 * tol_lateral
@@ -453,6 +512,7 @@ impl Behavior for BujoldAgent {
         // Perception runs every tick so adaptation follows the light, except while
         // imprinting (the imprint must not be mixed with adapted statistics).
         let percept = self.schema.perceive(inputs);
+        let change = inputs.camera(0).and_then(|c| self.frame_change.observe(&c.image));
         let mut view = FiducialView::from_percept(&percept, &self.geometry);
         let mut planning: Option<FiducialView> = None;
         if let Some(v) = view.as_mut() {
@@ -484,6 +544,9 @@ impl Behavior for BujoldAgent {
         if self.phase_start == f64::NEG_INFINITY {
             self.phase_start = now;
             self.odo_mark = odo;
+            if self.phase == Phase::Search {
+                self.start_heading = Some(odo.theta);
+            }
         }
         let in_phase = now - self.phase_start;
         let dir = self.geometry.drive_dir;
@@ -568,6 +631,15 @@ impl Behavior for BujoldAgent {
                         FailureReason::TargetNeverDetected
                     };
                     self.fail(reason, now, odo, false)
+                } else if self.search_jammed(change, now) {
+                    // Beside the gate a corner catches the body: the tracks spin, the view
+                    // does not move. Drive out, front first, and search again turning the
+                    // other way, which swings the caught corner off the body.
+                    self.unjams += 1;
+                    self.last_side = -self.last_side;
+                    tracing::debug!(target: "marsupial::behavior", now, unjams = self.unjams, "search turn jammed");
+                    self.enter(Phase::Unjam { stage: 0 }, now, odo);
+                    self.hold(now)
                 } else {
                     let mut s = self.search;
                     s.rate *= self.last_side;
@@ -575,6 +647,28 @@ impl Behavior for BujoldAgent {
                         MotorOutput::drive(s.act(in_phase)).with_aux(raised()),
                         self.feedback(now),
                     )
+                }
+            }
+            Phase::Unjam { stage: 0 } => {
+                // Turning back over the ground just swept is free.
+                let err = crate::geometry::wrap_angle(self.start_heading.unwrap_or(odo.theta) - odo.theta);
+                if err.abs() < 5f64.to_radians() || in_phase > 20.0 {
+                    self.enter(Phase::Unjam { stage: 1 }, now, odo);
+                    self.hold(now)
+                } else {
+                    let w = (2.0 * err).clamp(-self.steering.turn_rate, self.steering.turn_rate);
+                    Step::running(
+                        MotorOutput::drive(DriveCommand::Turn { omega: w }).with_aux(raised()),
+                        self.feedback(now),
+                    )
+                }
+            }
+            Phase::Unjam { .. } => {
+                if self.travelled(&odo) >= UNJAM_M || in_phase > 2.0 * UNJAM_M / DEPARTURE_SPEED_MPS {
+                    self.enter(Phase::Search, now, odo);
+                    self.hold(now)
+                } else {
+                    self.drive_away(now)
                 }
             }
             Phase::Approach => match (view, off_axis) {
@@ -779,10 +873,24 @@ impl Agent for BujoldAgent {
         self.alpha_filtered = None;
         self.alpha_window.clear();
         self.retries = 0;
+        self.unjams = 0;
+        self.start_heading = None;
         self.ever_seen = false;
         self.last_seen = None;
-        self.phase = Phase::Search;
+        self.phase = match self.dock_hint {
+            // Ballistic region: drive by odometry to the approach zone's staging point and
+            // face along the axis, then look (the repositioning manoeuvre does exactly this).
+            Some(dock) => Phase::Reposition {
+                stage: 0,
+                target: dock.compose(&Pose2::new(BALLISTIC_STAGING_M, 0.0, 0.0)),
+            },
+            None => Phase::Search,
+        };
         self.phase_start = f64::NEG_INFINITY;
+    }
+
+    fn set_dock_hint(&mut self, hint: Option<Pose2>) {
+        self.dock_hint = hint;
     }
 }
 
@@ -838,8 +946,15 @@ mod tests {
         // On the axis but heading 4.5°: within 5° but beyond 80 % of it.
         assert!(!at_dock_decision(&[view(0.0, 4.5); 5], 0.15, 0.02, 5f64.to_radians()).back_in);
         // A small offset cancelled by a heading that steers back onto the axis: backs in.
-        let d = at_dock_decision(&[view(1.5, 2.0); 5], 0.15, 0.02, 5f64.to_radians());
-        assert!(d.lateral_at_entrance.abs() < 0.003 && d.back_in, "{d:?}");
+        let d = at_dock_decision(&[view(2.0, 2.0); 5], 0.15, 0.02, 5f64.to_radians());
+        assert!(d.lateral_at_entrance.abs() < 1e-12 && d.back_in, "{d:?}");
+        // The lever arm from camera to rear counts: 1° off with the heading 4° back toward
+        // the axis leaves the camera 6.6 mm off, but the rear reaches the entrance 20 mm
+        // past the axis (ignoring the 0.15 m arm would predict 10 mm and back in).
+        let d = at_dock_decision(&[view(1.0, 4.0); 5], 0.15, 0.02, 5f64.to_radians());
+        let expected = 0.38 * 1f64.to_radians().sin() - 0.38 * 4f64.to_radians().sin();
+        assert!((d.lateral_at_entrance - expected).abs() < 1e-12, "{d:?}");
+        assert!(!d.back_in, "{d:?}");
         assert!(!at_dock_decision(&[], 0.15, 0.02, 0.1).back_in);
     }
 

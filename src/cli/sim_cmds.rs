@@ -173,7 +173,15 @@ pub fn print_table(s: &Summary, out: &mut dyn Write) -> std::io::Result<()> {
         vary(&|g| &g.terrain),
     );
     writeln!(out, "{}", s.scenario)?;
-    let mut head = String::from("start ");
+    // The start column fits the longest label (explicit starts may be named).
+    let sw = s
+        .groups
+        .iter()
+        .map(|g| g.start.chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(5);
+    let mut head = format!("{:<sw$} ", "start");
     if vl {
         head.push_str(" lighting  ");
     }
@@ -188,7 +196,7 @@ pub fn print_table(s: &Summary, out: &mut dyn Write) -> std::io::Result<()> {
         "{head}  runs  success  mean time (s)  sd (s)  v_eff (cm/s)  cmds/m  failures"
     )?;
     let row = |g: &GroupSummary, out: &mut dyn Write| -> std::io::Result<()> {
-        let mut line = format!("{:<6}", g.start);
+        let mut line = format!("{:<sw$} ", g.start);
         if vl {
             line.push_str(&format!(" {:<10}", g.lighting));
         }

@@ -18,6 +18,7 @@ pub mod camera_model;
 pub mod colour_model;
 pub mod components;
 pub mod fastmath;
+pub mod frame_change;
 pub mod hsv;
 pub mod hsv_stats;
 pub mod image;

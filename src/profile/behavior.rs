@@ -61,6 +61,11 @@ pub struct PotentialFieldGains {
     pub gain: f64,
     /// Heading-controller gain turning the field vector into a twist, 1/s.
     pub k_theta: f64,
+    /// Radius of the final zone, m: the tangential pull fades from full at twice this
+    /// distance from the dock to nothing at it, so the robot arrives pointing at the
+    /// entrance (0, the default: no fading).
+    #[serde(default)]
+    pub final_radius_m: f64,
 }
 
 /// Gains and thresholds of RAPOSA's seven-state servo (seed 001 §II.D–E). The paper gives
@@ -228,6 +233,7 @@ pub(crate) fn validate_behavior(b: &BehaviorSpec, v: &mut Validator<'_>) {
                 );
                 v.positive("behavior.potential_field.gain", g.gain);
                 v.positive("behavior.potential_field.k_theta", g.k_theta);
+                v.non_negative("behavior.potential_field.final_radius_m", g.final_radius_m);
             }
         },
         ApproachKind::SevenState => match &b.seven_state {

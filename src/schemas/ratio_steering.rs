@@ -76,19 +76,29 @@ impl RatioSteering {
     pub fn act(&self, view: &FiducialView) -> MotorOutput {
         let e = self.error(view);
         let angle = (e * self.image_width / 2.0 / self.geometry.fx).atan();
+        self.steer(angle, self.speed_for(view.total_px as f64))
+    }
+
+    /// The dead band as a heading error, rad: the angle a steering error of `dead_band`
+    /// (a fraction of the half image) stands for.
+    pub fn dead_band_angle(&self) -> f64 {
+        (self.dead_band * self.image_width / 2.0 / self.geometry.fx).atan()
+    }
+
+    /// Realises a heading error `angle` (rad, counter-clockwise positive) and a speed `v`
+    /// the schema's way: within the dead band drive at `v`; outside it turn by
+    /// `understeer` × the error this tick (capped at the turn rate), in place on a
+    /// turn-or-drive base, or as one twist on a base that can do both. Any approach that
+    /// yields a heading error (the potential field does) can drive through this.
+    pub fn steer(&self, angle: f64, v: f64) -> MotorOutput {
+        let within = angle.abs() <= self.dead_band_angle();
         let omega = (self.understeer * angle / self.tick_s).clamp(-self.turn_rate, self.turn_rate);
-        let v = self.speed_for(view.total_px as f64);
-        if !self.restricted {
-            return MotorOutput::drive(DriveCommand::Twist(Twist::new(
-                v,
-                if e.abs() <= self.dead_band { 0.0 } else { omega },
-            )));
-        }
-        if e.abs() <= self.dead_band {
-            MotorOutput::drive(DriveCommand::Straight { v })
-        } else {
-            MotorOutput::drive(DriveCommand::Turn { omega })
-        }
+        let cmd = match (self.restricted, within) {
+            (false, _) => DriveCommand::Twist(Twist::new(v, if within { 0.0 } else { omega })),
+            (true, true) => DriveCommand::Straight { v },
+            (true, false) => DriveCommand::Turn { omega },
+        };
+        MotorOutput::drive(cmd)
     }
 }
 
@@ -169,6 +179,24 @@ mod tests {
         assert!(s.error(&view(40.0, desired)).abs() < 1e-9);
         // Symmetric on the other side.
         assert!((s.error(&view(-40.0, 0.0)) + e_centred).abs() < 1e-9);
+    }
+
+    #[test]
+    fn steer_realises_any_heading_error_with_the_same_dead_band() {
+        let s = schema();
+        let db = s.dead_band_angle();
+        // The dead band in pixels and in angle are the same boundary.
+        assert!((db - (0.05f64 * 128.0 / 182.8).atan()).abs() < 1e-12);
+        assert_eq!(s.steer(0.99 * db, -0.04).drive, DriveCommand::Straight { v: -0.04 });
+        assert_eq!(s.steer(-0.99 * db, -0.04).drive, DriveCommand::Straight { v: -0.04 });
+        let DriveCommand::Turn { omega } = s.steer(1.01 * db, -0.04).drive else {
+            panic!()
+        };
+        assert!((omega - 0.6 * 1.01 * db / 0.1).abs() < 1e-12, "understeered: {omega}");
+        let DriveCommand::Turn { omega } = s.steer(-1.0, -0.04).drive else {
+            panic!()
+        };
+        assert_eq!(omega, -0.5, "capped at the turn rate");
     }
 
     #[test]

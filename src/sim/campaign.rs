@@ -219,7 +219,43 @@ pub fn run_one(
     let jx = pair.normal() * sc.starts.position_jitter_m;
     let jy = pair.normal() * sc.starts.position_jitter_m;
     let jt = pair.normal() * sc.starts.heading_jitter_deg.to_radians();
-    sim.place(Pose2::new(s.pose.x + jx, s.pose.y + jy, s.pose.theta + jt), false);
+    let (length, width) = (profile.body.length_m, profile.body.width_m);
+    let overlaps = |pose: &Pose2| super::dock::overlaps(&p.world.dock, pose, length, width);
+    if overlaps(&s.pose) {
+        return Err(SimError::InvalidStart(format!(
+            "start `{}` places the robot at ({:.3} m, {:.3} m, {:.1}°), overlapping the dock's body",
+            s.label,
+            s.pose.x,
+            s.pose.y,
+            s.pose.theta.to_degrees()
+        )));
+    }
+    // A start by the body may be jittered into it: the proctor's hand meets the body, so
+    // the robot is slid straight out from the entrance, 5 mm at a time, until it is clear.
+    let mut start = Pose2::new(s.pose.x + jx, s.pose.y + jy, s.pose.theta + jt);
+    let out_dir = start.y.atan2(start.x);
+    for _ in 0..100 {
+        if !overlaps(&start) {
+            break;
+        }
+        start.x += 0.005 * out_dir.cos();
+        start.y += 0.005 * out_dir.sin();
+    }
+    sim.place(start, false);
+    if sc.ballistic.enabled {
+        // Odometry restarts at the placed pose: the dock's origin seen from there, with
+        // the a-priori error (its own stream, so the other draws stay as they were).
+        let mut r = Rng::new(spec.seed ^ 0xBA11_1571C);
+        let exact = start.relative(&Pose2::default());
+        let b = &sc.ballistic;
+        agent.set_dock_hint(Some(Pose2::new(
+            exact.x + r.normal() * b.error_m,
+            exact.y + r.normal() * b.error_m,
+            exact.theta + r.normal() * b.heading_error_deg.to_radians(),
+        )));
+    } else {
+        agent.set_dock_hint(None);
+    }
     agent.begin_docking();
     let end = run_recorded(&mut sim, agent.as_mut(), sc.timeout_s, frames, "frame");
     let success = sim.docked();

@@ -41,6 +41,22 @@ fn in_body(g: &DockGeometry, x: f64, y: f64) -> bool {
     x < 0.0 && x > -g.body_length && y.abs() < g.body_half_width
 }
 
+/// True when a robot of `length × width` at `pose` overlaps the mother's body (or, for an
+/// open dock, touches the target other than by docking): a start no proctor could place.
+pub fn overlaps(g: &DockGeometry, pose: &Pose2, length: f64, width: f64) -> bool {
+    if g.open {
+        return matches!(judge_open(g, pose, length, width), Contact::Stuck { .. });
+    }
+    let robot_in_body = footprint(pose, length, width).iter().any(|&(x, y)| in_body(g, x, y));
+    let body_in_robot = [(0.0, g.body_half_width), (0.0, -g.body_half_width)]
+        .iter()
+        .any(|&(x, y)| {
+            let (a, b) = pose.to_local(x, y);
+            a.abs() < length / 2.0 && b.abs() < width / 2.0
+        });
+    robot_in_body || body_in_robot
+}
+
 /// Judges a move from `from` to `to`.
 pub fn judge(
     g: &DockGeometry,
@@ -140,6 +156,23 @@ mod tests {
             open: false,
             target_extent: None,
         }
+    }
+
+    #[test]
+    fn starts_overlapping_the_body_are_recognised() {
+        let (l, w) = (0.4, 0.18);
+        // Paper position 1 (0.33 m from the rear, 70° off the axis) facing the flap: clear.
+        assert!(!overlaps(&g(), &Pose2::new(0.27, -0.50, 110f64.to_radians()), l, w));
+        assert!(!overlaps(&g(), &Pose2::new(1.0, 0.0, 0.0), l, w));
+        // Beside the gate turned 45°: a rear corner is inside the body.
+        assert!(overlaps(&g(), &Pose2::new(0.2, -0.524, -44.5f64.to_radians()), l, w));
+        // Straddling the body's corner diagonally: no robot corner inside the body, the
+        // body's corner inside the robot.
+        let diagonal = Pose2::new(0.0, -0.45, 45f64.to_radians());
+        assert!(!footprint(&diagonal, 0.4, 0.1).iter().any(|&(x, y)| in_body(&g(), x, y)));
+        assert!(overlaps(&g(), &diagonal, 0.4, 0.1));
+        // Inside the body outright.
+        assert!(overlaps(&g(), &Pose2::new(-0.6, 0.0, 0.0), l, w));
     }
 
     #[test]

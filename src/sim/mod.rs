@@ -16,6 +16,9 @@ pub enum SimError {
     /// The simulator cannot (yet) build what the profile describes.
     #[error("not supported by the simulator: {0}")]
     Unsupported(String),
+    /// A start pose the robot cannot be placed at.
+    #[error("{0}")]
+    InvalidStart(String),
     /// A scenario file problem.
     #[error(transparent)]
     Config(#[from] crate::config::ConfigError),

@@ -192,6 +192,20 @@ impl Default for ImprintSpec {
     }
 }
 
+/// `[ballistic]`: the robot is not placed facing the dock but told where it is a priori
+/// (GPS, or remembered from departure), with an error, and must drive there first (the
+/// ballistic region of seed 004 Fig. 1).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct BallisticSpec {
+    /// Hand the agent an a-priori dock pose at each start.
+    pub enabled: bool,
+    /// SD of the a-priori position's error, m (each axis).
+    pub error_m: f64,
+    /// SD of the a-priori axis direction's error, degrees.
+    pub heading_error_deg: f64,
+}
+
 /// `[record]`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
@@ -246,6 +260,9 @@ pub struct Scenario {
     /// Departure and imprinting.
     #[serde(default)]
     pub imprint: ImprintSpec,
+    /// A-priori dock location and its error.
+    #[serde(default)]
+    pub ballistic: BallisticSpec,
     /// Clutter.
     #[serde(default)]
     pub clutter: Vec<ClutterSpec>,
@@ -289,6 +306,8 @@ impl Validate for Scenario {
         });
         v.require(self.trials >= 1, "trials", || "expected at least 1 trial".into());
         v.positive("timeout_s", self.timeout_s);
+        v.non_negative("ballistic.error_m", self.ballistic.error_m);
+        v.non_negative("ballistic.heading_error_deg", self.ballistic.heading_error_deg);
         v.require(self.dt_s > 0.0 && self.dt_s <= 0.05, "dt_s", || {
             format!("expected a physics step in (0, 0.05] s, got {}", self.dt_s)
         });
