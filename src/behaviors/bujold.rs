@@ -11,9 +11,9 @@
 //!    facing along it (the repositioning manoeuvre), then look;
 //! 1. **search**: rotate in place until the fiducial is acquired (toward the side it was
 //!    last seen), bounded by `search_timeout_s`. A turn that does not change the view for
-//!    1.5 s is jammed against the body (the tracks spin, the camera sees it): **unjam** by
-//!    turning back to the heading docking began with, driving out 20 cm front first, and
-//!    searching the other way, at most three times;
+//!    1.5 s is jammed against the body (the tracks spin, the camera sees it): **unjam**
+//!    by turning back to the heading the close dock began with, driving out 20 cm front
+//!    first, and searching the other way, at most three times;
 //! 2. **approach**: ratio steering ([`RatioSteering`]) or potential fields
 //!    ([`PotentialField`], realised through the ratio-steering schema's dead band,
 //!    understeer and turn-or-drive alternation) on the fiducial's relative pose, speed
@@ -126,8 +126,9 @@ pub struct BujoldAgent {
     still_since: Option<f64>,
     /// Unjamming manoeuvres this docking attempt.
     unjams: u32,
-    /// Odometry heading when docking began (the robot was placed facing the dock, so its
-    /// front pointed away from it), rad.
+    /// Odometry heading the close dock began facing along, front away from the dock
+    /// (where the robot was placed, or where the ballistic drive left it), rad: unjamming
+    /// turns back to it.
     start_heading: Option<f64>,
     /// The a-priori dock pose in the odometry frame of the next docking (see
     /// [`Agent::set_dock_hint`]).
@@ -332,6 +333,7 @@ impl BujoldAgent {
         self.odo_mark = odo;
         self.samples.clear();
         self.still_since = None;
+        self.frame_change.reset();
     }
 
     fn travelled(&self, odo: &Pose2) -> f64 {
@@ -341,6 +343,16 @@ impl BujoldAgent {
     /// Stand still, raised.
     fn hold(&self, now: f64) -> Step {
         Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(now))
+    }
+
+    /// Turn in place toward a heading error `err` (rad), raised: twice the error per
+    /// second, capped at the turn rate (the odometry manoeuvres' turns).
+    fn turn_by(&self, err: f64, now: f64) -> Step {
+        let omega = (2.0 * err).clamp(-self.steering.turn_rate, self.steering.turn_rate);
+        Step::running(
+            MotorOutput::drive(DriveCommand::Turn { omega }).with_aux(raised()),
+            self.feedback(now),
+        )
     }
 
     /// Drive straight away from the dock (front first), raised, at the departure speed.
@@ -373,8 +385,6 @@ impl BujoldAgent {
         )
     }
 
-    /// Starts a repositioning to the staging point on the dock axis, from the estimated
-    /// pose in the dock frame (`view`) and the current odometry pose.
     /// The planning view with the median viewing angle of the last [`ALPHA_WINDOW`]
     /// reliable frames, when that window is full, the blocks are tall enough to trust and
     /// the robot is more than [`REPOSITION_LATERAL_M`] off the axis; `None` otherwise.
@@ -386,6 +396,8 @@ impl BujoldAgent {
         ((planning.distance * alpha.sin()).abs() > REPOSITION_LATERAL_M).then(|| planning.with_alpha(alpha))
     }
 
+    /// Starts a repositioning to the staging point on the dock axis, from the estimated
+    /// pose in the dock frame (`view`) and the current odometry pose.
     fn reposition(&mut self, view: &FiducialView, now: f64, odo: Pose2) {
         // Robot centre in the dock frame: the camera sits `rear_behind_camera − L/2` ahead
         // of the rear; near enough to treat the camera as the centre here.
@@ -410,8 +422,10 @@ impl BujoldAgent {
     }
 
     /// True when the search has turned for [`JAMMED_AFTER_S`] without the view changing
-    /// (and unjams are left). `change` is this frame's [`FrameChange`] cue.
-    fn search_jammed(&mut self, change: Option<f32>, now: f64) -> bool {
+    /// (and unjams are left). Takes this tick's frame into the [`FrameChange`] cue, which
+    /// runs only while searching.
+    fn search_jammed(&mut self, inputs: &Inputs<'_>, now: f64) -> bool {
+        let change = inputs.camera(0).and_then(|c| self.frame_change.observe(&c.image));
         match change {
             Some(c) if c < STILL_LEVELS => {
                 let since = *self.still_since.get_or_insert(now);
@@ -512,7 +526,6 @@ impl Behavior for BujoldAgent {
         // Perception runs every tick so adaptation follows the light, except while
         // imprinting (the imprint must not be mixed with adapted statistics).
         let percept = self.schema.perceive(inputs);
-        let change = inputs.camera(0).and_then(|c| self.frame_change.observe(&c.image));
         let mut view = FiducialView::from_percept(&percept, &self.geometry);
         let mut planning: Option<FiducialView> = None;
         if let Some(v) = view.as_mut() {
@@ -544,9 +557,7 @@ impl Behavior for BujoldAgent {
         if self.phase_start == f64::NEG_INFINITY {
             self.phase_start = now;
             self.odo_mark = odo;
-            if self.phase == Phase::Search {
-                self.start_heading = Some(odo.theta);
-            }
+            self.start_heading.get_or_insert(odo.theta);
         }
         let in_phase = now - self.phase_start;
         let dir = self.geometry.drive_dir;
@@ -631,7 +642,7 @@ impl Behavior for BujoldAgent {
                         FailureReason::TargetNeverDetected
                     };
                     self.fail(reason, now, odo, false)
-                } else if self.search_jammed(change, now) {
+                } else if self.search_jammed(inputs, now) {
                     // Beside the gate a corner catches the body: the tracks spin, the view
                     // does not move. Drive out, front first, and search again turning the
                     // other way, which swings the caught corner off the body.
@@ -656,11 +667,7 @@ impl Behavior for BujoldAgent {
                     self.enter(Phase::Unjam { stage: 1 }, now, odo);
                     self.hold(now)
                 } else {
-                    let w = (2.0 * err).clamp(-self.steering.turn_rate, self.steering.turn_rate);
-                    Step::running(
-                        MotorOutput::drive(DriveCommand::Turn { omega: w }).with_aux(raised()),
-                        self.feedback(now),
-                    )
+                    self.turn_by(err, now)
                 }
             }
             Phase::Unjam { .. } => {
@@ -753,10 +760,6 @@ impl Behavior for BujoldAgent {
                 let (dx, dy) = (target.x - odo.x, target.y - odo.y);
                 let dist = dx.hypot(dy);
                 let tol = 3f64.to_radians();
-                let turn = |err: f64| {
-                    let w = (2.0 * err).clamp(-self.steering.turn_rate, self.steering.turn_rate);
-                    MotorOutput::drive(DriveCommand::Turn { omega: w }).with_aux(raised())
-                };
                 match stage {
                     3 => {
                         // Clear the body: straight out, front first, 0.3 m.
@@ -792,7 +795,7 @@ impl Behavior for BujoldAgent {
                             self.phase = Phase::Reposition { stage: 1, target };
                             self.hold(now)
                         } else {
-                            Step::running(turn(err), self.feedback(now))
+                            self.turn_by(err, now)
                         }
                     }
                     1 => {
@@ -823,7 +826,7 @@ impl Behavior for BujoldAgent {
                             self.enter(Phase::Approach, now, odo);
                             self.hold(now)
                         } else {
-                            Step::running(turn(err), self.feedback(now))
+                            self.turn_by(err, now)
                         }
                     }
                 }
@@ -874,16 +877,16 @@ impl Agent for BujoldAgent {
         self.alpha_window.clear();
         self.retries = 0;
         self.unjams = 0;
-        self.start_heading = None;
         self.ever_seen = false;
         self.last_seen = None;
-        self.phase = match self.dock_hint {
-            // Ballistic region: drive by odometry to the approach zone's staging point and
-            // face along the axis, then look (the repositioning manoeuvre does exactly this).
-            Some(dock) => Phase::Reposition {
-                stage: 0,
-                target: dock.compose(&Pose2::new(BALLISTIC_STAGING_M, 0.0, 0.0)),
-            },
+        // Ballistic region: drive by odometry to the approach zone's staging point and face
+        // along the axis, then look (the repositioning manoeuvre does exactly this).
+        let staging = self
+            .dock_hint
+            .map(|dock| dock.compose(&Pose2::new(BALLISTIC_STAGING_M, 0.0, 0.0)));
+        self.start_heading = staging.map(|t| t.theta);
+        self.phase = match staging {
+            Some(target) => Phase::Reposition { stage: 0, target },
             None => Phase::Search,
         };
         self.phase_start = f64::NEG_INFINITY;
