@@ -102,10 +102,11 @@ pub struct Prepared {
     pub runs: Vec<RunSpec>,
 }
 
-/// Loads backdrops and builds the world for a loaded scenario.
+/// Loads backdrops, builds the world and lists the runs of a loaded scenario.
 ///
 /// # Errors
-/// [`SimError`] when a backdrop cannot be read or the world cannot be built.
+/// [`SimError`] when a backdrop cannot be read, the world cannot be built, or a start
+/// places the robot inside the dock's body (before any run, so no campaign stops midway).
 pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
     let dir = loaded.file.parent().unwrap_or(Path::new(".")).to_path_buf();
     let backdrops: Vec<Arc<RgbImage>> = loaded
@@ -116,6 +117,20 @@ pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
         .collect::<Result<_, _>>()?;
     let world = world::build(&loaded.profile, &loaded.scenario.clutter, &backdrops)?;
     let runs = loaded.scenario.runs(&loaded.profile);
+    let body = &loaded.profile.body;
+    if let Some(r) = runs
+        .iter()
+        .find(|r| super::dock::overlaps(&world.dock, &r.start.pose, body.length_m, body.width_m))
+    {
+        let p = r.start.pose;
+        return Err(SimError::InvalidStart(format!(
+            "start `{}` places the robot at ({:.3} m, {:.3} m, {:.1}°), overlapping the dock's body",
+            r.start.label,
+            p.x,
+            p.y,
+            p.theta.to_degrees()
+        )));
+    }
     Ok(Prepared { loaded, world, runs })
 }
 
@@ -219,28 +234,13 @@ pub fn run_one(
     let jx = pair.normal() * sc.starts.position_jitter_m;
     let jy = pair.normal() * sc.starts.position_jitter_m;
     let jt = pair.normal() * sc.starts.heading_jitter_deg.to_radians();
-    let (length, width) = (profile.body.length_m, profile.body.width_m);
-    let overlaps = |pose: &Pose2| super::dock::overlaps(&p.world.dock, pose, length, width);
-    if overlaps(&s.pose) {
-        return Err(SimError::InvalidStart(format!(
-            "start `{}` places the robot at ({:.3} m, {:.3} m, {:.1}°), overlapping the dock's body",
-            s.label,
-            s.pose.x,
-            s.pose.y,
-            s.pose.theta.to_degrees()
-        )));
-    }
-    // A start by the body may be jittered into it: the proctor's hand meets the body, so
-    // the robot is slid straight out from the entrance, 5 mm at a time, until it is clear.
-    let mut start = Pose2::new(s.pose.x + jx, s.pose.y + jy, s.pose.theta + jt);
-    let out_dir = start.y.atan2(start.x);
-    for _ in 0..100 {
-        if !overlaps(&start) {
-            break;
-        }
-        start.x += 0.005 * out_dir.cos();
-        start.y += 0.005 * out_dir.sin();
-    }
+    // `prepare` refused nominal starts inside the body; the jitter may still push one in.
+    let start = super::dock::slid_clear(
+        &p.world.dock,
+        Pose2::new(s.pose.x + jx, s.pose.y + jy, s.pose.theta + jt),
+        profile.body.length_m,
+        profile.body.width_m,
+    );
     sim.place(start, false);
     if sc.ballistic.enabled {
         // Odometry restarts at the placed pose: the dock's origin seen from there, with

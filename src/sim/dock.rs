@@ -57,6 +57,21 @@ pub fn overlaps(g: &DockGeometry, pose: &Pose2, length: f64, width: f64) -> bool
     robot_in_body || body_in_robot
 }
 
+/// `pose`, or, when it overlaps the body (a proctor's placement jittered into it), the
+/// pose slid straight out from the entrance in 5 mm steps until it is clear: the
+/// proctor's hand meets the body. Gives up after half a metre.
+pub fn slid_clear(g: &DockGeometry, mut pose: Pose2, length: f64, width: f64) -> Pose2 {
+    let (s, c) = pose.y.atan2(pose.x).sin_cos();
+    for _ in 0..100 {
+        if !overlaps(g, &pose, length, width) {
+            break;
+        }
+        pose.x += 0.005 * c;
+        pose.y += 0.005 * s;
+    }
+    pose
+}
+
 /// Judges a move from `from` to `to`.
 pub fn judge(
     g: &DockGeometry,
@@ -173,6 +188,20 @@ mod tests {
         assert!(overlaps(&g(), &diagonal, 0.4, 0.1));
         // Inside the body outright.
         assert!(overlaps(&g(), &Pose2::new(-0.6, 0.0, 0.0), l, w));
+        // A jittered start just inside is slid out radially, by less than 5 mm past contact;
+        // a clear one is left alone.
+        let jittered = Pose2::new(0.2, -0.524, -44.5f64.to_radians());
+        let slid = slid_clear(&g(), jittered, l, w);
+        assert!(!overlaps(&g(), &slid, l, w) && slid.theta == jittered.theta);
+        let r = jittered.x.hypot(jittered.y);
+        let back = Pose2::new(
+            slid.x - 0.005 * jittered.x / r,
+            slid.y - 0.005 * jittered.y / r,
+            slid.theta,
+        );
+        assert!(overlaps(&g(), &back, l, w), "one step back still overlaps");
+        let clear = Pose2::new(1.0, 0.0, 0.0);
+        assert_eq!(slid_clear(&g(), clear, l, w), clear);
     }
 
     #[test]
