@@ -72,9 +72,16 @@ pub fn parse_str<T: DeserializeOwned + Validate>(src: &str, file: &Path) -> Resu
 /// [`ConfigError::Io`] when the file cannot be read (or is not UTF-8), otherwise as
 /// [`parse_str`].
 pub fn load<T: DeserializeOwned + Validate>(path: &Path) -> Result<T, ConfigError> {
-    let src = std::fs::read_to_string(path).map_err(|e| ConfigError::Io {
+    parse_str(&read_source(path)?, path)
+}
+
+/// Reads a configuration file's text.
+///
+/// # Errors
+/// [`ConfigError::Io`] when the file cannot be read (or is not UTF-8).
+pub fn read_source(path: &Path) -> Result<String, ConfigError> {
+    std::fs::read_to_string(path).map_err(|e| ConfigError::Io {
         file: path.to_path_buf(),
         source: Arc::new(e),
-    })?;
-    parse_str(&src, path)
+    })
 }

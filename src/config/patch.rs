@@ -11,7 +11,7 @@
 //! value whole. The base's comments and layout are kept (edited with `toml_edit`), except
 //! a replaced value's trailing comment, which described the old value.
 
-use toml_edit::{DocumentMut, Item, Table};
+use toml_edit::{DocumentMut, Item, Table, TableLike};
 
 /// `base` (TOML text) with `patch` merged in, as TOML text.
 ///
@@ -30,7 +30,7 @@ pub fn patched(base: &str, patch: &toml::Table) -> Result<String, String> {
     Ok(doc.to_string())
 }
 
-fn merge(base: &mut Table, patch: &Table, path: &str) -> Result<(), String> {
+fn merge(base: &mut Table, patch: &dyn TableLike, path: &str) -> Result<(), String> {
     for (key, item) in patch.iter() {
         let here = if path.is_empty() {
             key.to_string()
@@ -38,7 +38,9 @@ fn merge(base: &mut Table, patch: &Table, path: &str) -> Result<(), String> {
             format!("{path}.{key}")
         };
         match (base.get_mut(key), item.as_table_like()) {
-            (Some(existing), Some(patch_table)) if !item.is_array_of_tables() => {
+            // A table (standard or inline) merges; anything else, arrays of tables
+            // included, is not table-like and replaces.
+            (Some(existing), Some(patch_table)) => {
                 if existing.is_inline_table() {
                     // Widen an inline table to a standard one so keys can be merged in.
                     let t = existing.as_inline_table().cloned().unwrap_or_default().into_table();
@@ -49,11 +51,7 @@ fn merge(base: &mut Table, patch: &Table, path: &str) -> Result<(), String> {
                         "`{here}` is not a table in the profile, so a table cannot patch it"
                     ));
                 };
-                let mut sub = Table::new();
-                for (k, v) in patch_table.iter() {
-                    sub.insert(k, v.clone());
-                }
-                merge(target, &sub, &here)?;
+                merge(target, patch_table, &here)?;
             }
             // Replacing in place keeps the key's leading comments (they usually describe a
             // section); the old value's trailing comment goes with it.
@@ -102,6 +100,14 @@ mod tests {
         assert_eq!(v["a"].as_array().unwrap().len(), 1);
         assert_eq!(v["m"]["x"].as_integer(), Some(1));
         assert_eq!(v["m"]["y"].as_integer(), Some(5));
+        // An array of tables is replaced whole too, not merged element by element.
+        let base = "[[cameras]]\nw = 1\nh = 1\n\n[[cameras]]\nw = 3\n";
+        let out = patched(base, &table("[[cameras]]\nw = 2\n")).unwrap();
+        let v: toml::Table = out.parse().unwrap();
+        let cams = v["cameras"].as_array().unwrap();
+        assert_eq!(cams.len(), 1);
+        assert_eq!(cams[0]["w"].as_integer(), Some(2));
+        assert!(cams[0].get("h").is_none(), "{out}");
     }
 
     #[test]

@@ -428,10 +428,7 @@ pub struct Loaded {
 /// reported against "the profile as patched by the scenario", without line numbers (the
 /// merged text exists only in memory).
 fn load_patched(profile_file: &Path, patch: &toml::Table, scenario_file: &Path) -> Result<Profile, ConfigError> {
-    let src = std::fs::read_to_string(profile_file).map_err(|e| ConfigError::Io {
-        file: profile_file.to_path_buf(),
-        source: std::sync::Arc::new(e),
-    })?;
+    let src = config::read_source(profile_file)?;
     let shown = PathBuf::from(format!(
         "{} as patched by [profile_patch] in {}",
         profile_file.display(),
