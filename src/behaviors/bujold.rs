@@ -254,9 +254,7 @@ impl BujoldAgent {
                     coercive_attraction: p.coercive_attraction,
                     gain: p.gain,
                     k_theta: p.k_theta,
-                    // The camera looks along the motion: keep the flap as far inside the
-                    // image as ratio steering's aim point does.
-                    max_off_sight: crate::schemas::ratio_steering::MAX_AIM_RAD,
+                    max_off_sight: p.max_off_sight_deg.to_radians(),
                     final_radius: p.final_radius_m,
                 })
             }
@@ -333,7 +331,6 @@ impl BujoldAgent {
         self.odo_mark = odo;
         self.samples.clear();
         self.still_since = None;
-        self.frame_change.reset();
     }
 
     fn travelled(&self, odo: &Pose2) -> f64 {
@@ -422,10 +419,8 @@ impl BujoldAgent {
     }
 
     /// True when the search has turned for [`JAMMED_AFTER_S`] without the view changing
-    /// (and unjams are left). Takes this tick's frame into the [`FrameChange`] cue, which
-    /// runs only while searching.
-    fn search_jammed(&mut self, inputs: &Inputs<'_>, now: f64) -> bool {
-        let change = inputs.camera(0).and_then(|c| self.frame_change.observe(&c.image));
+    /// (and unjams are left). `change` is this tick's [`FrameChange`] cue.
+    fn search_jammed(&mut self, change: Option<f32>, now: f64) -> bool {
         match change {
             Some(c) if c < STILL_LEVELS => {
                 let since = *self.still_since.get_or_insert(now);
@@ -526,6 +521,16 @@ impl Behavior for BujoldAgent {
         // Perception runs every tick so adaptation follows the light, except while
         // imprinting (the imprint must not be mixed with adapted statistics).
         let percept = self.schema.perceive(inputs);
+        // The frame-change cue is read only while searching. It also runs in the phases a
+        // search is entered from (approach, unjam), so a search's first frame is compared
+        // with the frame just before it; elsewhere (departure, decision, back-in,
+        // manoeuvres) it is skipped.
+        let change = match self.phase {
+            Phase::Search | Phase::Approach | Phase::Unjam { .. } => {
+                inputs.camera(0).and_then(|c| self.frame_change.observe(&c.image))
+            }
+            _ => None,
+        };
         let mut view = FiducialView::from_percept(&percept, &self.geometry);
         let mut planning: Option<FiducialView> = None;
         if let Some(v) = view.as_mut() {
@@ -642,7 +647,7 @@ impl Behavior for BujoldAgent {
                         FailureReason::TargetNeverDetected
                     };
                     self.fail(reason, now, odo, false)
-                } else if self.search_jammed(inputs, now) {
+                } else if self.search_jammed(change, now) {
                     // Beside the gate a corner catches the body: the tracks spin, the view
                     // does not move. Drive out, front first, and search again turning the
                     // other way, which swings the caught corner off the body.

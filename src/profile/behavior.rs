@@ -66,6 +66,16 @@ pub struct PotentialFieldGains {
     /// entrance (0, the default: no fading).
     #[serde(default)]
     pub final_radius_m: f64,
+    /// Largest angle between the field's direction and the line of sight to the dock,
+    /// degrees: a camera that looks along the motion keeps the dock in view with about
+    /// half its field of view less a margin (Bujold: 25° of a 70° lens). 180, the
+    /// default, leaves the field free.
+    #[serde(default = "free_field_deg")]
+    pub max_off_sight_deg: f64,
+}
+
+fn free_field_deg() -> f64 {
+    180.0
 }
 
 /// Gains and thresholds of RAPOSA's seven-state servo (seed 001 §II.D–E). The paper gives
@@ -234,6 +244,12 @@ pub(crate) fn validate_behavior(b: &BehaviorSpec, v: &mut Validator<'_>) {
                 v.positive("behavior.potential_field.gain", g.gain);
                 v.positive("behavior.potential_field.k_theta", g.k_theta);
                 v.non_negative("behavior.potential_field.final_radius_m", g.final_radius_m);
+                v.range(
+                    "behavior.potential_field.max_off_sight_deg",
+                    g.max_off_sight_deg,
+                    0.0,
+                    180.0,
+                );
             }
         },
         ApproachKind::SevenState => match &b.seven_state {
