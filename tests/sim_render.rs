@@ -349,3 +349,40 @@ fn a_glossy_highlight_peaks_at_a_dielectrics_fresnel_reflection() {
         "peak {peak:.4}, expected {expected:.4}"
     );
 }
+
+/// Backs `bujold::STILL_LEVELS` and `perception::frame_change`'s claims on rendered
+/// frames under the default sensor: between two frames of a still robot the cue stays
+/// well under the 1-level threshold; one 10 Hz tick of the search turn (25°/s, 2.5°)
+/// reads over three times it, beside the gate, at range and close on the axis (3.9,
+/// 3.4 and 8.0 when written; run with `--nocapture` to see them).
+#[test]
+fn the_frame_change_cue_separates_a_still_robot_from_a_turning_one() {
+    use marsupial::behaviors::bujold::STILL_LEVELS;
+    use marsupial::perception::frame_change::FrameChange;
+    let p = bujold();
+    let w = world::build(&p, &[], &[]).unwrap();
+    let cam = &p.cameras[0];
+    let light = LightingRun::new(LightingSpec::default().resolve(), &mut Rng::new(3), 200.0);
+    let sensor = SensorParams::default();
+    for (x, y, heading_deg) in [(0.3, -0.5, 110.0), (1.5, 0.4, 30.0), (0.8, 0.0, 0.0)] {
+        let mut r = Renderer::new(CameraModel::from_spec(cam), cam.width_px, cam.height_px, 1);
+        let mut out = RgbImage::default();
+        let mut cue = FrameChange::new();
+        let mut frame = |k: u64, deg: f64, cue: &mut FrameChange| {
+            let pose = camera_pose(&Pose2::new(x, y, f64::to_radians(heading_deg + deg)), &cam.mount);
+            r.render(&w.scene, &pose, &light.at(k as f64 * 0.1), &sensor, k, &mut out);
+            cue.observe(&out.view())
+        };
+        // Let auto-exposure settle on the view first.
+        for k in 0..20 {
+            frame(k, 0.0, &mut cue);
+        }
+        let still = (20..25)
+            .map(|k| frame(k, 0.0, &mut cue).unwrap())
+            .fold(0.0f32, f32::max);
+        let turned = frame(25, 2.5, &mut cue).unwrap();
+        eprintln!("({x}, {y}, {heading_deg}°): still ≤ {still:.2}, turned {turned:.2}");
+        assert!(still < 0.5 * STILL_LEVELS, "({x}, {y}): still reads {still}");
+        assert!(turned > 3.0 * STILL_LEVELS, "({x}, {y}): a turn reads {turned}");
+    }
+}

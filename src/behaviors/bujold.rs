@@ -209,7 +209,8 @@ pub const CLEARANCE_X_M: f64 = 0.45;
 /// Blocks at least this tall (px) give a viewing angle good enough to plan on.
 pub const RELIABLE_HEIGHT_PX: f64 = 40.0;
 /// A view changing less than this (mean 8-bit levels per frame, see [`FrameChange`]) is
-/// still: sensor noise reads 0.1–0.3, a turn tens of levels.
+/// still: pixel noise of ±6 levels reads under 0.5 (`frame_change`'s tests), one tick of
+/// the search turn 3.4–8 on rendered scenes (`tests/sim_render.rs`).
 pub const STILL_LEVELS: f32 = 1.0;
 /// The search turn jammed: the view still for this long while turning, s.
 pub const JAMMED_AFTER_S: f64 = 1.5;

@@ -5,8 +5,10 @@
 //! against the mother's body: the tracks spin either way. The camera can. Each frame is
 //! reduced to a 16 × 12 grid of mean brightness; the cue is the mean absolute difference
 //! between consecutive grids, in 8-bit levels. A turn at 25°/s moves a 70° image by a
-//! tenth of its width per 10 Hz frame and changes cells by tens of levels; a still robot
-//! sees only sensor noise, averaged over each cell's samples to a fraction of a level.
+//! twenty-eighth of its width per 10 Hz frame, which reads 3.4–8 levels on rendered
+//! Bujold scenes (`tests/sim_render.rs`); a still robot sees only sensor noise, averaged
+//! over each cell's samples to a fraction of a level (±6 levels of pixel noise read under
+//! 0.5, tested below).
 //! Lighting that changes (a flashing beacon) reads as motion, so the cue errs on the side
 //! of "moving".
 
@@ -118,8 +120,8 @@ mod tests {
         assert_eq!(c.observe(&frame(0, 6, 1).view()), None, "first frame");
         let still = c.observe(&frame(0, 6, 2).view()).unwrap();
         assert!(still < 0.5, "sensor noise only: {still}");
-        // A tenth of the width, as a 25°/s turn gives per 10 Hz frame.
-        let moved = c.observe(&frame(25, 6, 3).view()).unwrap();
+        // 8 px: what one 10 Hz tick of a 25°/s turn moves a 256-px, 70° image.
+        let moved = c.observe(&frame(8, 6, 3).view()).unwrap();
         assert!(moved > 10.0 * still.max(0.1) && moved > 5.0, "turning: {moved}");
     }
 
