@@ -23,6 +23,33 @@ fn run_bujold(name: &str, rest: &str) -> (Vec<campaign::RunRecord>, campaign::Su
     campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap()
 }
 
+/// Loads a shipped scenario at one trial per start, lets `setup` check and trim it, and
+/// runs the campaign.
+fn run_shipped(
+    file: &str,
+    setup: impl FnOnce(&mut marsupial::sim::scenario::Loaded),
+) -> (Vec<campaign::RunRecord>, campaign::Summary) {
+    let mut loaded = Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(file)).unwrap();
+    loaded.scenario.trials = 1;
+    setup(&mut loaded);
+    let p = campaign::prepare(loaded).unwrap();
+    campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap()
+}
+
+fn assert_docked(r: &campaign::RunRecord) {
+    assert!(r.success, "start {}: {} after {:.1} s", r.start, r.outcome, r.time_s);
+}
+
+/// The profile's tolerance at the entrance: ±2 cm, ±5°.
+fn assert_within_tolerance(r: &campaign::RunRecord) {
+    let (lateral, heading) = (r.entrance_lateral_m.unwrap(), r.entrance_heading_deg.unwrap());
+    assert!(
+        lateral.abs() <= 0.02 && heading.abs() <= 5.0,
+        "start {}: entered {lateral:+.3} m, {heading:+.1}°",
+        r.start
+    );
+}
+
 #[test]
 fn docks_from_starts_across_the_approach_zone() {
     let (records, summary) = run_bujold(
@@ -30,9 +57,9 @@ fn docks_from_starts_across_the_approach_zone() {
         "seed = 11\ntrials = 1\n[starts]\ngrid = \"paper16\"\nselect = [2, 5, 6, 8, 9, 14]\nposition_jitter_m = 0.02\nheading_jitter_deg = 3.0\n",
     );
     for r in &records {
-        assert!(r.success, "start {}: {} after {:.1} s", r.start, r.outcome, r.time_s);
+        assert_docked(r);
         assert_eq!(r.imprinted, Some(true));
-        assert!(r.entrance_lateral_m.unwrap().abs() <= 0.02 && r.entrance_heading_deg.unwrap().abs() <= 5.0);
+        assert_within_tolerance(r);
     }
     assert_eq!(summary.overall.successes, 6);
 }
@@ -42,19 +69,16 @@ fn docks_from_starts_across_the_approach_zone() {
 /// without the keep-in-view clamp, and from far on the axis.
 #[test]
 fn potential_field_approach_docks_from_the_wings() {
-    let mut loaded =
-        Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/bujold-potential.toml")).unwrap();
-    assert_eq!(
-        loaded.profile.behavior.approach,
-        marsupial::profile::ApproachKind::PotentialField
-    );
-    loaded.scenario.trials = 1;
-    loaded.scenario.starts.select = Some(vec![1, 4, 7, 12, 14, 16]);
-    let p = campaign::prepare(loaded).unwrap();
-    let (records, summary) = campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap();
+    let (records, summary) = run_shipped("scenarios/bujold-potential.toml", |loaded| {
+        assert_eq!(
+            loaded.profile.behavior.approach,
+            marsupial::profile::ApproachKind::PotentialField
+        );
+        loaded.scenario.starts.select = Some(vec![1, 4, 7, 12, 14, 16]);
+    });
     for r in &records {
-        assert!(r.success, "start {}: {} after {:.1} s", r.start, r.outcome, r.time_s);
-        assert!(r.entrance_lateral_m.unwrap().abs() <= 0.02 && r.entrance_heading_deg.unwrap().abs() <= 5.0);
+        assert_docked(r);
+        assert_within_tolerance(r);
     }
     assert_eq!(summary.overall.successes, 6);
 }
@@ -70,7 +94,7 @@ fn a_search_jammed_against_the_body_gets_free_and_docks() {
         "seed = 4\ntrials = 2\n[starts]\nposition_jitter_m = 0.01\nheading_jitter_deg = 3.0\npoints = [ { x_m = 0.2, y_m = -0.51, heading_deg = 45.0 }, { x_m = 0.2, y_m = 0.51, heading_deg = -45.0 } ]\n",
     );
     for r in &records {
-        assert!(r.success, "start {}: {} after {:.1} s", r.start, r.outcome, r.time_s);
+        assert_docked(r);
     }
     assert_eq!(summary.overall.successes, 4);
 }
@@ -80,15 +104,19 @@ fn a_search_jammed_against_the_body_gets_free_and_docks() {
 /// to the approach zone by odometry, acquires the flap and close-docks.
 #[test]
 fn ballistic_go_to_then_close_dock_from_beyond_sight() {
-    let mut loaded =
-        Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/bujold-ballistic.toml")).unwrap();
-    assert!(loaded.scenario.ballistic.enabled && loaded.scenario.ballistic.error_m > 0.0);
-    loaded.scenario.trials = 1;
-    let p = campaign::prepare(loaded).unwrap();
-    assert!(p.runs.len() >= 5 && p.runs.iter().all(|r| r.start.distance >= 3.0));
-    let (records, summary) = campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap();
+    let (records, summary) = run_shipped("scenarios/bujold-ballistic.toml", |loaded| {
+        assert!(loaded.scenario.ballistic.enabled && loaded.scenario.ballistic.error_m > 0.0);
+        assert!(
+            loaded
+                .scenario
+                .runs(&loaded.profile)
+                .iter()
+                .all(|r| r.start.distance >= 3.0)
+        );
+    });
+    assert!(records.len() >= 5);
     for r in &records {
-        assert!(r.success, "start {}: {} after {:.1} s", r.start, r.outcome, r.time_s);
+        assert_docked(r);
         assert!(r.path_m > 2.5, "start {}: drove only {:.2} m", r.start, r.path_m);
     }
     assert_eq!(summary.overall.successes, records.len());
