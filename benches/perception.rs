@@ -1,6 +1,6 @@
 //! Bujold's perceptual schema (SCT segmentation of both colours, labelling, pairing,
 //! adaptation) on 640×480 and 256×240 frames, with the per-stage split and the colour
-//! space conversions for reference. Targets (issue: colour perception): whole schema under
+//! space conversions for reference, and the search's frame-change cue. Targets (issue: colour perception): whole schema under
 //! 1 ms at 640×480 and under 0.25 ms at 256×240, one core.
 //!
 //! RAPOSA's pyramid schema (HSV segmentation of both bands, ellipses, blue regions, pair
@@ -54,6 +54,17 @@ fn bench_size(c: &mut Criterion, w: usize, h: usize) {
         b.iter(|| {
             t += 0.1;
             black_box(schema.process(black_box(&view), t).expect("frame"))
+        })
+    });
+    // The search's frame-change cue (Bujold's jam detection), alternating two frames.
+    let other = common::scene(w, h, 0.3, 2);
+    let mut cue = marsupial::perception::frame_change::FrameChange::new();
+    let mut flip = false;
+    g.bench_function("frame_change_cue", |b| {
+        b.iter(|| {
+            flip = !flip;
+            let v = if flip { other.view() } else { frame.view() };
+            black_box(cue.observe(black_box(&v)))
         })
     });
     let ranges = schema.model().ranges();
