@@ -1,0 +1,287 @@
+//! The camera sensor: white balance, exposure, shot and read noise, clipping and sRGB
+//! gamma, from linear scene radiance to 8-bit RGB.
+//!
+//! Auto-exposure moves only halfway toward the level this frame needs, in log terms, so a
+//! sudden light change over- or under-exposes the next few frames. Noise comes from a
+//! per-row offset into a seeded table of normal deviates, scaled per output level.
+
+use crate::perception::RgbImage;
+use crate::sim::rng::{NoiseTable, splitmix64};
+use crate::sim::scene::srgb_to_linear;
+
+/// Sensor settings (from the scenario).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorParams {
+    /// Read noise SD, in 8-bit linear units.
+    pub read_noise: f32,
+    /// Shot-noise scale: SD = shot·√(signal) in 8-bit linear units.
+    pub shot_noise: f32,
+    /// Fixed exposure multiplier when auto-exposure is off.
+    pub exposure: f32,
+    /// Follow the scene brightness.
+    pub auto_exposure: bool,
+    /// Mean linear level auto-exposure aims for (0–1).
+    pub target_level: f32,
+    /// Analogue gain.
+    pub gain: f32,
+    /// Per-channel white-balance multipliers (1, 1, 1 is neutral).
+    pub white_balance: [f32; 3],
+    /// Highlight protection of auto-exposure: the largest fraction of pixels allowed to
+    /// clip in any channel (1 = plain mean metering, which burns out a bright target in
+    /// front of a dark body).
+    pub highlight_clip: f32,
+}
+
+impl Default for SensorParams {
+    fn default() -> Self {
+        Self {
+            read_noise: 1.5,
+            shot_noise: 0.35,
+            exposure: 1.0,
+            auto_exposure: true,
+            target_level: 0.18,
+            gain: 1.0,
+            white_balance: [1.0; 3],
+            highlight_clip: 0.01,
+        }
+    }
+}
+
+/// Bins of the highlight histogram: sixteen per octave, from 2⁻¹² to 2⁴ of full scale.
+const HIGHLIGHT_BINS: usize = 256;
+
+/// Highlight-histogram bin of a linear level `v` > 0: the float's exponent and top four
+/// mantissa bits (sixteen equal steps per octave, none wider than 6.25 %), offset so 2⁻¹²
+/// is bin 0. No `log2` call: it runs on every sampled pixel.
+#[inline]
+fn octave_bin(v: f32) -> usize {
+    let code = (v.max(1e-30).to_bits() >> 19) as i64 - ((127 - 12) << 4);
+    code.clamp(0, HIGHLIGHT_BINS as i64 - 1) as usize
+}
+
+/// The upper edge (linear level) of highlight bin `b`.
+fn octave_bin_top(b: usize) -> f32 {
+    f32::from_bits((((b as u32) + 1 + ((127 - 12) << 4)) << 19).min(0x7f7f_ffff))
+}
+
+/// Entries of the linear → sRGB table (a power of two, so an index is masked, not checked).
+const LUT_LEN: usize = 1 << 12;
+const LUT_MAX: f32 = (LUT_LEN - 1) as f32;
+
+/// ⌊x⌋ for x in [0, 2²²), by the float-rounding trick: adding 1.5·2²³ leaves the integer
+/// part in the low mantissa bits. Unlike `as i32`, which must saturate and map NaN, it
+/// compiles to plain vector adds, so the pass that scales a row into table indices
+/// vectorises. (An exact integer x may round down to x − 1: one table step, 1/4095 of full
+/// scale.)
+#[inline(always)]
+fn floor_index(x: f32) -> i32 {
+    const MAGIC: f32 = 12_582_912.0; // 1.5 · 2²³
+    (x - 0.5 + MAGIC).to_bits() as i32 - MAGIC.to_bits() as i32
+}
+
+/// The sensor's state across frames: exposure, and the tables it reuses.
+#[derive(Debug, Clone)]
+pub(super) struct Sensor {
+    noise: NoiseTable,
+    /// Linear level (× `LUT_MAX`) → sRGB byte.
+    to_srgb: Box<[u8; LUT_LEN]>,
+    /// Linear level (0–1) of each output byte.
+    level_lin: [f32; 256],
+    /// Output levels per 8-bit linear unit at each output byte: the sRGB curve's slope.
+    level_slope: [f32; 256],
+    /// This frame's noise SD per output byte, in output levels.
+    sd_out: [i32; 256],
+    /// This frame's linear level (× `LUT_MAX`) → output byte | its noise SD << 8: one
+    /// lookup per channel instead of two dependent ones.
+    level_and_sd: Box<[i32; LUT_LEN]>,
+    /// White-balance × exposure gain per value of a row (r, g, b, r, g, b, …).
+    row_gain: Vec<f32>,
+    /// Per value of a row: its table index, then its table entry.
+    row_code: Vec<i32>,
+    exposure: f32,
+    /// Histogram of sampled pixels' brightest channel, by [`octave_bin`].
+    highlights: [u32; HIGHLIGHT_BINS],
+}
+
+impl Sensor {
+    /// A sensor whose noise table is seeded by `noise_seed`.
+    pub fn new(noise_seed: u64) -> Self {
+        let mut to_srgb = Box::new([0u8; LUT_LEN]);
+        for (i, o) in to_srgb.iter_mut().enumerate() {
+            let l = i as f32 / LUT_MAX;
+            let s = if l <= 0.003_130_8 {
+                12.92 * l
+            } else {
+                1.055 * l.powf(1.0 / 2.4) - 0.055
+            };
+            *o = (s * 255.0 + 0.5).clamp(0.0, 255.0) as u8;
+        }
+        let mut level_lin = [0.0; 256];
+        let mut level_slope = [0.0; 256];
+        for level in 0..256 {
+            let s = level as f32 / 255.0;
+            let lin = srgb_to_linear(s);
+            let lin2 = srgb_to_linear((s + 1.0 / 255.0).min(1.0));
+            level_lin[level] = lin;
+            level_slope[level] = if lin2 > lin {
+                (1.0 / 255.0) / (lin2 - lin) / 255.0
+            } else {
+                1.0
+            };
+        }
+        Self {
+            noise: NoiseTable::new(noise_seed),
+            to_srgb,
+            level_lin,
+            level_slope,
+            sd_out: [0; 256],
+            level_and_sd: Box::new([0; LUT_LEN]),
+            row_gain: Vec::new(),
+            row_code: Vec::new(),
+            exposure: 1.0,
+            highlights: [0; HIGHLIGHT_BINS],
+        }
+    }
+
+    /// Current exposure multiplier.
+    pub fn exposure(&self) -> f32 {
+        self.exposure
+    }
+
+    /// Exposes `radiance` (linear, row-major, `width` wide) into `out`; `frame_seed` picks
+    /// this frame's noise. Leaves `radiance` zeroed for the next frame: each row is cleared
+    /// as soon as it is read, while it is in cache.
+    #[allow(
+        clippy::manual_clamp,
+        reason = "max/min send NaN to 0 and vectorise; clamp keeps NaN"
+    )]
+    pub fn expose(
+        &mut self,
+        radiance: &mut [[f32; 3]],
+        width: usize,
+        params: &SensorParams,
+        frame_seed: u64,
+        out: &mut RgbImage,
+    ) {
+        let height = radiance.len() / width.max(1);
+        out.resize(width, height);
+        if params.auto_exposure {
+            self.meter(radiance, params);
+        } else {
+            self.exposure = params.exposure;
+        }
+        let k = self.exposure * params.gain;
+        let wb = [0, 1, 2].map(|c| params.white_balance[c] * k * LUT_MAX);
+        // Noise SD per output level: read noise (amplified when the scene is dark and the
+        // camera's gain is up) plus shot noise ∝ √signal, both taken through the slope of
+        // the sRGB curve at that level.
+        let read = params.read_noise * k.max(1.0).sqrt();
+        for ((sd, lin), slope) in self.sd_out.iter_mut().zip(&self.level_lin).zip(&self.level_slope) {
+            let sd_lin = read + params.shot_noise * (lin * 255.0).sqrt();
+            *sd = (sd_lin * slope.min(8.0)).round() as i32;
+        }
+        for (e, &g) in self.level_and_sd.iter_mut().zip(self.to_srgb.iter()) {
+            *e = g as i32 | (self.sd_out[g as usize] << 8);
+        }
+        let lut = &*self.level_and_sd;
+        let row_len = width * 3;
+        // The white balance repeated along a row, so the scaling pass is one flat loop.
+        self.row_gain.clear();
+        self.row_gain.extend((0..row_len).map(|i| wb[i % 3]));
+        self.row_code.resize(row_len, 0);
+        let (gain, code) = (&self.row_gain[..row_len], &mut self.row_code[..row_len]);
+        for (y, (rad_row, out_row)) in radiance
+            .chunks_exact_mut(width)
+            .zip(out.as_bytes_mut().chunks_exact_mut(row_len))
+            .enumerate()
+        {
+            // Three passes per row; the first and last vectorise, the middle one is the
+            // table lookup. Scale into table indices (max/min also send NaN to 0):
+            for ((c, &r), &g) in code.iter_mut().zip(rad_row.as_flattened()).zip(gain) {
+                *c = floor_index((r * g).max(0.0).min(LUT_MAX));
+            }
+            rad_row.as_flattened_mut().fill(0.0);
+            // look up the output byte and its noise SD,
+            for c in code.iter_mut() {
+                *c = lut[*c as usize & (LUT_LEN - 1)];
+            }
+            // and add noise. Each row reads the noise table sequentially from a random
+            // start: cache friendly, and no visible repetition between rows or frames.
+            let start = splitmix64(frame_seed ^ ((y as u64) << 32)) as usize;
+            let noise = self.noise.window(start, row_len);
+            for ((o, &e), &n) in out_row.iter_mut().zip(code.iter()).zip(noise) {
+                let v = (e & 0xFF) + ((n as i32 * (e >> 8)) >> 8);
+                *o = v.clamp(0, 255) as u8;
+            }
+        }
+    }
+
+    /// Auto-exposure: the mean green level, subsampled, and a histogram of each sample's
+    /// brightest white-balanced channel. The exposure aims the mean at the target unless
+    /// that would clip more than `highlight_clip` of the pixels, then it protects the
+    /// highlights. It adapts partly toward the aim each frame (camera lag).
+    fn meter(&mut self, radiance: &[[f32; 3]], params: &SensorParams) {
+        let mut sum = 0.0f32;
+        let mut n = 0u32;
+        self.highlights.fill(0);
+        let wbn = params.white_balance;
+        for px in radiance.iter().step_by(7) {
+            sum += px[1];
+            n += 1;
+            let m = (px[0] * wbn[0]).max(px[1] * wbn[1]).max(px[2] * wbn[2]);
+            self.highlights[octave_bin(m)] += 1;
+        }
+        let mean = (sum / n.max(1) as f32).max(1e-4);
+        let mut want = params.target_level / mean;
+        let allowed = (params.highlight_clip.clamp(0.0, 1.0) * n as f32) as u32;
+        if allowed < n {
+            let mut above = 0u32;
+            for b in (0..HIGHLIGHT_BINS).rev() {
+                above += self.highlights[b];
+                if above > allowed {
+                    want = want.min(1.0 / (octave_bin_top(b) * params.gain.max(1e-6)));
+                    break;
+                }
+            }
+        }
+        self.exposure *= (want / self.exposure).powf(0.5);
+        self.exposure = self.exposure.clamp(1e-3, 1e3);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn floor_index_matches_the_cast_off_integers() {
+        let mut x = 0.0f32;
+        while x < LUT_MAX {
+            let want = x as i32;
+            let got = floor_index(x);
+            if x.fract() == 0.0 {
+                assert!(got == want || got == want - 1, "{x}: {got}");
+            } else {
+                assert_eq!(got, want, "{x}");
+            }
+            x += 0.173;
+        }
+        assert_eq!(floor_index(0.0), 0);
+        assert_eq!(floor_index(LUT_MAX - 0.001), LUT_MAX as i32 - 1);
+        assert!(floor_index(LUT_MAX) >= LUT_MAX as i32 - 1);
+    }
+
+    #[test]
+    fn octave_bins_bracket_their_values() {
+        for k in 0..2000 {
+            let v = 2f32.powf(-11.5 + k as f32 * 0.0075);
+            let b = octave_bin(v);
+            assert!(octave_bin_top(b) >= v, "{v}: bin {b} tops at {}", octave_bin_top(b));
+            assert!(b == 0 || octave_bin_top(b - 1) <= v, "{v}: bin {b}");
+            // Sixteen steps per octave, none wider than 6.25 %.
+            assert!(octave_bin_top(b) <= v * 1.0625 * 1.0001);
+        }
+        assert_eq!(octave_bin(0.0), 0);
+        assert_eq!(octave_bin(1e9), HIGHLIGHT_BINS - 1);
+    }
+}
