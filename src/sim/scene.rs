@@ -36,6 +36,16 @@ pub enum Material {
     },
     /// A photo stretched over the primitive (row 0 at b = +half_v, column 0 at a = −half_u).
     Image(Arc<RgbImage>),
+    /// Circular fiducials printed on a `base`-coloured surface (Axel's central module):
+    /// see [`CircleMark`] for the pattern.
+    Circles {
+        /// Albedo of the surface between the marks.
+        base: [f32; 3],
+        /// Outer radius of every mark's black disc, m.
+        radius: f32,
+        /// The marks.
+        marks: Arc<[CircleMark]>,
+    },
     /// Value noise in cells of `cell` metres around `base` with relative contrast `contrast`.
     Noise {
         /// Mean albedo.
@@ -45,6 +55,33 @@ pub enum Material {
         /// Cell size, m.
         cell: f32,
     },
+}
+
+/// One circular fiducial at local (a, b) of its surface. Seen from the front, with outer
+/// radius R: a white margin out to 1.3 R, a black disc of radius R, a white ring from
+/// 0.6 R to 0.8 R (so the black and white blobs share a centroid, which is what a detector
+/// pairs), and in the black core a white bar 0.24 R wide through the centre. The bar's
+/// direction is the mark's rotation (0: along the surface's u axis, counter-clockwise
+/// toward v); −45°, 0°, 45° and 90° are the four distinct ones, as the bar is symmetric.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CircleMark {
+    /// Centre, along u, m.
+    pub a: f32,
+    /// Centre, along v, m.
+    pub b: f32,
+    /// Bar direction (cos, sin) in (u, v).
+    pub dir: [f32; 2],
+}
+
+impl CircleMark {
+    /// A mark centred at (a, b) whose bar is turned `rotation_rad` from the u axis.
+    pub fn new(a: f32, b: f32, rotation_rad: f32) -> Self {
+        Self {
+            a,
+            b,
+            dir: [rotation_rad.cos(), rotation_rad.sin()],
+        }
+    }
 }
 
 /// Geometry of a primitive.

@@ -4,9 +4,9 @@
 //! the dock along its axis, +z up. The mother's (or station's) body lies at x < 0.
 
 use super::SimError;
-use super::scene::{Material, Prim, Scene, Shape, Tag, albedo, boxed};
+use super::scene::{CircleMark, Material, Prim, Scene, Shape, Tag, albedo, boxed};
 use crate::perception::RgbImage;
-use crate::profile::{NamedColor, Profile};
+use crate::profile::{CirclesSpec, NamedColor, Profile};
 use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
@@ -288,9 +288,11 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
             Material::Solid(albedo([30, 30, 32], 1.0)),
             Tag::Body,
         ));
+    } else if let Some(circles) = &profile.fiducial.circles {
+        build_central_module(circles, &mut dock, &mut prims, &mut target_prims, body_grey);
     } else {
         return Err(SimError::Unsupported(format!(
-            "the simulator builds two-block and pyramid targets so far; profile `{}` has another fiducial",
+            "the simulator builds two-block, pyramid and circle targets so far; profile `{}` has another fiducial",
             profile.name
         )));
     }
@@ -336,6 +338,117 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
         dock,
         target_prims,
     })
+}
+
+/// Height of the docking cone's mouth on Axel's central module; the fiducial face starts
+/// above it.
+const CONE_MOUTH_HEIGHT: f64 = 0.25;
+
+/// Axel's central module (seed 000): a box body whose front face (x = 0, facing +x)
+/// carries the circle fiducials at their placements, above the funnel-like docking cone.
+/// The cone's mouth, `entrance_width_m` wide and [`CONE_MOUTH_HEIGHT`] high at the
+/// ground, narrows over the dock depth to a throat a quarter as wide, which the
+/// caster arm must enter. The body is 1 m deep and wide enough for the mouth and the
+/// marks; it is tall enough for the highest mark.
+fn build_central_module(
+    circles: &CirclesSpec,
+    dock: &mut DockGeometry,
+    prims: &mut Vec<Prim>,
+    target_prims: &mut Vec<usize>,
+    body_grey: [f32; 3],
+) {
+    let radius = circles.diameter_m / 2.0;
+    let margin = 1.3 * radius + 0.05;
+    let widest = circles.placements.iter().map(|p| p.y_m.abs()).fold(0.0, f64::max);
+    let highest = circles.placements.iter().map(|p| p.z_m).fold(0.0, f64::max);
+    dock.body_length = 1.0;
+    dock.body_half_width = (widest + margin).max(dock.entrance_half + 0.05);
+    let (w2, top, z0) = (dock.body_half_width, highest + margin, CONE_MOUTH_HEIGHT);
+    let mut body = boxed(
+        Point3::new(-dock.body_length, -w2, 0.0),
+        Point3::new(0.0, w2, top),
+        Material::Solid(body_grey),
+        Tag::Body,
+    );
+    body.remove(0); // the front face is rebuilt: marks above, the cone's mouth below
+    prims.extend(body);
+    let (face_h, face_zc) = ((top - z0) / 2.0, (top + z0) / 2.0);
+    let marks: Vec<CircleMark> = circles
+        .placements
+        .iter()
+        .map(|p| {
+            CircleMark::new(
+                p.y_m as f32,
+                (p.z_m - face_zc) as f32,
+                p.rotation_deg.to_radians() as f32,
+            )
+        })
+        .collect();
+    target_prims.push(prims.len());
+    prims.push(Prim::new(
+        Shape::Rect {
+            centre: Point3::new(0.0, 0.0, face_zc),
+            u: y_axis(),
+            v: z_axis(),
+            half: [w2, face_h],
+        },
+        Material::Circles {
+            base: body_grey,
+            radius: radius as f32,
+            marks: marks.into(),
+        },
+        Tag::Target,
+    ));
+    // Beside the mouth, the front face comes down to the ground.
+    let e = dock.entrance_half;
+    for (y0, y1) in [(-w2, -e), (e, w2)] {
+        if y1 - y0 > 1e-6 {
+            prims.push(Prim::new(
+                Shape::Rect {
+                    centre: Point3::new(0.0, (y0 + y1) / 2.0, z0 / 2.0),
+                    u: y_axis(),
+                    v: z_axis(),
+                    half: [(y1 - y0) / 2.0, z0 / 2.0],
+                },
+                Material::Solid(body_grey),
+                Tag::Body,
+            ));
+        }
+    }
+    // The cone: four walls from the mouth to the throat, and the dark throat.
+    let d = dock.depth;
+    let (te, tz) = (e / 4.0, z0 / 2.0);
+    let mouth = [
+        Point3::new(0.0, -e, 0.0),
+        Point3::new(0.0, e, 0.0),
+        Point3::new(0.0, e, z0),
+        Point3::new(0.0, -e, z0),
+    ];
+    let throat = [
+        Point3::new(-d, -te, 0.0),
+        Point3::new(-d, te, 0.0),
+        Point3::new(-d, te, tz),
+        Point3::new(-d, -te, tz),
+    ];
+    let cone = Material::Solid(albedo([95, 97, 100], 1.0));
+    for i in 0..4 {
+        let j = (i + 1) % 4;
+        for p in [[mouth[i], mouth[j], throat[j]], [mouth[i], throat[j], throat[i]]] {
+            let mut t = Prim::new(Shape::Triangle { p }, cone.clone(), Tag::Body);
+            t.two_sided = true;
+            prims.push(t);
+        }
+    }
+    prims.push(Prim::new(
+        Shape::Rect {
+            centre: Point3::new(-d, 0.0, tz / 2.0),
+            u: y_axis(),
+            v: z_axis(),
+            half: [te, tz / 2.0],
+        },
+        Material::Solid(albedo([20, 20, 22], 1.0)),
+        Tag::Body,
+    ));
 }
 
 fn add_clutter(prims: &mut Vec<Prim>, c: &ClutterSpec, profile: &Profile) {

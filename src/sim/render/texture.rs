@@ -7,7 +7,7 @@
 
 use super::hits::cov;
 use crate::perception::RgbImage;
-use crate::sim::scene::{Material, srgb_to_linear};
+use crate::sim::scene::{CircleMark, Material, srgb_to_linear};
 use std::sync::LazyLock;
 
 /// Linear value of each sRGB byte, scaled by the 0.8 reflectance a printed photo has.
@@ -56,6 +56,15 @@ pub(super) enum Texture<'a> {
         /// Rows per metre of −b, and the row at b = 0.
         sy: f32,
     },
+    /// Circular fiducials on a base colour.
+    Circles {
+        /// Albedo between the marks.
+        base: [f32; 3],
+        /// Outer radius, m.
+        radius: f32,
+        /// The marks.
+        marks: &'a [CircleMark],
+    },
     /// Value noise.
     Noise {
         /// Mean albedo.
@@ -80,6 +89,11 @@ impl<'a> Texture<'a> {
                 im,
                 sx: im.width() as f32 / (2.0 * half[0]),
                 sy: im.height() as f32 / (2.0 * half[1]),
+            },
+            Material::Circles { base, radius, marks } => Self::Circles {
+                base: *base,
+                radius: *radius,
+                marks,
             },
             Material::Noise { base, contrast, cell } => Self::Noise {
                 base: *base,
@@ -107,6 +121,7 @@ impl<'a> Texture<'a> {
                 let lin = &*PHOTO_LINEAR;
                 [lin[p[0] as usize], lin[p[1] as usize], lin[p[2] as usize]]
             }
+            Self::Circles { base, radius, marks } => circles(*base, *radius, marks, a, b, fp),
             Self::Noise {
                 base,
                 contrast,
@@ -138,6 +153,38 @@ impl<'a> Texture<'a> {
         }
         Some(base)
     }
+}
+
+/// Albedo of printed paper: the white margin and ring of a circle mark.
+const MARK_WHITE: f32 = 0.85;
+/// Albedo of the black print (a matte black ink's floor).
+const MARK_BLACK: f32 = 0.04;
+
+/// A circle-mark surface at (a, b): the pattern of [`CircleMark`], each edge anti-aliased
+/// over the footprint `fp`.
+#[inline]
+fn circles(base: [f32; 3], radius: f32, marks: &[CircleMark], a: f32, b: f32, fp: f32) -> [f32; 3] {
+    let fp = fp.max(1e-6);
+    let reach = 1.3 * radius + fp;
+    for m in marks {
+        let (da, db) = (a - m.a, b - m.b);
+        let r2 = da * da + db * db;
+        if r2 >= reach * reach {
+            continue;
+        }
+        let r = r2.sqrt();
+        let inside = |edge: f32| cov((edge - r) / fp);
+        let margin = inside(1.3 * radius);
+        let core = inside(0.6 * radius);
+        let ring = inside(0.8 * radius) - core;
+        let off_bar = (db * m.dir[0] - da * m.dir[1]).abs();
+        let bar = core * cov((0.12 * radius - off_bar) / fp);
+        let black = (inside(radius) - ring - bar).max(0.0);
+        let white = (margin - black).max(0.0);
+        let rest = 1.0 - margin;
+        return base.map(|c| c * rest + MARK_WHITE * white + MARK_BLACK * black);
+    }
+    base
 }
 
 /// Value noise's albedo multiplier at (a, b) for footprint `fp`: texture finer than the
@@ -197,6 +244,31 @@ mod tests {
             Texture::new(&Material::Solid([0.5; 3]), [1.0; 2]).noise_row(&a, &b, &fp, &mut gain),
             None
         );
+    }
+
+    #[test]
+    fn a_circle_mark_has_its_rings_and_its_bar_where_specified() {
+        let base = [0.3, 0.3, 0.3];
+        let r = 0.05;
+        // Mark at (0.1, 0.2) with its bar turned 90°: along v.
+        let m = Material::Circles {
+            base,
+            radius: r,
+            marks: Arc::from(vec![CircleMark::new(0.1, 0.2, std::f32::consts::FRAC_PI_2)]),
+        };
+        let t = Texture::new(&m, [1.0; 2]);
+        let at = |da: f32, db: f32| t.sample(0.1 + da, 0.2 + db, 1e-4)[0];
+        assert_eq!(at(0.0, 0.0), MARK_WHITE, "the bar crosses the centre");
+        assert_eq!(at(0.0, 0.5 * r), MARK_WHITE, "and runs along v");
+        assert_eq!(at(0.5 * r, 0.0), MARK_BLACK, "the core beside the bar is black");
+        assert_eq!(at(-0.7 * r, 0.0), MARK_WHITE, "the white ring");
+        assert_eq!(at(0.0, -0.9 * r), MARK_BLACK, "the black outer ring");
+        assert_eq!(at(0.7, 0.0), 0.3, "far away: the surface");
+        assert_eq!(at(1.2 * r, 0.0), MARK_WHITE, "the margin");
+        assert_eq!(at(2.0 * r, 0.0), 0.3, "beyond it, the surface");
+        // Anti-aliased: a footprint as wide as the ring averages it with the black around.
+        let blurred = t.sample(0.1 - 0.7 * r, 0.2, 0.4 * r)[0];
+        assert!(blurred > MARK_BLACK && blurred < MARK_WHITE, "{blurred}");
     }
 
     #[test]

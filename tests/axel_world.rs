@@ -1,0 +1,142 @@
+//! Axel's central module in the simulator: the eight circle fiducials appear where both
+//! cameras of the stereo pair project them, with their pattern (black core, white ring,
+//! black rim) and their bars turned as the profile places them.
+
+use marsupial::geometry::Pose2;
+use marsupial::perception::RgbImage;
+use marsupial::perception::camera_model::CameraModel;
+use marsupial::profile::Profile;
+use marsupial::sim::camera::camera_pose;
+use marsupial::sim::lighting::LightState;
+use marsupial::sim::render::{Renderer, SensorParams};
+use marsupial::sim::scene::Tag;
+use marsupial::sim::world;
+use nalgebra::Point3;
+use std::path::Path;
+
+fn axel() -> Profile {
+    Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/axel.toml")).unwrap()
+}
+
+fn quiet() -> SensorParams {
+    SensorParams {
+        read_noise: 0.0,
+        shot_noise: 0.0,
+        auto_exposure: false,
+        exposure: 1.0,
+        ..SensorParams::default()
+    }
+}
+
+/// Grey level (green channel) at the pixel containing `px`.
+fn level(im: &RgbImage, px: [f64; 2]) -> u8 {
+    im.view().get(px[0] as usize, px[1] as usize).expect("in view")[1]
+}
+
+#[test]
+fn both_cameras_see_every_circle_where_their_models_project_it() {
+    let p = axel();
+    let circles = p.fiducial.circles.clone().expect("axel has circles");
+    let w = world::build(&p, &[], &[]).expect("axel world");
+    assert_eq!(w.target_prims.len(), 1, "the marked face is the target");
+    let radius = circles.diameter_m / 2.0;
+    // 1.6 m out on the axis, a little to one side, facing the module.
+    let robot = Pose2::new(1.6, 0.1, std::f64::consts::PI - 0.05);
+    let mut centres_x = Vec::new();
+    for cam in &p.cameras {
+        let model = CameraModel::from_spec(cam);
+        let mut r = Renderer::new(model.clone(), cam.width_px, cam.height_px, 1);
+        let pose = camera_pose(&robot, &cam.mount);
+        let mut im = RgbImage::default();
+        r.render(&w.scene, &pose, &LightState::uniform(1.0), &quiet(), 0, &mut im);
+        let project = |q: Point3<f64>| {
+            let c = pose.rotation.transpose() * (q - pose.position);
+            model.project(&c).expect("in front of the camera")
+        };
+        let mut xs = Vec::new();
+        for (i, pl) in circles.placements.iter().enumerate() {
+            let at = |along: f64, across: f64| {
+                // Offsets in the face's (u = +y, v = +z) along and across the bar.
+                let rot = pl.rotation_deg.to_radians();
+                let (c, s) = (rot.cos(), rot.sin());
+                Point3::new(0.0, pl.y_m + along * c - across * s, pl.z_m + along * s + across * c)
+            };
+            let centre = project(at(0.0, 0.0));
+            // The pattern, read across and along the bar.
+            let core = level(&im, project(at(0.0, 0.4 * radius)));
+            let ring = level(&im, project(at(0.0, 0.7 * radius)));
+            let rim = level(&im, project(at(0.0, -0.9 * radius)));
+            let bar = level(&im, project(at(0.4 * radius, 0.0)));
+            let margin = level(&im, project(at(0.0, 1.15 * radius)));
+            assert!(core < 90 && rim < 90, "{} circle {i}: core {core}, rim {rim}", cam.name);
+            assert!(
+                ring > 170 && bar > 170 && margin > 170,
+                "{} circle {i}: ring {ring}, bar {bar}, margin {margin}",
+                cam.name
+            );
+            // The dark pixels' centroid is the projected centre (the pattern is symmetric
+            // under a half turn), to a fraction of a pixel.
+            let reach = (project(at(0.0, 1.0 * radius))[1] - centre[1])
+                .abs()
+                .max((project(at(1.0 * radius, 0.0))[0] - centre[0]).abs())
+                + 3.0;
+            let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+            for y in (centre[1] - reach) as usize..=(centre[1] + reach) as usize {
+                for x in (centre[0] - reach) as usize..=(centre[0] + reach) as usize {
+                    let d = 255.0 - im.view().get(x, y).unwrap()[1] as f64;
+                    let (dx, dy) = (x as f64 + 0.5 - centre[0], y as f64 + 0.5 - centre[1]);
+                    if d > 60.0 && dx * dx + dy * dy <= reach * reach {
+                        sx += (x as f64 + 0.5) * d;
+                        sy += (y as f64 + 0.5) * d;
+                        n += d;
+                    }
+                }
+            }
+            let (cx, cy) = (sx / n, sy / n);
+            assert!(
+                (cx - centre[0]).abs() < 0.5 && (cy - centre[1]).abs() < 0.5,
+                "{} circle {i}: centroid ({cx:.2}, {cy:.2}) vs projected ({:.2}, {:.2})",
+                cam.name,
+                centre[0],
+                centre[1]
+            );
+            xs.push(centre[0]);
+        }
+        centres_x.push(xs);
+    }
+    // The pair's disparity: the left camera (+y) sees every circle further right.
+    for (l, r) in centres_x[0].iter().zip(&centres_x[1]) {
+        assert!(l - r > 50.0, "disparity {}", l - r);
+    }
+}
+
+#[test]
+fn the_module_body_blocks_starts_and_the_cone_is_its_dock() {
+    let p = axel();
+    let w = world::build(&p, &[], &[]).expect("axel world");
+    let dock = w.dock;
+    assert!(!dock.open && !dock.needs_lowered);
+    assert_eq!(dock.entrance_half, p.dock.unwrap().entrance_width_m / 2.0);
+    assert!(dock.body_half_width >= dock.entrance_half, "the mouth fits the face");
+    let widest = p
+        .fiducial
+        .circles
+        .unwrap()
+        .placements
+        .iter()
+        .map(|q| q.y_m.abs())
+        .fold(0.0, f64::max);
+    assert!(dock.body_half_width > widest + 0.05, "every mark is on the face");
+    // The module lies behind its face (x ≤ 0), within its footprint.
+    for prim in w
+        .scene
+        .prims
+        .iter()
+        .filter(|q| matches!(q.tag, Tag::Body | Tag::Target))
+    {
+        for q in prim.bounds().as_slice() {
+            assert!(q.x <= 1e-9 && q.x >= -dock.body_length - 1e-9, "{q:?}");
+            assert!(q.y.abs() <= dock.body_half_width + 1e-9, "{q:?}");
+        }
+    }
+}
