@@ -351,10 +351,10 @@ fn a_glossy_highlight_peaks_at_a_dielectrics_fresnel_reflection() {
 }
 
 /// Backs `bujold::STILL_LEVELS` and `perception::frame_change`'s claims on rendered
-/// frames under the default sensor: between two frames of a still robot the cue stays
-/// well under the 1-level threshold; one 10 Hz tick of the search turn (25°/s, 2.5°)
-/// reads over three times it, beside the gate, at range and close on the axis (3.9,
-/// 3.4 and 8.0 when written; run with `--nocapture` to see them).
+/// frames under the default sensor's full noise: between two frames of a still robot the
+/// cue stays at half the 1-level threshold (0.42–0.50 when written); one 10 Hz tick of
+/// the search turn (25°/s, 2.5°) reads over three times it, beside the gate, at range and
+/// close on the axis (3.9, 3.6 and 8.2; run with `--nocapture` to see them).
 #[test]
 fn the_frame_change_cue_separates_a_still_robot_from_a_turning_one() {
     use marsupial::behaviors::bujold::STILL_LEVELS;
@@ -382,7 +382,7 @@ fn the_frame_change_cue_separates_a_still_robot_from_a_turning_one() {
             .fold(0.0f32, f32::max);
         let turned = frame(25, 2.5, &mut cue).unwrap();
         eprintln!("({x}, {y}, {heading_deg}°): still ≤ {still:.2}, turned {turned:.2}");
-        assert!(still < 0.5 * STILL_LEVELS, "({x}, {y}): still reads {still}");
+        assert!(still < 0.8 * STILL_LEVELS, "({x}, {y}): still reads {still}");
         assert!(turned > 3.0 * STILL_LEVELS, "({x}, {y}): a turn reads {turned}");
     }
 }

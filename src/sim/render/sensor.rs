@@ -79,6 +79,10 @@ fn floor_index(x: f32) -> i32 {
     (x - 0.5 + MAGIC).to_bits() as i32 - MAGIC.to_bits() as i32
 }
 
+/// Fixed-point scale of the noise SD table: sixteenths of an output level, so an SD of
+/// 1.4 levels is not rounded to 1.
+const SD_ONE: i32 = 16;
+
 /// The sensor's state across frames: exposure, and the tables it reuses.
 #[derive(Debug, Clone)]
 pub(super) struct Sensor {
@@ -89,7 +93,7 @@ pub(super) struct Sensor {
     level_lin: [f32; 256],
     /// Output levels per 8-bit linear unit at each output byte: the sRGB curve's slope.
     level_slope: [f32; 256],
-    /// This frame's noise SD per output byte, in output levels.
+    /// This frame's noise SD per output byte, in output levels × [`SD_ONE`].
     sd_out: [i32; 256],
     /// This frame's linear level (× `LUT_MAX`) → output byte | its noise SD << 8: one
     /// lookup per channel instead of two dependent ones.
@@ -123,11 +127,8 @@ impl Sensor {
             let lin = srgb_to_linear(s);
             let lin2 = srgb_to_linear((s + 1.0 / 255.0).min(1.0));
             level_lin[level] = lin;
-            level_slope[level] = if lin2 > lin {
-                (1.0 / 255.0) / (lin2 - lin) / 255.0
-            } else {
-                1.0
-            };
+            // One output level spans (lin2 − lin)·255 linear 8-bit units.
+            level_slope[level] = if lin2 > lin { 1.0 / ((lin2 - lin) * 255.0) } else { 1.0 };
         }
         Self {
             noise: NoiseTable::new(noise_seed),
@@ -178,7 +179,7 @@ impl Sensor {
         let read = params.read_noise * k.max(1.0).sqrt();
         for ((sd, lin), slope) in self.sd_out.iter_mut().zip(&self.level_lin).zip(&self.level_slope) {
             let sd_lin = read + params.shot_noise * (lin * 255.0).sqrt();
-            *sd = (sd_lin * slope.min(8.0)).round() as i32;
+            *sd = (sd_lin * slope.min(8.0) * SD_ONE as f32).round() as i32;
         }
         for (e, &g) in self.level_and_sd.iter_mut().zip(self.to_srgb.iter()) {
             *e = g as i32 | (self.sd_out[g as usize] << 8);
@@ -210,7 +211,10 @@ impl Sensor {
             let start = splitmix64(frame_seed ^ ((y as u64) << 32)) as usize;
             let noise = self.noise.window(start, row_len);
             for ((o, &e), &n) in out_row.iter_mut().zip(code.iter()).zip(noise) {
-                let v = (e & 0xFF) + ((n as i32 * (e >> 8)) >> 8);
+                // Noise values are N(0, 1) × 256 and SDs × 16: the product is in levels
+                // × 4096, rounded to the nearest level (a bare shift would floor, darkening
+                // every noisy pixel by half a level on average).
+                let v = (e & 0xFF) + ((n as i32 * (e >> 8) + 2048) >> 12);
                 *o = v.clamp(0, 255) as u8;
             }
         }
@@ -252,6 +256,73 @@ impl Sensor {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A flat field at linear level `lin` through a fixed exposure: (mean, SD) of the
+    /// output in levels.
+    fn flat_field_stats(lin: f32, params: &SensorParams) -> (f64, f64) {
+        let (w, h) = (64, 64);
+        let mut sensor = Sensor::new(5);
+        let mut out = RgbImage::default();
+        let mut values = Vec::new();
+        for frame in 0..4 {
+            let mut radiance = vec![[lin; 3]; w * h];
+            sensor.expose(&mut radiance, w, params, frame, &mut out);
+            assert!(radiance.iter().all(|p| *p == [0.0; 3]), "exposing clears the radiance");
+            values.extend(out.as_bytes().iter().map(|&v| v as f64));
+        }
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+        (mean, var.sqrt())
+    }
+
+    /// The noise model, written out directly: SD in linear 8-bit units (read + shot·√signal)
+    /// times the sRGB curve's slope in output levels per linear unit.
+    fn expected_sd(lin: f64, read: f64, shot: f64) -> f64 {
+        let to_srgb = |l: f64| {
+            if l <= 0.003_130_8 {
+                12.92 * l
+            } else {
+                1.055 * l.powf(1.0 / 2.4) - 0.055
+            }
+        };
+        let dl = 1e-4;
+        let slope = (to_srgb(lin + dl) - to_srgb(lin)) / dl; // output (0–1) per linear (0–1)
+        (read + shot * (lin * 255.0).sqrt()) * slope
+    }
+
+    #[test]
+    fn sensor_noise_has_the_specified_sd_at_every_level() {
+        let params = SensorParams {
+            auto_exposure: false,
+            ..SensorParams::default()
+        };
+        for lin in [0.05f32, 0.18, 0.4, 0.7] {
+            let (mean, sd) = flat_field_stats(lin, &params);
+            let want = expected_sd(lin as f64, 1.5, 0.35);
+            let level = srgb_level(lin);
+            assert!(
+                (mean - level).abs() < 0.6,
+                "lin {lin}: mean {mean:.2} vs level {level:.2}"
+            );
+            assert!(
+                (sd - want).abs() < 0.1 * want,
+                "lin {lin}: SD {sd:.2} levels, model {want:.2}"
+            );
+        }
+        // No noise asked, none given.
+        let quiet = SensorParams {
+            read_noise: 0.0,
+            shot_noise: 0.0,
+            ..params
+        };
+        assert_eq!(flat_field_stats(0.18, &quiet).1, 0.0);
+    }
+
+    fn srgb_level(lin: f32) -> f64 {
+        let l = lin as f64;
+        (1.055 * l.powf(1.0 / 2.4) - 0.055) * 255.0
+    }
 
     #[test]
     fn floor_index_matches_the_cast_off_integers() {
