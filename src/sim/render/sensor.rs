@@ -76,7 +76,7 @@ const LUT_MAX: f32 = (LUT_LEN - 1) as f32;
 #[inline(always)]
 fn floor_index(x: f32) -> i32 {
     const MAGIC: f32 = 12_582_912.0; // 1.5 · 2²³
-    (x - 0.5 + MAGIC).to_bits() as i32 - MAGIC.to_bits() as i32
+    (x - 0.5 + MAGIC).to_bits().wrapping_sub(MAGIC.to_bits()) as i32
 }
 
 /// Fixed-point scale of the noise SD table: sixteenths of an output level, so an SD of
@@ -179,7 +179,9 @@ impl Sensor {
         let read = params.read_noise * k.max(1.0).sqrt();
         for ((sd, lin), slope) in self.sd_out.iter_mut().zip(&self.level_lin).zip(&self.level_slope) {
             let sd_lin = read + params.shot_noise * (lin * 255.0).sqrt();
-            *sd = (sd_lin * slope.min(8.0) * SD_ONE as f32).round() as i32;
+            // An SD past the whole output range means nothing more; the cap also bounds
+            // the fixed-point products below whatever noise a scenario asks for.
+            *sd = (sd_lin * slope.min(8.0) * SD_ONE as f32).round().clamp(0.0, 255.0 * SD_ONE as f32) as i32;
         }
         for (e, &g) in self.level_and_sd.iter_mut().zip(self.to_srgb.iter()) {
             *e = g as i32 | (self.sd_out[g as usize] << 8);
@@ -317,6 +319,13 @@ mod tests {
             ..params
         };
         assert_eq!(flat_field_stats(0.18, &quiet).1, 0.0);
+        // Absurd noise saturates the output instead of overflowing.
+        let loud = SensorParams {
+            read_noise: 1e9,
+            ..params
+        };
+        let (mean, sd) = flat_field_stats(0.18, &loud);
+        assert!(sd > 100.0 && (0.0..=255.0).contains(&mean), "{mean} {sd}");
     }
 
     fn srgb_level(lin: f32) -> f64 {
