@@ -2,6 +2,7 @@
 //! scenarios and trial campaigns.
 
 pub mod camera;
+pub mod krawler;
 pub mod lighting;
 pub mod render;
 pub mod rng;

@@ -46,6 +46,13 @@ pub enum Material {
         /// The marks.
         marks: Arc<[CircleMark]>,
     },
+    /// Coloured squares painted on a `base`-coloured surface (the AutoKrawler's markers).
+    Squares {
+        /// Albedo between the squares.
+        base: [f32; 3],
+        /// The squares.
+        squares: Arc<[PaintedSquare]>,
+    },
     /// Value noise in cells of `cell` metres around `base` with relative contrast `contrast`.
     Noise {
         /// Mean albedo.
@@ -82,6 +89,21 @@ impl CircleMark {
             dir: [rotation_rad.cos(), rotation_rad.sin()],
         }
     }
+}
+
+/// A square of paint at local (a, b) of its surface, sides along u and v. Painting marks
+/// as texture, not as primitives laid on top, keeps them in front of their surface
+/// whatever the draw order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PaintedSquare {
+    /// Centre, along u, m.
+    pub a: f32,
+    /// Centre, along v, m.
+    pub b: f32,
+    /// Half the side, m.
+    pub half: f32,
+    /// Albedo.
+    pub albedo: [f32; 3],
 }
 
 /// Geometry of a primitive.

@@ -119,7 +119,7 @@ fn yaw(v: Vector3<f64>, deg: f64) -> Vector3<f64> {
 /// red. Without the floor a rendered cyan sits exactly on SCT's B = 90° edge wherever no
 /// highlight reaches it, and a faint highlight moved it 12° (to B 78°) in the dusk
 /// departure frames we measured: an edge no real paint sits on.
-fn paint(c: NamedColor) -> [f32; 3] {
+pub(super) fn paint(c: NamedColor) -> [f32; 3] {
     albedo(c.rgb(), 0.85 - PAINT_FLOOR).map(|v| v + PAINT_FLOOR)
 }
 

@@ -181,7 +181,9 @@ impl Sensor {
             let sd_lin = read + params.shot_noise * (lin * 255.0).sqrt();
             // An SD past the whole output range means nothing more; the cap also bounds
             // the fixed-point products below whatever noise a scenario asks for.
-            *sd = (sd_lin * slope.min(8.0) * SD_ONE as f32).round().clamp(0.0, 255.0 * SD_ONE as f32) as i32;
+            *sd = (sd_lin * slope.min(8.0) * SD_ONE as f32)
+                .round()
+                .clamp(0.0, 255.0 * SD_ONE as f32) as i32;
         }
         for (e, &g) in self.level_and_sd.iter_mut().zip(self.to_srgb.iter()) {
             *e = g as i32 | (self.sd_out[g as usize] << 8);

@@ -7,7 +7,7 @@
 
 use super::hits::cov;
 use crate::perception::RgbImage;
-use crate::sim::scene::{CircleMark, Material, srgb_to_linear};
+use crate::sim::scene::{CircleMark, Material, PaintedSquare, srgb_to_linear};
 use std::sync::LazyLock;
 
 /// Linear value of each sRGB byte, scaled by the 0.8 reflectance a printed photo has.
@@ -65,6 +65,13 @@ pub(super) enum Texture<'a> {
         /// The marks.
         marks: &'a [CircleMark],
     },
+    /// Painted squares on a base colour.
+    Squares {
+        /// Albedo between the squares.
+        base: [f32; 3],
+        /// The squares.
+        squares: &'a [PaintedSquare],
+    },
     /// Value noise.
     Noise {
         /// Mean albedo.
@@ -95,6 +102,7 @@ impl<'a> Texture<'a> {
                 radius: *radius,
                 marks,
             },
+            Material::Squares { base, squares } => Self::Squares { base: *base, squares },
             Material::Noise { base, contrast, cell } => Self::Noise {
                 base: *base,
                 contrast: *contrast,
@@ -122,6 +130,17 @@ impl<'a> Texture<'a> {
                 [lin[p[0] as usize], lin[p[1] as usize], lin[p[2] as usize]]
             }
             Self::Circles { base, radius, marks } => circles(*base, *radius, marks, a, b, fp),
+            Self::Squares { base, squares } => {
+                let fp = fp.max(1e-6);
+                let mut out = *base;
+                for q in squares.iter() {
+                    let c = cov((q.half - (a - q.a).abs()) / fp) * cov((q.half - (b - q.b).abs()) / fp);
+                    if c > 0.0 {
+                        out = [0, 1, 2].map(|i| out[i] + (q.albedo[i] - out[i]) * c);
+                    }
+                }
+                out
+            }
             Self::Noise {
                 base,
                 contrast,

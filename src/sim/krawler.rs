@@ -1,0 +1,286 @@
+//! The AutoKrawler's running gear as its belly fisheye sees it (seed 003, DESIGN §2.4).
+//!
+//! The scene is in the body frame (x forward, y left, z up, origin on the ground below the
+//! body's centre) and is rebuilt from a [`KrawlerState`] each frame, so a test or an
+//! experiment sets the ten degrees of freedom it wants the camera to observe and knows
+//! them exactly. Each axle is a rigid assembly that rolls about the body's x axis through
+//! its centre and sits a distance d below the camera: the axle beam, a plate on top
+//! carrying two magenta markers (roll), two wheels steered about vertical kingpins at the
+//! beam's ends, and a tie rod joining the wheels' steering arms, carrying two more
+//! markers. Steering swings the arms, so the tie rod shifts sideways against the plate,
+//! which is what the paper's ratio of marker distances measures. Each wheel is a
+//! sixteen-sided prism whose faces carry a rubber tread texture, with one face painted
+//! white: the once-per-turn correction marker. Spinning a wheel turns its faces.
+//!
+//! Simplified: both wheels of an axle steer by the same angle (the paper estimates one λ
+//! per axle), the wheels stay on the axle's roll (they do not follow the ground), and the
+//! body above the camera is not drawn (a belly camera does not see it).
+
+use super::SimError;
+use super::scene::{Material, PaintedSquare, Prim, Scene, Shape, Tag, albedo, boxed};
+use super::world::paint;
+use crate::profile::Profile;
+use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
+
+/// The kinematic state the camera observes (seed 003's ten degrees of freedom).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KrawlerState {
+    /// Axle roll ψ (front, rear), rad: positive lifts the left wheel.
+    pub roll: [f64; 2],
+    /// Vertical distance from the camera down to each axle's centre (front, rear), m.
+    pub drop: [f64; 2],
+    /// Steering λ (front, rear), rad: positive turns the wheels' fronts to the left.
+    pub steer: [f64; 2],
+    /// Wheel rotations θ (front left, front right, rear left, rear right), rad: positive
+    /// rolls the robot forward. At θ = 0 the white correction face is on top.
+    pub wheel: [f64; 4],
+}
+
+impl KrawlerState {
+    /// Level axles at the height the wheels rest at on flat ground, straight, unrotated.
+    pub fn rest(profile: &Profile) -> Self {
+        let gear = Gear::of(profile);
+        let drop = gear.camera_z - gear.wheel_radius;
+        Self {
+            roll: [0.0; 2],
+            drop: [drop; 2],
+            steer: [0.0; 2],
+            wheel: [0.0; 4],
+        }
+    }
+}
+
+/// Dimensions of the running gear, from the profile (drive and markers) and our estimates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Gear {
+    track: f64,
+    wheelbase: f64,
+    wheel_radius: f64,
+    camera_z: f64,
+    marker_side: f64,
+}
+
+/// Width of a wheel's tread, m (estimate).
+const WHEEL_WIDTH: f64 = 0.08;
+/// Steering-arm length from kingpin to tie-rod end, m (estimate).
+const ARM: f64 = 0.09;
+/// Markers sit this far either side of the axle's centre line, m (estimate).
+const MARKER_Y: f64 = 0.1;
+/// Tread faces per wheel.
+const FACES: usize = 16;
+/// Height of the axle plate's top above the axle's centre, m.
+const PLATE_TOP: f64 = 0.021;
+/// Half the tie rod's height, m: its top carries the steering markers.
+const ROD_TOP: f64 = 0.012;
+
+impl Gear {
+    fn of(profile: &Profile) -> Self {
+        let d = &profile.drive;
+        Self {
+            track: d.track_m,
+            wheelbase: d.wheelbase_m.unwrap_or(0.66),
+            wheel_radius: d.wheel_radius_m.unwrap_or(0.115),
+            camera_z: profile.cameras.first().map_or(0.4, |c| c.mount.z_m),
+            marker_side: profile.fiducial.markers.map_or(0.03, |m| m.side_m),
+        }
+    }
+}
+
+/// The rendered gear: the scene, and where the state put each marker.
+#[derive(Debug, Clone)]
+pub struct KrawlerScene {
+    /// Everything the belly camera can see, in the body frame, over the ground.
+    pub scene: Scene,
+    /// Marker centres in the body frame: front plate left, right; front tie rod left,
+    /// right; then the same for the rear axle.
+    pub markers: [Point3<f64>; 8],
+    /// Centre of each wheel's white correction face (FL, FR, RL, RR), body frame.
+    pub correction: [Point3<f64>; 4],
+}
+
+/// Builds the gear of an AutoKrawler `profile` (one with `[fiducial.markers]`) in `state`.
+///
+/// # Errors
+/// [`SimError::Unsupported`] for a profile without eight markers.
+pub fn build(profile: &Profile, state: &KrawlerState) -> Result<KrawlerScene, SimError> {
+    let spec = profile
+        .fiducial
+        .markers
+        .ok_or_else(|| SimError::Unsupported(format!("profile `{}` has no [fiducial.markers]", profile.name)))?;
+    if spec.count != 8 {
+        return Err(SimError::Unsupported(format!(
+            "the gear carries 8 markers (two per axle plate and tie rod); profile `{}` asks for {}",
+            profile.name, spec.count
+        )));
+    }
+    let g = Gear::of(profile);
+    let marker_albedo = paint(spec.color);
+    let metal_albedo = albedo([90, 92, 95], 1.0);
+    let metal = Material::Solid(metal_albedo);
+    let plate_albedo = albedo([150, 150, 150], 1.0);
+    // A pair of markers, ±MARKER_Y across a surface's v axis (its local b).
+    let pair = |base: [f32; 3], a: f64| Material::Squares {
+        base,
+        squares: [1.0f32, -1.0]
+            .map(|side| PaintedSquare {
+                a: a as f32,
+                b: side * MARKER_Y as f32,
+                half: g.marker_side as f32 / 2.0,
+                albedo: marker_albedo,
+            })
+            .to_vec()
+            .into(),
+    };
+    let rubber = Material::Noise {
+        base: albedo([45, 45, 48], 1.0),
+        contrast: 0.6,
+        cell: 0.012,
+    };
+    let white = Material::Solid(albedo([255, 255, 255], 0.85));
+    let mut prims = Vec::new();
+    let mut markers = [Point3::origin(); 8];
+    let mut correction = [Point3::origin(); 4];
+    for axle in 0..2 {
+        // Front axle ahead (+x), its steering arms pointing back toward the body's centre.
+        let (x, inboard) = if axle == 0 {
+            (g.wheelbase / 2.0, -1.0)
+        } else {
+            (-g.wheelbase / 2.0, 1.0)
+        };
+        let pose = Isometry3::from_parts(
+            Translation3::new(x, 0.0, g.camera_z - state.drop[axle]),
+            UnitQuaternion::from_axis_angle(&Vector3::x_axis(), state.roll[axle]),
+        );
+        let mut put = |p: Prim| prims.push(transform(p, &pose));
+        let half_beam = g.track / 2.0 - WHEEL_WIDTH / 2.0 - 0.01;
+        for p in boxed(
+            Point3::new(-0.02, -half_beam, -0.02),
+            Point3::new(0.02, half_beam, 0.02),
+            metal.clone(),
+            Tag::Own,
+        ) {
+            put(p);
+        }
+        put(flat(
+            Point3::new(0.0, 0.0, PLATE_TOP),
+            [0.06, 0.16],
+            pair(plate_albedo, 0.0),
+        ));
+        // The tie rod: the arms' ends, swung by the steering, shift it sideways.
+        let (s, c) = state.steer[axle].sin_cos();
+        let rod = Vector3::new(inboard * ARM * c, inboard * ARM * s, 0.0);
+        let mut rod_box = boxed(
+            Point3::new(rod.x - 0.012, rod.y - half_beam + 0.02, -ROD_TOP),
+            Point3::new(rod.x + 0.012, rod.y + half_beam - 0.02, ROD_TOP),
+            metal.clone(),
+            Tag::Own,
+        );
+        // The box's top face is centred on the rod, u along x, v along y.
+        rod_box[4].material = pair(metal_albedo, 0.0);
+        rod_box.into_iter().for_each(&mut put);
+        for (k, side) in [1.0, -1.0].into_iter().enumerate() {
+            let on_plate = Point3::new(0.0, side * MARKER_Y, PLATE_TOP);
+            let on_rod = Point3::new(rod.x, rod.y + side * MARKER_Y, ROD_TOP);
+            markers[axle * 4 + k] = pose * on_plate;
+            markers[axle * 4 + 2 + k] = pose * on_rod;
+        }
+        // Wheels: kingpins at the beam's ends; the left wheel is index 0 of the axle.
+        for (k, side) in [1.0, -1.0].into_iter().enumerate() {
+            let hub = Isometry3::from_parts(
+                Translation3::new(0.0, side * g.track / 2.0, 0.0),
+                UnitQuaternion::from_axis_angle(&Vector3::z_axis(), state.steer[axle]),
+            );
+            let wheel = pose * hub;
+            let theta = state.wheel[axle * 2 + k];
+            for f in 0..FACES {
+                let phi = theta + std::f64::consts::TAU * f as f64 / FACES as f64;
+                let (sp, cp) = phi.sin_cos();
+                let apothem = g.wheel_radius * (std::f64::consts::PI / FACES as f64).cos();
+                let half_arc = g.wheel_radius * (std::f64::consts::PI / FACES as f64).sin();
+                let centre = Point3::new(apothem * sp, 0.0, apothem * cp);
+                let face = Prim::new(
+                    Shape::Rect {
+                        centre,
+                        u: Vector3::new(cp, 0.0, -sp),
+                        v: Vector3::y(),
+                        half: [half_arc, WHEEL_WIDTH / 2.0],
+                    },
+                    if f == 0 { white.clone() } else { rubber.clone() },
+                    Tag::Own,
+                );
+                if f == 0 {
+                    correction[axle * 2 + k] = wheel * centre;
+                }
+                prims.push(transform(face, &wheel));
+            }
+            for wall in [1.0, -1.0] {
+                let n = Vector3::y() * wall;
+                prims.push(transform(
+                    Prim::new(
+                        Shape::Disc {
+                            centre: Point3::new(0.0, wall * WHEEL_WIDTH / 2.0, 0.0),
+                            u: n.cross(&Vector3::z()),
+                            v: Vector3::z(),
+                            radius: g.wheel_radius * 0.98,
+                        },
+                        metal.clone(),
+                        Tag::Own,
+                    ),
+                    &wheel,
+                ));
+            }
+        }
+    }
+    Ok(KrawlerScene {
+        scene: Scene {
+            prims,
+            ground: Material::Noise {
+                base: albedo([120, 110, 95], 1.0),
+                contrast: 0.3,
+                cell: 0.02,
+            },
+            sky: [0.9, 0.95, 1.0],
+        },
+        markers,
+        correction,
+    })
+}
+
+/// A flat horizontal square or rectangle facing up (+z), half extents along x and y.
+fn flat(centre: Point3<f64>, half: [f64; 2], material: Material) -> Prim {
+    Prim::new(
+        Shape::Rect {
+            centre,
+            u: Vector3::x(),
+            v: Vector3::y(),
+            half,
+        },
+        material,
+        Tag::Own,
+    )
+}
+
+/// `p` moved by `iso`.
+fn transform(mut p: Prim, iso: &Isometry3<f64>) -> Prim {
+    let r: Rotation3<f64> = iso.rotation.to_rotation_matrix();
+    p.shape = match p.shape {
+        Shape::Rect { centre, u, v, half } => Shape::Rect {
+            centre: iso * centre,
+            u: r * u,
+            v: r * v,
+            half,
+        },
+        Shape::Disc { centre, u, v, radius } => Shape::Disc {
+            centre: iso * centre,
+            u: r * u,
+            v: r * v,
+            radius,
+        },
+        Shape::Triangle { p: q } => Shape::Triangle { p: q.map(|x| iso * x) },
+        Shape::Sphere { centre, radius } => Shape::Sphere {
+            centre: iso * centre,
+            radius,
+        },
+    };
+    p
+}

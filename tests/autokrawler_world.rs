@@ -1,0 +1,168 @@
+//! The AutoKrawler's running gear under its belly fisheye: the eight magenta markers
+//! appear where the fisheye model projects the state's marker positions, steering shifts
+//! the tie-rod markers against the plate markers as the paper's ratio reads it, and the
+//! white correction face shows on top of a wheel and hides under it.
+
+use marsupial::geometry::Pose2;
+use marsupial::perception::RgbImage;
+use marsupial::perception::camera_model::CameraModel;
+use marsupial::profile::Profile;
+use marsupial::sim::camera::camera_pose;
+use marsupial::sim::krawler::{KrawlerState, build};
+use marsupial::sim::lighting::LightState;
+use marsupial::sim::render::{CameraPose, Renderer, SensorParams};
+use nalgebra::Point3;
+use std::path::Path;
+
+fn krawler() -> Profile {
+    Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/autokrawler.toml")).unwrap()
+}
+
+fn quiet() -> SensorParams {
+    SensorParams {
+        read_noise: 0.0,
+        shot_noise: 0.0,
+        auto_exposure: false,
+        exposure: 1.0,
+        ..SensorParams::default()
+    }
+}
+
+struct View {
+    image: RgbImage,
+    model: CameraModel,
+    pose: CameraPose,
+}
+
+impl View {
+    fn project(&self, p: &Point3<f64>) -> [f64; 2] {
+        let c = self.pose.rotation.transpose() * (p - self.pose.position);
+        self.model.project(&c).expect("in the fisheye's field")
+    }
+
+    /// Weighted centroid of magenta pixels within `reach` px of `around`.
+    fn magenta_centroid(&self, around: [f64; 2], reach: f64) -> Option<[f64; 2]> {
+        let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+        let v = self.image.view();
+        let (x0, x1) = ((around[0] - reach).max(0.0) as usize, (around[0] + reach) as usize);
+        let (y0, y1) = ((around[1] - reach).max(0.0) as usize, (around[1] + reach) as usize);
+        for y in y0..=y1.min(self.image.height() - 1) {
+            for x in x0..=x1.min(self.image.width() - 1) {
+                let p = v.get(x, y).unwrap();
+                // Magenta: red and blue well above green.
+                let w = (p[0].min(p[2]) as f64 - p[1] as f64 - 60.0).max(0.0);
+                sx += (x as f64 + 0.5) * w;
+                sy += (y as f64 + 0.5) * w;
+                n += w;
+            }
+        }
+        (n > 0.0).then(|| [sx / n, sy / n])
+    }
+}
+
+fn view(p: &Profile, state: &KrawlerState) -> (View, marsupial::sim::krawler::KrawlerScene) {
+    let gear = build(p, state).expect("autokrawler gear");
+    let cam = &p.cameras[0];
+    let model = CameraModel::from_spec(cam);
+    let mut r = Renderer::new(model.clone(), cam.width_px, cam.height_px, 1);
+    let pose = camera_pose(&Pose2::new(0.0, 0.0, 0.0), &cam.mount);
+    let mut image = RgbImage::default();
+    r.render(&gear.scene, &pose, &LightState::uniform(1.0), &quiet(), 0, &mut image);
+    (View { image, model, pose }, gear)
+}
+
+#[test]
+fn every_marker_appears_where_the_fisheye_projects_it_in_any_state() {
+    let p = krawler();
+    let rest = KrawlerState::rest(&p);
+    let states = [
+        rest,
+        KrawlerState {
+            steer: [0.45, -0.3],
+            ..rest
+        },
+        KrawlerState {
+            roll: [0.12, -0.08],
+            drop: [rest.drop[0] - 0.03, rest.drop[1] + 0.02],
+            ..rest
+        },
+        KrawlerState {
+            steer: [-0.5, 0.5],
+            roll: [-0.1, 0.1],
+            wheel: [1.0, 2.0, 3.0, 4.0],
+            ..rest
+        },
+    ];
+    for (k, state) in states.iter().enumerate() {
+        let (v, gear) = view(&p, state);
+        for (i, m) in gear.markers.iter().enumerate() {
+            let at = v.project(m);
+            let c = v
+                .magenta_centroid(at, 12.0)
+                .unwrap_or_else(|| panic!("state {k} marker {i}: nothing magenta at {at:?}"));
+            let err = ((c[0] - at[0]).powi(2) + (c[1] - at[1]).powi(2)).sqrt();
+            assert!(
+                err < 1.0,
+                "state {k} marker {i}: centroid {c:?} vs projected {at:?} ({err:.2} px)"
+            );
+        }
+    }
+}
+
+/// The paper's steering cue: on each axle, the distance from a tie-rod marker to the
+/// plate marker on the same side, left over right, is 1 straight and moves away from 1
+/// with the steering's sign; measured here on the image, from the centroids.
+#[test]
+fn steering_shifts_the_tie_rod_markers_against_the_plate_markers() {
+    let p = krawler();
+    let rest = KrawlerState::rest(&p);
+    let ratio = |steer: f64| {
+        let (v, gear) = view(
+            &p,
+            &KrawlerState {
+                steer: [steer, steer],
+                ..rest
+            },
+        );
+        let at = |i: usize| {
+            v.magenta_centroid(v.project(&gear.markers[i]), 12.0)
+                .expect("marker seen")
+        };
+        let dist = |a: [f64; 2], b: [f64; 2]| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+        // Front axle: plate left 0, right 1; rod left 2, right 3.
+        dist(at(2), at(0)) / dist(at(3), at(1))
+    };
+    let straight = ratio(0.0);
+    assert!((straight - 1.0).abs() < 0.03, "straight: {straight}");
+    let (left, right) = (ratio(0.4), ratio(-0.4));
+    assert!(
+        (left - 1.0) * (right - 1.0) < 0.0,
+        "opposite sides of 1: {left}, {right}"
+    );
+    assert!((left - 1.0).abs() > 0.1 && (right - 1.0).abs() > 0.1, "{left}, {right}");
+}
+
+#[test]
+fn the_white_correction_face_shows_on_top_and_hides_underneath() {
+    let p = krawler();
+    let rest = KrawlerState::rest(&p);
+    // Where the front-left wheel's correction face is at θ = 0: on top.
+    let on_top_at = build(&p, &rest).unwrap().correction[0];
+    let whiteness = |theta: f64| {
+        let (v, gear) = view(
+            &p,
+            &KrawlerState {
+                wheel: [theta; 4],
+                ..rest
+            },
+        );
+        let at = v.project(&on_top_at);
+        let px = v.image.view().get(at[0] as usize, at[1] as usize).unwrap();
+        (px[0].min(px[1]).min(px[2]), gear.correction[0])
+    };
+    let (on_top, p0) = whiteness(0.0);
+    let (underneath, p1) = whiteness(std::f64::consts::PI);
+    assert!(on_top > 200, "the white face on top: {on_top}");
+    assert!(underneath < 120, "rubber where it was: {underneath}");
+    assert!(p1.z < p0.z - 0.2, "the face went under: {} → {}", p0.z, p1.z);
+}
