@@ -322,6 +322,28 @@ impl Renderer {
             for &(x0, x1) in &self.runs {
                 hit_row(ground, self.rays.row(y, x0, x1), &mut self.hits);
                 let h = &self.hits;
+                let n = x1 - x0;
+                if let Some(base) = tex.noise_row(&h.a[..n], &h.b[..n], &h.fp[..n], &mut self.tex_gain) {
+                    // Value-noise ground (the usual one): branch-free, so it vectorises.
+                    // Full pixels add nothing; sky pixels add sky.
+                    let (cov, t, gain) = (&h.cov[..n], &h.t[..n], &self.tex_gain[..n]);
+                    let (rad, alpha) = (&mut rad[x0..x1], &alpha[x0..x1]);
+                    let lit = [0, 1, 2].map(|c| base[c] * irr[c]);
+                    for j in 0..n {
+                        let rest = 1.0 - alpha[j];
+                        let rest = if rest > 1e-3 { rest } else { 0.0 };
+                        let hit = cov[j] > 0.0;
+                        // Fade to the sky colour far away (haze), which also hides
+                        // texture aliasing.
+                        let haze = if hit { (t[j] * (1.0 / 40.0)).min(1.0) } else { 1.0 };
+                        let g = if hit { gain[j] * (1.0 - haze) } else { 0.0 };
+                        let px = &mut rad[j];
+                        for c in 0..3 {
+                            px[c] += rest * (lit[c] * g + sky[c] * haze);
+                        }
+                    }
+                    continue;
+                }
                 for (j, (px, a)) in rad[x0..x1].iter_mut().zip(&alpha[x0..x1]).enumerate() {
                     let rest = 1.0 - a;
                     if rest <= 1e-3 {
