@@ -3,6 +3,8 @@
 //! the tie-rod markers against the plate markers as the paper's ratio reads it, and the
 //! white correction face shows on top of a wheel and hides under it.
 
+mod common;
+
 use marsupial::geometry::Pose2;
 use marsupial::perception::RgbImage;
 use marsupial::perception::camera_model::CameraModel;
@@ -10,22 +12,11 @@ use marsupial::profile::Profile;
 use marsupial::sim::camera::camera_pose;
 use marsupial::sim::krawler::{KrawlerState, build};
 use marsupial::sim::lighting::LightState;
-use marsupial::sim::render::{CameraPose, Renderer, SensorParams};
+use marsupial::sim::render::{CameraPose, Renderer};
 use nalgebra::Point3;
-use std::path::Path;
 
 fn krawler() -> Profile {
-    Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/autokrawler.toml")).unwrap()
-}
-
-fn quiet() -> SensorParams {
-    SensorParams {
-        read_noise: 0.0,
-        shot_noise: 0.0,
-        auto_exposure: false,
-        exposure: 1.0,
-        ..SensorParams::default()
-    }
+    common::shipped_profile("autokrawler")
 }
 
 struct View {
@@ -67,7 +58,14 @@ fn view(p: &Profile, state: &KrawlerState) -> (View, marsupial::sim::krawler::Kr
     let mut r = Renderer::new(model.clone(), cam.width_px, cam.height_px, 1);
     let pose = camera_pose(&Pose2::new(0.0, 0.0, 0.0), &cam.mount);
     let mut image = RgbImage::default();
-    r.render(&gear.scene, &pose, &LightState::uniform(1.0), &quiet(), 0, &mut image);
+    r.render(
+        &gear.scene,
+        &pose,
+        &LightState::uniform(1.0),
+        &common::quiet_sensor(),
+        0,
+        &mut image,
+    );
     (View { image, model, pose }, gear)
 }
 

@@ -2,30 +2,21 @@
 //! cameras of the stereo pair project them, with their pattern (black core, white ring,
 //! black rim) and their bars turned as the profile places them.
 
+mod common;
+
 use marsupial::geometry::Pose2;
 use marsupial::perception::RgbImage;
 use marsupial::perception::camera_model::CameraModel;
 use marsupial::profile::Profile;
 use marsupial::sim::camera::camera_pose;
 use marsupial::sim::lighting::LightState;
-use marsupial::sim::render::{Renderer, SensorParams};
+use marsupial::sim::render::Renderer;
 use marsupial::sim::scene::Tag;
 use marsupial::sim::world;
 use nalgebra::Point3;
-use std::path::Path;
 
 fn axel() -> Profile {
-    Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/axel.toml")).unwrap()
-}
-
-fn quiet() -> SensorParams {
-    SensorParams {
-        read_noise: 0.0,
-        shot_noise: 0.0,
-        auto_exposure: false,
-        exposure: 1.0,
-        ..SensorParams::default()
-    }
+    common::shipped_profile("axel")
 }
 
 /// Grey level (green channel) at the pixel containing `px`.
@@ -48,7 +39,14 @@ fn both_cameras_see_every_circle_where_their_models_project_it() {
         let mut r = Renderer::new(model.clone(), cam.width_px, cam.height_px, 1);
         let pose = camera_pose(&robot, &cam.mount);
         let mut im = RgbImage::default();
-        r.render(&w.scene, &pose, &LightState::uniform(1.0), &quiet(), 0, &mut im);
+        r.render(
+            &w.scene,
+            &pose,
+            &LightState::uniform(1.0),
+            &common::quiet_sensor(),
+            0,
+            &mut im,
+        );
         let project = |q: Point3<f64>| {
             let c = pose.rotation.transpose() * (q - pose.position);
             model.project(&c).expect("in front of the camera")

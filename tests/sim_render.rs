@@ -4,6 +4,8 @@
 //! lighting presets move colour statistics in the intended direction, a glossy highlight
 //! peaks at a dielectric's Fresnel reflection, and auto-exposure protects highlights.
 
+mod common;
+
 use marsupial::geometry::Pose2;
 use marsupial::perception::camera_model::CameraModel;
 use marsupial::perception::{RgbImage, TwoBlockSchema};
@@ -15,21 +17,12 @@ use marsupial::sim::rng::Rng;
 use marsupial::sim::scene::{Material, Prim, Scene, Shape, Tag};
 use marsupial::sim::world;
 use nalgebra::{Point3, Vector3};
-use std::path::Path;
 
 fn bujold() -> Profile {
-    Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/bujold.toml")).unwrap()
+    common::shipped_profile("bujold")
 }
 
-fn quiet() -> SensorParams {
-    SensorParams {
-        read_noise: 0.0,
-        shot_noise: 0.0,
-        auto_exposure: false,
-        exposure: 1.0,
-        ..SensorParams::default()
-    }
-}
+use common::quiet_sensor as quiet;
 
 /// A small white square facing +x at `centre`, on a black world.
 fn marker_scene(centre: Point3<f64>, half: f64) -> Scene {

@@ -1,7 +1,28 @@
-//! Helpers shared by integration tests: drawing synthetic fiducials.
+//! Helpers shared by integration tests: drawing synthetic fiducials, loading shipped
+//! profiles, a noiseless sensor.
 #![allow(dead_code)]
 
 use marsupial::perception::{RgbImage, SctRange};
+use marsupial::profile::Profile;
+use marsupial::sim::render::SensorParams;
+use std::path::Path;
+
+/// A profile shipped in `profiles/`, by name.
+pub fn shipped_profile(name: &str) -> Profile {
+    Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("profiles/{name}.toml"))).unwrap()
+}
+
+/// A sensor without noise or auto-exposure (fixed exposure 1), for renders whose pixel
+/// values a test reads.
+pub fn quiet_sensor() -> SensorParams {
+    SensorParams {
+        read_noise: 0.0,
+        shot_noise: 0.0,
+        auto_exposure: false,
+        exposure: 1.0,
+        ..SensorParams::default()
+    }
+}
 
 pub const CYAN: [u8; 3] = [20, 190, 210];
 pub const MAGENTA: [u8; 3] = [200, 30, 190];

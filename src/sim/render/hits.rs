@@ -505,57 +505,15 @@ mod tests {
 
     #[test]
     fn a_one_sided_plane_seen_from_behind_or_edge_on_is_culled() {
-        let n = [0.0, 0.0, 1.0];
+        let (x, y, z) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+        let rect = |o: [f32; 3], two_sided| Surface::planar(Kind::Rect, o, x, y, z, [0.5; 2], two_sided);
         // Camera at the origin, plane 1 m ahead with its normal pointing away: its back.
-        assert!(
-            Surface::planar(
-                Kind::Rect,
-                [0.0, 0.0, 1.0],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                n,
-                [0.5; 2],
-                false
-            )
-            .is_none()
-        );
-        assert!(
-            Surface::planar(
-                Kind::Rect,
-                [0.0, 0.0, 1.0],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                n,
-                [0.5; 2],
-                true
-            )
-            .is_some()
-        );
+        assert!(rect(z, false).is_none());
+        assert!(rect(z, true).is_some());
         // The camera in the plane.
-        assert!(
-            Surface::planar(
-                Kind::Rect,
-                [1.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 0.0],
-                n,
-                [0.5; 2],
-                true
-            )
-            .is_none()
-        );
+        assert!(rect(x, true).is_none());
         // A degenerate triangle.
-        assert!(
-            Surface::planar(
-                Kind::Triangle,
-                [0.0, 0.0, 1.0],
-                [1.0, 0.0, 0.0],
-                [2.0, 0.0, 0.0],
-                [0.0, 0.0, -1.0],
-                [0.0; 2],
-                true
-            )
-            .is_none()
-        );
+        let sliver = Surface::planar(Kind::Triangle, z, x, [2.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0; 2], true);
+        assert!(sliver.is_none());
     }
 }
