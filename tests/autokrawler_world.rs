@@ -31,23 +31,12 @@ impl View {
         self.model.project(&c).expect("in the fisheye's field")
     }
 
-    /// Weighted centroid of magenta pixels within `reach` px of `around`.
+    /// Weighted centroid of magenta pixels (red and blue well above green) within
+    /// `reach` px of `around`.
     fn magenta_centroid(&self, around: [f64; 2], reach: f64) -> Option<[f64; 2]> {
-        let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
-        let v = self.image.view();
-        let (x0, x1) = ((around[0] - reach).max(0.0) as usize, (around[0] + reach) as usize);
-        let (y0, y1) = ((around[1] - reach).max(0.0) as usize, (around[1] + reach) as usize);
-        for y in y0..=y1.min(self.image.height() - 1) {
-            for x in x0..=x1.min(self.image.width() - 1) {
-                let p = v.get(x, y).unwrap();
-                // Magenta: red and blue well above green.
-                let w = (p[0].min(p[2]) as f64 - p[1] as f64 - 60.0).max(0.0);
-                sx += (x as f64 + 0.5) * w;
-                sy += (y as f64 + 0.5) * w;
-                n += w;
-            }
-        }
-        (n > 0.0).then(|| [sx / n, sy / n])
+        common::weighted_centroid(&self.image, around, reach, |p| {
+            (p[0].min(p[2]) as f64 - p[1] as f64 - 60.0).max(0.0)
+        })
     }
 }
 
@@ -72,7 +61,7 @@ fn view(p: &Profile, state: &KrawlerState) -> (View, marsupial::sim::krawler::Kr
 #[test]
 fn every_marker_appears_where_the_fisheye_projects_it_in_any_state() {
     let p = krawler();
-    let rest = KrawlerState::rest(&p);
+    let rest = KrawlerState::rest(&p).expect("autokrawler gear");
     let states = [
         rest,
         KrawlerState {
@@ -113,7 +102,7 @@ fn every_marker_appears_where_the_fisheye_projects_it_in_any_state() {
 #[test]
 fn steering_shifts_the_tie_rod_markers_against_the_plate_markers() {
     let p = krawler();
-    let rest = KrawlerState::rest(&p);
+    let rest = KrawlerState::rest(&p).expect("autokrawler gear");
     let ratio = |steer: f64| {
         let (v, gear) = view(
             &p,
@@ -143,7 +132,7 @@ fn steering_shifts_the_tie_rod_markers_against_the_plate_markers() {
 #[test]
 fn the_white_correction_face_shows_on_top_and_hides_underneath() {
     let p = krawler();
-    let rest = KrawlerState::rest(&p);
+    let rest = KrawlerState::rest(&p).expect("autokrawler gear");
     // Where the front-left wheel's correction face is at θ = 0: on top.
     let on_top_at = build(&p, &rest).unwrap().correction[0];
     let whiteness = |theta: f64| {
@@ -163,4 +152,17 @@ fn the_white_correction_face_shows_on_top_and_hides_underneath() {
     assert!(on_top > 200, "the white face on top: {on_top}");
     assert!(underneath < 120, "rubber where it was: {underneath}");
     assert!(p1.z < p0.z - 0.2, "the face went under: {} → {}", p0.z, p1.z);
+}
+
+#[test]
+fn a_profile_without_the_gear_is_refused_with_what_it_lacks() {
+    let bujold = common::shipped_profile("bujold");
+    let e = KrawlerState::rest(&bujold).unwrap_err().to_string();
+    assert!(e.contains("double-Ackermann") && e.contains("bujold"), "{e}");
+    let mut no_radius = krawler();
+    no_radius.drive.wheel_radius_m = None;
+    let e = build(&no_radius, &KrawlerState::rest(&krawler()).unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("wheel_radius_m"), "{e}");
 }

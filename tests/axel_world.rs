@@ -78,19 +78,11 @@ fn both_cameras_see_every_circle_where_their_models_project_it() {
                 .abs()
                 .max((project(at(1.0 * radius, 0.0))[0] - centre[0]).abs())
                 + 3.0;
-            let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
-            for y in (centre[1] - reach) as usize..=(centre[1] + reach) as usize {
-                for x in (centre[0] - reach) as usize..=(centre[0] + reach) as usize {
-                    let d = 255.0 - im.view().get(x, y).unwrap()[1] as f64;
-                    let (dx, dy) = (x as f64 + 0.5 - centre[0], y as f64 + 0.5 - centre[1]);
-                    if d > 60.0 && dx * dx + dy * dy <= reach * reach {
-                        sx += (x as f64 + 0.5) * d;
-                        sy += (y as f64 + 0.5) * d;
-                        n += d;
-                    }
-                }
-            }
-            let (cx, cy) = (sx / n, sy / n);
+            let dark = |p: [u8; 3]| {
+                let d = 255.0 - p[1] as f64;
+                if d > 60.0 { d } else { 0.0 }
+            };
+            let [cx, cy] = common::weighted_centroid(&im, centre, reach, dark).expect("dark pixels");
             assert!(
                 (cx - centre[0]).abs() < 0.5 && (cy - centre[1]).abs() < 0.5,
                 "{} circle {i}: centroid ({cx:.2}, {cy:.2}) vs projected ({:.2}, {:.2})",

@@ -19,7 +19,8 @@
 use super::SimError;
 use super::scene::{Material, PaintedSquare, Prim, Scene, Shape, Tag, albedo, boxed};
 use super::world::paint;
-use crate::profile::Profile;
+use crate::kinematics::DriveModel;
+use crate::profile::{NamedColor, Profile};
 use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 /// The kinematic state the camera observes (seed 003's ten degrees of freedom).
@@ -38,19 +39,23 @@ pub struct KrawlerState {
 
 impl KrawlerState {
     /// Level axles at the height the wheels rest at on flat ground, straight, unrotated.
-    pub fn rest(profile: &Profile) -> Self {
-        let gear = Gear::of(profile);
+    ///
+    /// # Errors
+    /// As [`build`], for a profile that does not describe the AutoKrawler's gear.
+    pub fn rest(profile: &Profile) -> Result<Self, SimError> {
+        let gear = Gear::of(profile)?;
         let drop = gear.camera_z - gear.wheel_radius;
-        Self {
+        Ok(Self {
             roll: [0.0; 2],
             drop: [drop; 2],
             steer: [0.0; 2],
             wheel: [0.0; 4],
-        }
+        })
     }
 }
 
-/// Dimensions of the running gear, from the profile (drive and markers) and our estimates.
+/// Dimensions of the running gear, from the profile (drive, camera mount and markers);
+/// the rest are our estimates, the constants below.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Gear {
     track: f64,
@@ -58,6 +63,7 @@ struct Gear {
     wheel_radius: f64,
     camera_z: f64,
     marker_side: f64,
+    marker_color: NamedColor,
 }
 
 /// Width of a wheel's tread, m (estimate).
@@ -74,15 +80,38 @@ const PLATE_TOP: f64 = 0.021;
 const ROD_TOP: f64 = 0.012;
 
 impl Gear {
-    fn of(profile: &Profile) -> Self {
-        let d = &profile.drive;
-        Self {
-            track: d.track_m,
-            wheelbase: d.wheelbase_m.unwrap_or(0.66),
-            wheel_radius: d.wheel_radius_m.unwrap_or(0.115),
-            camera_z: profile.cameras.first().map_or(0.4, |c| c.mount.z_m),
-            marker_side: profile.fiducial.markers.map_or(0.03, |m| m.side_m),
+    /// The gear `profile` describes: a double-Ackermann drive with a wheel radius, a
+    /// camera, and eight markers.
+    fn of(profile: &Profile) -> Result<Self, SimError> {
+        let missing = |what: &str| {
+            SimError::Unsupported(format!(
+                "profile `{}` has no {what}: the AutoKrawler gear needs it",
+                profile.name
+            ))
+        };
+        let DriveModel::DoubleAckermann(drive) = profile.drive.model() else {
+            return Err(missing("double-Ackermann drive"));
+        };
+        let wheel_radius = profile
+            .drive
+            .wheel_radius_m
+            .ok_or_else(|| missing("drive.wheel_radius_m"))?;
+        let camera = profile.cameras.first().ok_or_else(|| missing("camera"))?;
+        let markers = profile.fiducial.markers.ok_or_else(|| missing("[fiducial.markers]"))?;
+        if markers.count != 8 {
+            return Err(SimError::Unsupported(format!(
+                "the gear carries 8 markers (two per axle plate and tie rod); profile `{}` asks for {}",
+                profile.name, markers.count
+            )));
         }
+        Ok(Self {
+            track: drive.track,
+            wheelbase: drive.wheelbase,
+            wheel_radius,
+            camera_z: camera.mount.z_m,
+            marker_side: markers.side_m,
+            marker_color: markers.color,
+        })
     }
 }
 
@@ -98,23 +127,14 @@ pub struct KrawlerScene {
     pub correction: [Point3<f64>; 4],
 }
 
-/// Builds the gear of an AutoKrawler `profile` (one with `[fiducial.markers]`) in `state`.
+/// Builds the gear of an AutoKrawler `profile` in `state`.
 ///
 /// # Errors
-/// [`SimError::Unsupported`] for a profile without eight markers.
+/// [`SimError::Unsupported`] for a profile without a double-Ackermann drive, a wheel
+/// radius, a camera, or eight `[fiducial.markers]`.
 pub fn build(profile: &Profile, state: &KrawlerState) -> Result<KrawlerScene, SimError> {
-    let spec = profile
-        .fiducial
-        .markers
-        .ok_or_else(|| SimError::Unsupported(format!("profile `{}` has no [fiducial.markers]", profile.name)))?;
-    if spec.count != 8 {
-        return Err(SimError::Unsupported(format!(
-            "the gear carries 8 markers (two per axle plate and tie rod); profile `{}` asks for {}",
-            profile.name, spec.count
-        )));
-    }
-    let g = Gear::of(profile);
-    let marker_albedo = paint(spec.color);
+    let g = Gear::of(profile)?;
+    let marker_albedo = paint(g.marker_color);
     let metal_albedo = albedo([90, 92, 95], 1.0);
     let metal = Material::Solid(metal_albedo);
     let plate_albedo = albedo([150, 150, 150], 1.0);
@@ -232,15 +252,7 @@ pub fn build(profile: &Profile, state: &KrawlerState) -> Result<KrawlerScene, Si
         }
     }
     Ok(KrawlerScene {
-        scene: Scene {
-            prims,
-            ground: Material::Noise {
-                base: albedo([120, 110, 95], 1.0),
-                contrast: 0.3,
-                cell: 0.02,
-            },
-            sky: [0.9, 0.95, 1.0],
-        },
+        scene: Scene::on_floor(prims),
         markers,
         correction,
     })

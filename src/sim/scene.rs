@@ -145,6 +145,51 @@ pub enum Shape {
     },
 }
 
+/// A planar shape's frame: an origin, two in-plane axes and the unit normal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneFrame {
+    /// Centre (rect, disc) or first vertex (triangle).
+    pub origin: Point3<f64>,
+    /// First axis: unit for rects and discs, the first edge of a triangle.
+    pub u: Vector3<f64>,
+    /// Second axis: unit for rects and discs, the second edge of a triangle.
+    pub v: Vector3<f64>,
+    /// Unit normal, u × v normalised (the side a one-sided shape is seen from).
+    pub normal: Vector3<f64>,
+}
+
+impl Shape {
+    /// The frame of a planar shape; `None` for a sphere.
+    pub fn plane(&self) -> Option<PlaneFrame> {
+        match self {
+            Shape::Rect { centre, u, v, .. } | Shape::Disc { centre, u, v, .. } => Some(PlaneFrame {
+                origin: *centre,
+                u: *u,
+                v: *v,
+                normal: u.cross(v),
+            }),
+            Shape::Triangle { p } => {
+                let (u, v) = (p[1] - p[0], p[2] - p[0]);
+                Some(PlaneFrame {
+                    origin: p[0],
+                    u,
+                    v,
+                    normal: u.cross(&v).normalize(),
+                })
+            }
+            Shape::Sphere { .. } => None,
+        }
+    }
+
+    /// Where the shape is, for draw order: its centre, or a triangle's centroid.
+    pub fn centre(&self) -> Point3<f64> {
+        match self {
+            Shape::Rect { centre, .. } | Shape::Disc { centre, .. } | Shape::Sphere { centre, .. } => *centre,
+            Shape::Triangle { p } => Point3::from((p[0].coords + p[1].coords + p[2].coords) / 3.0),
+        }
+    }
+}
+
 /// What a primitive is, so lighting effects can target it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Tag {
@@ -270,4 +315,20 @@ pub struct Scene {
     pub ground: Material,
     /// Sky radiance (linear), seen where no ray hits anything.
     pub sky: [f32; 3],
+}
+
+impl Scene {
+    /// `prims` over the simulator's floor (a concrete-grey value-noise texture in 2 cm
+    /// cells) under a bright, slightly blue sky: the setting every built world shares.
+    pub fn on_floor(prims: Vec<Prim>) -> Self {
+        Self {
+            prims,
+            ground: Material::Noise {
+                base: albedo([125, 122, 115], 1.0),
+                contrast: 0.25,
+                cell: 0.02,
+            },
+            sky: [0.9, 0.95, 1.0],
+        }
+    }
 }

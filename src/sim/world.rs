@@ -326,15 +326,7 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
         ));
     }
     Ok(World {
-        scene: Scene {
-            prims,
-            ground: Material::Noise {
-                base: albedo([125, 122, 115], 1.0),
-                contrast: 0.25,
-                cell: 0.02,
-            },
-            sky: [0.9, 0.95, 1.0],
-        },
+        scene: Scene::on_floor(prims),
         dock,
         target_prims,
     })

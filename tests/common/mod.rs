@@ -123,3 +123,29 @@ pub fn scene(w: usize, h: usize, fid_frac: f64, seed: u64) -> RgbImage {
     }
     im
 }
+
+/// Centroid (pixel centres at +0.5) of the pixels within `reach` px of `around`, each
+/// weighted by `weight` of its RGB (0 leaves it out); `None` when nothing weighs.
+pub fn weighted_centroid(
+    im: &RgbImage,
+    around: [f64; 2],
+    reach: f64,
+    weight: impl Fn([u8; 3]) -> f64,
+) -> Option<[f64; 2]> {
+    let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+    let v = im.view();
+    let lo = |c: f64| (c - reach).max(0.0) as usize;
+    for y in lo(around[1])..=((around[1] + reach) as usize).min(im.height() - 1) {
+        for x in lo(around[0])..=((around[0] + reach) as usize).min(im.width() - 1) {
+            let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+            if (px - around[0]).powi(2) + (py - around[1]).powi(2) > reach * reach {
+                continue;
+            }
+            let w = weight(v.get(x, y).unwrap());
+            sx += px * w;
+            sy += py * w;
+            n += w;
+        }
+    }
+    (n > 0.0).then(|| [sx / n, sy / n])
+}

@@ -117,47 +117,38 @@ impl Renderer {
         // Front to back by centre distance: pixels already fully covered are skipped.
         self.order.clear();
         for (i, p) in scene.prims.iter().enumerate() {
-            let c = match &p.shape {
-                Shape::Rect { centre, .. } | Shape::Disc { centre, .. } | Shape::Sphere { centre, .. } => *centre,
-                Shape::Triangle { p } => Point3::from((p[0].coords + p[1].coords + p[2].coords) / 3.0),
-            };
-            self.order.push(((c - pose.position).norm() as f32, i));
+            self.order.push(((p.shape.centre() - pose.position).norm() as f32, i));
         }
         self.order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let key = f3(rt * light.key_direction());
         for k in 0..self.order.len() {
             let prim = &scene.prims[self.order[k].1];
-            let surface = match &prim.shape {
-                Shape::Rect { centre, u, v, half } => Surface::planar(
-                    Kind::Rect,
-                    f3(to_cam(centre)),
-                    f3(rt * u),
-                    f3(rt * v),
-                    f3(rt * u.cross(v)),
-                    [half[0] as f32, half[1] as f32],
-                    prim.two_sided,
+            // The surface in the camera frame, and the world normal and point the light
+            // is evaluated at (a sphere is lit as an upward-facing surface at its centre).
+            let (surface, world_n, lit_at) = match (&prim.shape, prim.shape.plane()) {
+                (Shape::Sphere { centre, radius }, _) => (
+                    Some(Surface::sphere(f3(to_cam(centre)), *radius as f32)),
+                    Vector3::z(),
+                    *centre,
                 ),
-                Shape::Disc { centre, u, v, radius } => Surface::planar(
-                    Kind::Disc,
-                    f3(to_cam(centre)),
-                    f3(rt * u),
-                    f3(rt * v),
-                    f3(rt * u.cross(v)),
-                    [*radius as f32; 2],
-                    prim.two_sided,
-                ),
-                Shape::Triangle { p } => {
-                    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
-                    Surface::planar(
-                        Kind::Triangle,
-                        f3(to_cam(&p[0])),
-                        f3(rt * e1),
-                        f3(rt * e2),
-                        f3(rt * e1.cross(&e2).normalize()),
-                        [0.0; 2],
+                (shape, Some(f)) => {
+                    let (kind, half) = match shape {
+                        Shape::Rect { half, .. } => (Kind::Rect, [half[0] as f32, half[1] as f32]),
+                        Shape::Disc { radius, .. } => (Kind::Disc, [*radius as f32; 2]),
+                        _ => (Kind::Triangle, [0.0; 2]),
+                    };
+                    let local = Surface::planar(
+                        kind,
+                        f3(to_cam(&f.origin)),
+                        f3(rt * f.u),
+                        f3(rt * f.v),
+                        f3(rt * f.normal),
+                        half,
                         prim.two_sided,
-                    )
+                    );
+                    (local, f.normal, f.origin)
                 }
-                Shape::Sphere { centre, radius } => Some(Surface::sphere(f3(to_cam(centre)), *radius as f32)),
+                (_, None) => continue,
             };
             // A one-sided plane seen from behind, or seen edge-on, is invisible.
             let Some(surface) = surface else {
@@ -166,18 +157,8 @@ impl Renderer {
             let Some(bbox) = self.screen_bounds(prim, &to_cam) else {
                 continue;
             };
-            let world_n = match &prim.shape {
-                Shape::Rect { u, v, .. } | Shape::Disc { u, v, .. } => u.cross(v),
-                Shape::Triangle { p } => (p[1] - p[0]).cross(&(p[2] - p[0])).normalize(),
-                Shape::Sphere { .. } => Vector3::z(),
-            };
-            let centre = match &prim.shape {
-                Shape::Rect { centre, .. } | Shape::Disc { centre, .. } | Shape::Sphere { centre, .. } => *centre,
-                Shape::Triangle { p } => p[0],
-            };
-            let irr = light.irradiance_at(&world_n, &centre, prim.tag);
-            let spec_dir = f3(rt * light.key_direction());
-            self.draw_prim(prim, &surface, bbox, irr, light, spec_dir);
+            let irr = light.irradiance_at(&world_n, &lit_at, prim.tag);
+            self.draw_prim(prim, &surface, bbox, irr, light, key);
         }
         self.draw_ground(scene, pose, light);
         self.sensor
@@ -335,7 +316,7 @@ impl Renderer {
                         let hit = cov[j] > 0.0;
                         // Fade to the sky colour far away (haze), which also hides
                         // texture aliasing.
-                        let haze = if hit { (t[j] * (1.0 / 40.0)).min(1.0) } else { 1.0 };
+                        let haze = if hit { haze(t[j]) } else { 1.0 };
                         let g = if hit { gain[j] * (1.0 - haze) } else { 0.0 };
                         let px = &mut rad[j];
                         for c in 0..3 {
@@ -357,7 +338,7 @@ impl Renderer {
                     }
                     let alb = tex.sample(h.a[j], h.b[j], h.fp[j]);
                     // Fade to the sky colour far away (haze), which also hides texture aliasing.
-                    let haze = (h.t[j] / 40.0).min(1.0);
+                    let haze = haze(h.t[j]);
                     for c in 0..3 {
                         px[c] += rest * (alb[c] * irr[c] * (1.0 - haze) + sky[c] * haze);
                     }
@@ -384,8 +365,14 @@ impl Renderer {
         let glare = prim.gloss * light.glare_strength() * SPECULAR_PEAK;
         let key_colour = light.key_colour();
         let tex = Texture::new(&prim.material, s.half);
-        // Matte, unshadowed and one colour: coverage is all the shading needs.
-        let plain_solid = shadows.is_empty() && glare <= 0.0 && matches!(tex, Texture::Solid(_));
+        // Matte and unshadowed: shading is albedo × irradiance, composited branch-free.
+        let matte = shadows.is_empty() && glare <= 0.0;
+        let solid = match tex {
+            Texture::Solid(c) => Some(c),
+            _ => None,
+        };
+        // Matte and one colour: coverage is all the shading needs.
+        let plain_solid = matte && solid.is_some();
         let [bx0, y0, bx1, y1] = bbox;
         let mut runs = std::mem::take(&mut self.runs);
         for y in y0..y1 {
@@ -401,16 +388,12 @@ impl Renderer {
                 let n = x1 - x0;
                 let noise_base = tex.noise_row(&h.a[..n], &h.b[..n], &h.fp[..n], &mut self.tex_gain);
                 let base = y * w + x0;
-                if shadows.is_empty() && glare <= 0.0 {
-                    // Matte, unshadowed, one colour or value noise (most of a scene):
-                    // branch-free, so it vectorises. Full or missed pixels add k = 0.
-                    let solid = match tex {
-                        Texture::Solid(c) => Some(c),
-                        _ => noise_base,
-                    };
-                    if let Some(alb) = solid {
+                if matte {
+                    // Matte, one colour or value noise (most of a scene): branch-free, so
+                    // it vectorises. Full or missed pixels add k = 0.
+                    if let Some(alb) = solid.or(noise_base) {
                         let gain = &self.tex_gain[..n];
-                        let unit = matches!(tex, Texture::Solid(_));
+                        let unit = solid.is_some();
                         let (rad, alpha) = (&mut self.radiance[base..base + n], &mut self.alpha[base..base + n]);
                         let cov = &h.cov[..n];
                         for j in 0..n {
@@ -423,7 +406,7 @@ impl Renderer {
                             let g = if unit { 1.0 } else { gain[j] };
                             let px = &mut rad[j];
                             for c in 0..3 {
-                                px[c] += k * (alb[c] * g * irr[c] * 1.0);
+                                px[c] += k * (alb[c] * g * irr[c]);
                             }
                             alpha[j] += k;
                         }
@@ -490,6 +473,13 @@ impl Renderer {
         }
         self.runs = runs;
     }
+}
+
+/// How far the ground has faded into the sky colour at distance `t`, m: linearly, to
+/// nothing at 40 m. It also hides the texture's aliasing far away.
+#[inline(always)]
+fn haze(t: f32) -> f32 {
+    (t * (1.0 / 40.0)).min(1.0)
 }
 
 /// The runs of a row still open to paint (pixels not yet fully covered), as (x0, x1)

@@ -93,8 +93,6 @@ pub(super) struct Sensor {
     level_lin: [f32; 256],
     /// Output levels per 8-bit linear unit at each output byte: the sRGB curve's slope.
     level_slope: [f32; 256],
-    /// This frame's noise SD per output byte, in output levels × [`SD_ONE`].
-    sd_out: [i32; 256],
     /// This frame's linear level (× `LUT_MAX`) → output byte | its noise SD << 8: one
     /// lookup per channel instead of two dependent ones.
     level_and_sd: Box<[i32; LUT_LEN]>,
@@ -135,7 +133,6 @@ impl Sensor {
             to_srgb,
             level_lin,
             level_slope,
-            sd_out: [0; 256],
             level_and_sd: Box::new([0; LUT_LEN]),
             row_gain: Vec::new(),
             row_code: Vec::new(),
@@ -177,7 +174,9 @@ impl Sensor {
         // camera's gain is up) plus shot noise ∝ √signal, both taken through the slope of
         // the sRGB curve at that level.
         let read = params.read_noise * k.max(1.0).sqrt();
-        for ((sd, lin), slope) in self.sd_out.iter_mut().zip(&self.level_lin).zip(&self.level_slope) {
+        // This frame's noise SD per output byte, in output levels × [`SD_ONE`].
+        let mut sd_out = [0i32; 256];
+        for ((sd, lin), slope) in sd_out.iter_mut().zip(&self.level_lin).zip(&self.level_slope) {
             let sd_lin = read + params.shot_noise * (lin * 255.0).sqrt();
             // An SD past the whole output range means nothing more; the cap also bounds
             // the fixed-point products below whatever noise a scenario asks for.
@@ -186,7 +185,7 @@ impl Sensor {
                 .clamp(0.0, 255.0 * SD_ONE as f32) as i32;
         }
         for (e, &g) in self.level_and_sd.iter_mut().zip(self.to_srgb.iter()) {
-            *e = g as i32 | (self.sd_out[g as usize] << 8);
+            *e = g as i32 | (sd_out[g as usize] << 8);
         }
         let lut = &*self.level_and_sd;
         let row_len = width * 3;
