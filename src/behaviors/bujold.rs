@@ -210,7 +210,7 @@ pub const CLEARANCE_X_M: f64 = 0.45;
 pub const RELIABLE_HEIGHT_PX: f64 = 40.0;
 /// A view changing less than this (mean 8-bit levels per frame, see [`FrameChange`]) is
 /// still: pixel noise of ±6 levels reads under 0.5 (`frame_change`'s tests), one tick of
-/// the search turn 3.4–8 on rendered scenes (`tests/sim_render.rs`).
+/// the search turn 3.6–8.2 on rendered scenes (`tests/sim_render.rs`).
 pub const STILL_LEVELS: f32 = 1.0;
 /// The search turn jammed: the view still for this long while turning, s.
 pub const JAMMED_AFTER_S: f64 = 1.5;

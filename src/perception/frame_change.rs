@@ -5,7 +5,7 @@
 //! against the mother's body: the tracks spin either way. The camera can. Each frame is
 //! reduced to a 16 × 12 grid of mean brightness; the cue is the mean absolute difference
 //! between consecutive grids, in 8-bit levels. A turn at 25°/s moves a 70° image by a
-//! twenty-eighth of its width per 10 Hz frame, which reads 3.4–8 levels on rendered
+//! twenty-eighth of its width per 10 Hz frame, which reads 3.6–8.2 levels on rendered
 //! Bujold scenes (`tests/sim_render.rs`); a still robot sees only sensor noise, averaged
 //! over each cell's samples to a fraction of a level (±6 levels of pixel noise read under
 //! 0.5, tested below).
