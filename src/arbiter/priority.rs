@@ -57,4 +57,10 @@ impl Behavior for Priority {
     fn reset(&mut self) {
         self.children.iter_mut().for_each(|c| c.reset());
     }
+
+    /// Every child that has the state starts there (a priority node usually holds one
+    /// sequence under its overrides).
+    fn start(&mut self, state: &str) -> bool {
+        self.children.iter_mut().fold(false, |any, c| c.start(state) || any)
+    }
 }

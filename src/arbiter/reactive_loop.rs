@@ -390,7 +390,7 @@ impl LoopCore {
         }
         let drive = self.config.drive.realise(&step.output.drive, &self.config.limits);
         match step.status {
-            Status::Running => TickOutput {
+            Status::Running | Status::Event(_) => TickOutput {
                 command: MotorOutput {
                     drive,
                     aux: step.output.aux,

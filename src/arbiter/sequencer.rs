@@ -1,13 +1,28 @@
-//! Sequencing: a state machine whose states are behaviors, with latched states.
+//! Sequencing: a state machine whose states are behaviors, with typed transitions,
+//! per-state timeouts and latched states.
 //!
 //! Each tick the sequencer may first ask its [`Selector`] which state should run (the
 //! reactive re-selection RAPOSA's seven states need); a *latched* state is exempt from
-//! re-selection until it reports `Done` (RAPOSA's states 6 and 7 must finish their
-//! manoeuvre). When the running state ends, the transition table picks the next state or
-//! finishes the whole sequence with that state's outcome.
+//! re-selection until it ends (RAPOSA's states 6 and 7 must finish their manoeuvre).
+//!
+//! A state ends in one of two ways, and the transition table says where each leads:
+//! * with a named **event** ([`Status::Event`]: `"acquired"`, `"lost"`, `"at_dock"`...):
+//!   this tick's output is still commanded and the next state is entered for the next
+//!   tick (an event with no entry in the table ends the sequence as failed to control);
+//! * with an **outcome** ([`Status::Done`]): `on_success` / `on_failure` decide, or an
+//!   event entry named `"docked"`, `"completed"` or `"failed"` when one is declared.
+//!
+//! A state may have a **timeout**: once it has run longer, the sequencer ends it with the
+//! event `"timeout"` before ticking it (stopping the base that tick); with no entry for
+//! `"timeout"` the sequence ends with [`FailureReason::Timeout`].
+//!
+//! Entering a state calls its [`Behavior::enter`] with the inputs of the tick the
+//! transition happened in, so it can note where and when it began. A sequencer that has
+//! finished is inactive (`None`) until it is started again ([`Behavior::start`],
+//! [`Behavior::enter`] or [`Behavior::reset`]).
 
 use super::decision::{Decision, Strategy};
-use crate::schemas::{Behavior, Feedback, Inputs, MotorOutput, Status, Step};
+use crate::schemas::{Behavior, FailureReason, Feedback, Inputs, MotorOutput, Outcome, Status, Step};
 
 /// Where to go when a state ends.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -38,6 +53,16 @@ struct State {
     latched: bool,
     on_success: Next,
     on_failure: Next,
+    /// Named events and where they lead (a handful per state: a linear scan is fastest).
+    on_event: Vec<(String, Next)>,
+    /// Longest time in the state, s.
+    timeout: Option<f64>,
+}
+
+impl State {
+    fn event(&self, name: &str) -> Option<Next> {
+        self.on_event.iter().find(|(e, _)| e == name).map(|(_, n)| *n)
+    }
 }
 
 /// A sequencer over behavior states.
@@ -45,20 +70,36 @@ pub struct Sequencer {
     name: String,
     states: Vec<State>,
     current: usize,
+    /// The current state is entered at the next tick (after a start or a reset).
+    pending_entry: bool,
+    /// When the current state was entered, loop time.
+    entered_at: f64,
+    /// The current state was started by its own [`Behavior::start`]: only the clock of
+    /// its timeout starts at the next tick.
+    pending_clock: bool,
+    /// The sequence has ended; inactive until started again.
+    finished: bool,
     selector: Option<Box<dyn Selector>>,
     transitions: u64,
+    /// Why the last transition fired (`"acquired"`, `"timeout"`, `"selected"`...).
+    last_event: Option<&'static str>,
     decision: Decision,
 }
 
 impl Sequencer {
-    /// An empty sequencer; add states with [`Sequencer::state`].
+    /// An empty sequencer; add states with [`Sequencer::state`]. It starts at state 0.
     pub fn new(name: impl Into<String>) -> Self {
         Self {
             name: name.into(),
             states: Vec::new(),
             current: 0,
+            pending_entry: true,
+            entered_at: 0.0,
+            pending_clock: false,
+            finished: false,
             selector: None,
             transitions: 0,
+            last_event: None,
             decision: Decision::new(Strategy::Sequencer),
         }
     }
@@ -72,15 +113,37 @@ impl Sequencer {
             latched,
             on_success: Next::Goto(i + 1),
             on_failure: Next::Finish,
+            on_event: Vec::new(),
+            timeout: None,
         });
         i
     }
 
-    /// Sets the transitions of state `i`; out-of-range indices are ignored.
+    /// Sets the outcome transitions of state `i`; out-of-range indices are ignored.
     pub fn transitions(&mut self, i: usize, on_success: Next, on_failure: Next) -> &mut Self {
         if let Some(s) = self.states.get_mut(i) {
             s.on_success = on_success;
             s.on_failure = on_failure;
+        }
+        self
+    }
+
+    /// Declares where the event `event` of state `i` leads (replacing an earlier entry);
+    /// out-of-range indices are ignored.
+    pub fn on_event(&mut self, i: usize, event: impl Into<String>, next: Next) -> &mut Self {
+        if let Some(s) = self.states.get_mut(i) {
+            let event = event.into();
+            s.on_event.retain(|(e, _)| *e != event);
+            s.on_event.push((event, next));
+        }
+        self
+    }
+
+    /// Limits the time state `i` may run (s); see the module docs. Out-of-range indices
+    /// are ignored.
+    pub fn timeout(&mut self, i: usize, seconds: f64) -> &mut Self {
+        if let Some(s) = self.states.get_mut(i) {
+            s.timeout = Some(seconds);
         }
         self
     }
@@ -96,9 +159,30 @@ impl Sequencer {
         self.current
     }
 
+    /// Name of the running state.
+    pub fn current_name(&self) -> &str {
+        self.states.get(self.current).map_or("", |s| s.behavior.name())
+    }
+
+    /// Index of the state named `name`.
+    pub fn index_of(&self, name: &str) -> Option<usize> {
+        self.states.iter().position(|s| s.behavior.name() == name)
+    }
+
+    /// True once the sequence has ended (until it is started again).
+    pub fn is_finished(&self) -> bool {
+        self.finished
+    }
+
     /// Number of state changes so far.
     pub fn transition_count(&self) -> u64 {
         self.transitions
+    }
+
+    /// Why the last transition fired: the event's name, `"selected"` for a selector's
+    /// switch, `"started"` for [`Behavior::start`].
+    pub fn last_event(&self) -> Option<&'static str> {
+        self.last_event
     }
 
     /// The last tick's decision.
@@ -106,21 +190,35 @@ impl Sequencer {
         &self.decision
     }
 
-    fn enter(&mut self, i: usize, now: f64) {
+    /// Makes state `i` current and enters it at the next tick.
+    pub fn start_at(&mut self, i: usize) {
+        if i < self.states.len() {
+            self.current = i;
+            self.pending_entry = true;
+            self.finished = false;
+            self.last_event = Some("started");
+        }
+    }
+
+    fn enter(&mut self, i: usize, inputs: &Inputs<'_>, why: &'static str) {
         if i != self.current {
             tracing::debug!(
                 target: "marsupial::arbiter",
                 arbiter = %self.name,
                 from = self.states.get(self.current).map(|s| s.behavior.name()).unwrap_or("-"),
                 to = self.states.get(i).map(|s| s.behavior.name()).unwrap_or("-"),
-                now,
+                event = why,
+                now = inputs.now,
                 "sequencer transition"
             );
             self.transitions += 1;
         }
         self.current = i;
+        self.last_event = Some(why);
+        self.entered_at = inputs.now;
+        self.pending_entry = false;
         if let Some(s) = self.states.get_mut(i) {
-            s.behavior.reset();
+            s.behavior.enter(inputs);
         }
     }
 
@@ -128,6 +226,60 @@ impl Sequencer {
         match next {
             Next::Goto(j) if j < self.states.len() => Some(j),
             _ => None,
+        }
+    }
+
+    /// Where state `cur` goes when it ends with `status` (not `Running`).
+    fn next_for(&self, cur: usize, status: Status) -> Next {
+        let s = &self.states[cur];
+        match status {
+            Status::Event(e) => s.event(e).unwrap_or(Next::Finish),
+            Status::Done(outcome) => {
+                let named = match outcome {
+                    Outcome::Docked => "docked",
+                    Outcome::Completed => "completed",
+                    Outcome::Failed(_) => "failed",
+                };
+                s.event(named).unwrap_or(if outcome.is_success() {
+                    s.on_success
+                } else {
+                    s.on_failure
+                })
+            }
+            Status::Running => Next::Goto(cur),
+        }
+    }
+
+    /// Ends state `cur` with `status`, returning the sequence's step for this tick.
+    fn finish_state(&mut self, cur: usize, step: Step, inputs: &Inputs<'_>) -> Step {
+        let next = self.next_for(cur, step.status);
+        match self.resolve(next) {
+            Some(j) => {
+                let why = match step.status {
+                    Status::Event(e) => e,
+                    Status::Done(Outcome::Docked) => "docked",
+                    Status::Done(Outcome::Completed) => "completed",
+                    _ => "failed",
+                };
+                self.enter(j, inputs, why);
+                Step {
+                    status: Status::Running,
+                    ..step
+                }
+            }
+            // `Finish`, or a `Goto` past the last state: the sequence ends with this
+            // state's outcome (an unhandled event counts as failing to control).
+            None => {
+                self.finished = true;
+                let outcome = match step.status {
+                    Status::Done(o) => o,
+                    _ => Outcome::Failed(FailureReason::FailedToControl),
+                };
+                Step {
+                    status: Status::Done(outcome),
+                    ..step
+                }
+            }
         }
     }
 }
@@ -139,21 +291,41 @@ impl Behavior for Sequencer {
 
     fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
         self.decision.clear();
-        if self.states.is_empty() {
+        if self.states.is_empty() || self.finished {
             return None;
         }
-        let latched = self.states[self.current].latched;
-        if !latched {
+        if self.pending_entry {
+            let cur = self.current;
+            self.enter(cur, inputs, self.last_event.unwrap_or("started"));
+        } else if self.pending_clock {
+            self.entered_at = inputs.now;
+        }
+        self.pending_clock = false;
+        if !self.states[self.current].latched {
             let cur = self.current;
             if let Some(sel) = self.selector.as_mut()
                 && let Some(j) = sel.select(inputs, cur)
                 && j < self.states.len()
                 && j != cur
             {
-                self.enter(j, inputs.now);
+                self.enter(j, inputs, "selected");
             }
         }
         let cur = self.current;
+        if let Some(limit) = self.states[cur].timeout
+            && inputs.now - self.entered_at > limit
+        {
+            // The state overran: stop the base this tick and take its "timeout" exit.
+            let feedback = Feedback::new("timeout", inputs.now - self.entered_at);
+            let step = match self.states[cur].event("timeout") {
+                Some(_) => Step::event("timeout", MotorOutput::stop(), feedback),
+                None => Step::done(Outcome::Failed(FailureReason::Timeout), MotorOutput::stop(), feedback),
+            };
+            self.decision.push(cur, None);
+            let result = self.finish_state(cur, step, inputs);
+            self.decision.output = Some(result.output);
+            return Some(result);
+        }
         let step = self.states[cur].behavior.tick(inputs);
         self.decision.push(cur, step.as_ref());
         self.decision.winner = Some(cur);
@@ -163,28 +335,7 @@ impl Behavior for Sequencer {
         };
         let result = match step.status {
             Status::Running => step,
-            Status::Done(outcome) => {
-                let next = if outcome.is_success() {
-                    self.states[cur].on_success
-                } else {
-                    self.states[cur].on_failure
-                };
-                match self.resolve(next) {
-                    Some(j) => {
-                        self.enter(j, inputs.now);
-                        Step {
-                            status: Status::Running,
-                            ..step
-                        }
-                    }
-                    // `Finish`, or a `Goto` past the last state: the sequence ends with
-                    // this state's outcome.
-                    None => Step {
-                        status: Status::Done(outcome),
-                        ..step
-                    },
-                }
-            }
+            _ => self.finish_state(cur, step, inputs),
         };
         self.decision.output = Some(result.output);
         let states = &self.states;
@@ -196,8 +347,36 @@ impl Behavior for Sequencer {
     fn reset(&mut self) {
         self.current = 0;
         self.transitions = 0;
+        self.finished = false;
+        self.pending_entry = true;
+        self.last_event = None;
         if let Some(s) = self.states.first_mut() {
             s.behavior.reset();
         }
+    }
+
+    fn enter(&mut self, inputs: &Inputs<'_>) {
+        self.reset();
+        self.enter(0, inputs, "started");
+    }
+
+    fn start(&mut self, state: &str) -> bool {
+        if let Some(i) = self.index_of(state) {
+            self.start_at(i);
+            return true;
+        }
+        // A nested sequence that has the state: make it current here too, entered by
+        // the child's own start (not reset by our entry).
+        for i in 0..self.states.len() {
+            if self.states[i].behavior.start(state) {
+                self.current = i;
+                self.pending_entry = false;
+                self.pending_clock = true;
+                self.finished = false;
+                self.last_event = Some("started");
+                return true;
+            }
+        }
+        false
     }
 }

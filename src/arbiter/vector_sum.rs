@@ -101,4 +101,10 @@ impl Behavior for VectorSum {
     fn reset(&mut self) {
         self.children.iter_mut().for_each(|(_, c)| c.reset());
     }
+
+    fn start(&mut self, state: &str) -> bool {
+        self.children
+            .iter_mut()
+            .fold(false, |any, (_, c)| c.start(state) || any)
+    }
 }

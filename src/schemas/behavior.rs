@@ -102,6 +102,11 @@ impl Feedback {
 pub enum Status {
     /// Keep ticking.
     Running,
+    /// This state of a sequence is over and names why (`"acquired"`, `"lost"`,
+    /// `"at_dock"`...): the enclosing [`Sequencer`](crate::arbiter::Sequencer) takes the
+    /// transition its table declares for the event after this tick, and this tick's
+    /// output is still commanded. Outside a sequencer an event reads as `Running`.
+    Event(&'static str),
     /// Finished; the output of this tick is its last.
     Done(Outcome),
 }
@@ -127,6 +132,16 @@ impl Step {
         }
     }
 
+    /// A step that commands `output` this tick and ends the current sequencer state with
+    /// `event` (see [`Status::Event`]).
+    pub fn event(event: &'static str, output: MotorOutput, feedback: Feedback) -> Self {
+        Self {
+            output,
+            feedback,
+            status: Status::Event(event),
+        }
+    }
+
     /// A final step: stops the base (every exit path commands zero velocity) and reports
     /// the outcome. Auxiliary commands in `aux_output` are kept.
     pub fn done(outcome: Outcome, aux_output: MotorOutput, feedback: Feedback) -> Self {
@@ -147,8 +162,22 @@ pub trait Behavior: Send {
     fn name(&self) -> &str;
     /// Runs one tick.
     fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step>;
-    /// Returns to the initial state (called by sequencers when a state is entered).
+    /// Returns to the initial state.
     fn reset(&mut self) {}
+    /// Called when a sequencer enters this behavior as its state, with the inputs of the
+    /// tick the transition happened in (so a state can note where and when it began:
+    /// its odometry mark, its start time). The default resets.
+    fn enter(&mut self, inputs: &Inputs<'_>) {
+        let _ = inputs;
+        self.reset();
+    }
+    /// Starts this behavior at the state named `state` (of a sequencer in it), entered at
+    /// the next tick; returns false when no state has that name. This is how a mission
+    /// (departure, docking) is started in a composed tree. The default has no states.
+    fn start(&mut self, state: &str) -> bool {
+        let _ = state;
+        false
+    }
 }
 
 impl<B: Behavior + ?Sized> Behavior for Box<B> {
@@ -160,6 +189,12 @@ impl<B: Behavior + ?Sized> Behavior for Box<B> {
     }
     fn reset(&mut self) {
         (**self).reset()
+    }
+    fn enter(&mut self, inputs: &Inputs<'_>) {
+        (**self).enter(inputs)
+    }
+    fn start(&mut self, state: &str) -> bool {
+        (**self).start(state)
     }
 }
 
