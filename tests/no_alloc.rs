@@ -173,3 +173,54 @@ fn a_ticks_camera_list_does_not_allocate() {
     assert_eq!(cams.len(), 4);
     assert_eq!(allocs(), 0, "four cameras fit inline");
 }
+
+/// The composed Bujold behavior (perception, shared memory, arbiters, phase schemas)
+/// allocates nothing per tick once warmed up: through search, approach, the at-dock
+/// decision, repositioning and back, with frames that come and go.
+#[test]
+fn composed_bujold_ticks_do_not_allocate() {
+    use marsupial::behaviors::agent_for;
+    use marsupial::geometry::Pose2;
+    use marsupial::schemas::{Inputs, OdometryReading, Stamped};
+    let p = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/bujold.toml")).unwrap();
+    let mut agent = agent_for(&p).unwrap();
+    // Far (small), near (at the dock's pixel count) and no fiducial.
+    let frames = [
+        common::scene(256, 240, 0.25, 1),
+        common::scene(256, 240, 0.9, 2),
+        common::background(256, 240),
+    ];
+    let run = |agent: &mut Box<dyn marsupial::behaviors::Agent>, from: u64, to: u64| {
+        let mut phases = 0u64;
+        for k in from..to {
+            let t = k as f64 * 0.1;
+            let f = &frames[(k / 40 % 3) as usize];
+            let cams: CameraInputs<'_> = smallvec::smallvec![Some(CameraInput {
+                stamp: t,
+                image: f.view()
+            })];
+            let mut inputs = Inputs::empty(t);
+            inputs.cameras = &cams;
+            let pose = Pose2::new(1.0 + 0.001 * (k % 50) as f64, 0.0, 0.01 * (k % 7) as f64);
+            inputs.odometry = Some(Stamped::new(
+                t,
+                OdometryReading {
+                    pose,
+                    ..Default::default()
+                },
+            ));
+            if let Some(s) = agent.tick(&inputs) {
+                phases = phases.wrapping_add(s.feedback.phase.len() as u64);
+            }
+        }
+        phases
+    };
+    agent.begin_docking();
+    run(&mut agent, 0, 240); // warm-up: every phase's buffers sized once
+    reset();
+    COUNTING.with(|c| c.set(true));
+    let ran = run(&mut agent, 240, 600);
+    COUNTING.with(|c| c.set(false));
+    assert!(ran > 0);
+    assert_eq!(allocs(), 0, "allocations in the composed behavior's ticks");
+}

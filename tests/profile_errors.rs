@@ -64,7 +64,7 @@ const CASES: &[(&str, &str, Option<usize>, &str)] = &[
     (
         "stale_below_tick.toml",
         "loop.camera_stale_s",
-        Some(68),
+        Some(67),
         "at least one tick",
     ),
     (
@@ -82,7 +82,7 @@ const CASES: &[(&str, &str, Option<usize>, &str)] = &[
     (
         "chroma_gate_too_wide.toml",
         "perception.min_chroma_deg",
-        Some(71),
+        Some(70),
         "expected a number in [0, 30], got 45",
     ),
     ("empty.toml", "", None, "missing field `name`"),

@@ -343,16 +343,23 @@ fn a_glossy_highlight_peaks_at_a_dielectrics_fresnel_reflection() {
     );
 }
 
-/// Backs `bujold::STILL_LEVELS` and `perception::frame_change`'s claims on rendered
+/// Backs the search's `still_levels` (profiles/bujold.toml) and `perception::frame_change`'s claims on rendered
 /// frames under the default sensor's full noise: between two frames of a still robot the
 /// cue stays at half the 1-level threshold (0.42–0.50 when written); one 10 Hz tick of
 /// the search turn (25°/s, 2.5°) reads over three times it, beside the gate, at range and
 /// close on the axis (3.9, 3.6 and 8.2; run with `--nocapture` to see them).
 #[test]
 fn the_frame_change_cue_separates_a_still_robot_from_a_turning_one() {
-    use marsupial::behaviors::bujold::STILL_LEVELS;
+    use marsupial::behaviors::bujold::params::SearchParams;
     use marsupial::perception::frame_change::FrameChange;
+    use marsupial::profile::NodeSpec;
     let p = bujold();
+    let tree = p.behavior.tree.as_ref().expect("bujold declares a tree");
+    let Some(NodeSpec::Leaf { params, .. }) = tree.nodes.get("search") else {
+        panic!("bujold's tree has a `search` leaf")
+    };
+    let search: SearchParams = toml::Value::Table(params.clone()).try_into().unwrap();
+    let still_levels = search.still_levels;
     let w = world::build(&p, &[], &[]).unwrap();
     let cam = &p.cameras[0];
     let light = LightingRun::new(LightingSpec::default().resolve(), &mut Rng::new(3), 200.0);
@@ -375,7 +382,7 @@ fn the_frame_change_cue_separates_a_still_robot_from_a_turning_one() {
             .fold(0.0f32, f32::max);
         let turned = frame(25, 2.5, &mut cue).unwrap();
         eprintln!("({x}, {y}, {heading_deg}°): still ≤ {still:.2}, turned {turned:.2}");
-        assert!(still < 0.8 * STILL_LEVELS, "({x}, {y}): still reads {still}");
-        assert!(turned > 3.0 * STILL_LEVELS, "({x}, {y}): a turn reads {turned}");
+        assert!(still < 0.8 * still_levels, "({x}, {y}): still reads {still}");
+        assert!(turned > 3.0 * still_levels, "({x}, {y}): a turn reads {turned}");
     }
 }

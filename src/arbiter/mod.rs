@@ -6,6 +6,7 @@
 //! [`Decision`] and emits it through `tracing` (target `marsupial::arbiter`).
 //! [`ReactiveLoop`] is the pure tick; [`runtime::run`] is the threaded wrapper.
 
+pub mod blackboard;
 pub mod decision;
 pub mod priority;
 pub mod reactive_loop;
@@ -13,6 +14,7 @@ pub mod runtime;
 pub mod sequencer;
 pub mod vector_sum;
 
+pub use blackboard::Blackboard;
 pub use decision::{Candidate, Decision, Strategy};
 pub use priority::Priority;
 pub use reactive_loop::{

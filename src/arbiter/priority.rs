@@ -61,6 +61,10 @@ impl Behavior for Priority {
     /// Every child that has the state starts there (a priority node usually holds one
     /// sequence under its overrides).
     fn start(&mut self, state: &str) -> bool {
-        self.children.iter_mut().fold(false, |any, c| c.start(state) || any)
+        let mut any = false;
+        for c in self.children.iter_mut() {
+            any |= c.start(state);
+        }
+        any
     }
 }

@@ -31,7 +31,7 @@ pub struct AgentStats {
 }
 
 /// Why no agent could be built for a profile.
-#[derive(Debug, Clone, PartialEq, Error)]
+#[derive(Debug, Clone, Error)]
 pub enum BuildError {
     /// The profile's approach has no behavior implementation.
     #[error("profile `{profile}`: approach `{approach:?}` has no docking behavior in this build")]
@@ -41,6 +41,10 @@ pub enum BuildError {
         /// Its approach.
         approach: ApproachKind,
     },
+    /// The profile's `[behavior.tree]` does not build: an unknown schema, params a schema
+    /// refuses (the error names the profile's line).
+    #[error("{0}")]
+    Tree(crate::config::ConfigError),
     /// The profile lacks something the behavior needs.
     #[error("profile `{profile}`: {what}")]
     Profile {

@@ -8,5 +8,6 @@
 pub mod agent;
 pub mod bujold;
 pub mod raposa;
+pub mod registry;
 
 pub use agent::{Agent, AgentStats, BuildError, agent_for};

@@ -1,5 +1,6 @@
 //! `[behavior]` and `[loop]`: which behaviors run, their gains, and loop timing.
 
+use super::tree::TreeSpec;
 use crate::config::Validator;
 use serde::{Deserialize, Serialize};
 
@@ -19,16 +20,49 @@ pub enum ApproachKind {
     None,
 }
 
-/// How the behaviors are coordinated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Coordination {
-    /// Subsumption.
-    Priority,
-    /// Weighted vector sum.
-    VectorSum,
-    /// State machine.
-    Sequencer,
+/// What Bujold's phase schemas share (`[behavior.bujold]`): how the fiducial views are
+/// filtered and where repositioning stages. Each phase's own tuning sits with its node in
+/// `[behavior.tree]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BujoldTuning {
+    /// The viewing angle from the block ratio is not trusted for blocks under this
+    /// height, px (at 1.3 m two-pixel noise is ±35° of viewing angle).
+    pub trust_from_px: f64,
+    /// ... and fully trusted this much taller, px.
+    pub trust_ramp_px: f64,
+    /// Low-pass gain on the viewing angle per frame.
+    pub alpha_low_pass: f64,
+    /// Blocks at least this tall give a viewing angle good enough to plan on, px.
+    pub reliable_height_px: f64,
+    /// Reliable frames the repositioning decision takes the median over (longer than a
+    /// rotating beacon's period: a flash cannot fake an off-axis view), at most 64.
+    pub alpha_window_frames: usize,
+    /// Staging distance on the dock axis for repositioning, m.
+    pub staging_x_m: f64,
+    /// Staging at least this much farther out than the robot is, m.
+    pub staging_margin_m: f64,
+    /// Closer to the body than this (m along the axis) the robot drives out before turning.
+    pub clearance_x_m: f64,
+    /// Where on the dock axis the ballistic drive to an a-priori dock location ends, m:
+    /// far enough that an a-priori error of a few decimetres still leaves the flap in view.
+    pub ballistic_staging_m: f64,
+}
+
+impl Default for BujoldTuning {
+    fn default() -> Self {
+        Self {
+            trust_from_px: 18.0,
+            trust_ramp_px: 25.0,
+            alpha_low_pass: 0.3,
+            reliable_height_px: 40.0,
+            alpha_window_frames: 16,
+            staging_x_m: 0.75,
+            staging_margin_m: 0.15,
+            clearance_x_m: 0.45,
+            ballistic_staging_m: 1.2,
+        }
+    }
 }
 
 /// Gains of the ratio-steering motor schema.
@@ -164,8 +198,12 @@ pub struct TwoArcGains {
 pub struct BehaviorSpec {
     /// Approach behavior.
     pub approach: ApproachKind,
-    /// Coordination strategy.
-    pub coordination: Coordination,
+    /// The behavior tree (leaves, arbiters, transitions); see [`TreeSpec`].
+    #[serde(default)]
+    pub tree: Option<TreeSpec>,
+    /// Tuning Bujold's phase schemas share.
+    #[serde(default)]
+    pub bujold: Option<BujoldTuning>,
     /// Retries after a failed attempt near the dock.
     pub max_retries: u32,
     /// Longest search rotation before giving up, s.
@@ -204,6 +242,18 @@ pub struct LoopSpec {
 }
 
 pub(crate) fn validate_behavior(b: &BehaviorSpec, v: &mut Validator<'_>) {
+    if let Some(t) = &b.tree {
+        super::tree::validate_tree(t, "behavior.tree", v);
+    }
+    if let Some(t) = &b.bujold {
+        v.range("behavior.bujold.alpha_low_pass", t.alpha_low_pass, 0.0, 1.0);
+        v.positive("behavior.bujold.trust_ramp_px", t.trust_ramp_px);
+        v.require(
+            (1..=64).contains(&t.alpha_window_frames),
+            "behavior.bujold.alpha_window_frames",
+            || format!("expected 1 to 64 frames, got {}", t.alpha_window_frames),
+        );
+    }
     v.positive("behavior.search_timeout_s", b.search_timeout_s);
     v.positive("behavior.phase_timeout_s", b.phase_timeout_s);
     let missing = |v: &mut Validator<'_>, table: &str| {

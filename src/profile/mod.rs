@@ -17,9 +17,10 @@ pub mod fiducial;
 pub mod geometry;
 pub mod perception;
 pub mod pyramid_perception;
+pub mod tree;
 
 pub use behavior::{
-    ApproachKind, BehaviorSpec, Coordination, LoopSpec, PotentialFieldGains, RatioSteeringGains, SevenStateGains,
+    ApproachKind, BehaviorSpec, BujoldTuning, LoopSpec, PotentialFieldGains, RatioSteeringGains, SevenStateGains,
     TwoArcGains,
 };
 pub use camera::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount};
@@ -28,11 +29,21 @@ pub use fiducial::{CirclePlacement, CirclesSpec, FiducialSpec, MarkersSpec, Name
 pub use geometry::{BodySpec, DockSpec, SuccessSpec, TetherSpec};
 pub use perception::{ImprintSpec, PerceptionSpec, SegmentationMode};
 pub use pyramid_perception::{HsvBand, PyramidPerceptionSpec};
+pub use tree::{NodeSpec, TreeSpec};
 
 use crate::arbiter::{LoopConfig, Staleness};
 use crate::config::{self, ConfigError, Validate, Validator};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+/// Where a loaded profile came from, for messages about it after loading.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProfileSource {
+    /// The file (or the name shown for text parsed from elsewhere).
+    pub file: std::path::PathBuf,
+    /// Its text.
+    pub text: String,
+}
 
 /// A platform profile.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -68,6 +79,9 @@ pub struct Profile {
     pub loop_: LoopSpec,
     /// Success tolerances.
     pub success: SuccessSpec,
+    /// The file and text it was loaded from (`None` for a profile built in code).
+    #[serde(skip)]
+    pub source: Option<std::sync::Arc<ProfileSource>>,
 }
 
 impl Validate for Profile {
@@ -111,7 +125,7 @@ impl Profile {
     /// # Errors
     /// [`ConfigError`] naming the file, field path, line and expectation.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        config::load(path)
+        Self::parse(&config::read_source(path)?, path)
     }
 
     /// Parses and validates profile text; `file` is used in messages.
@@ -119,7 +133,34 @@ impl Profile {
     /// # Errors
     /// As [`Profile::load`].
     pub fn parse(src: &str, file: &Path) -> Result<Self, ConfigError> {
-        config::parse_str(src, file)
+        let mut p: Self = config::parse_str(src, file)?;
+        p.source = Some(std::sync::Arc::new(ProfileSource {
+            file: file.to_path_buf(),
+            text: src.to_string(),
+        }));
+        Ok(p)
+    }
+
+    /// Reports problems found after loading (when a behavior tree is built) the way
+    /// loading does: naming the file, the line of each field path, and what was expected.
+    pub fn problems(&self, problems: Vec<(String, String)>) -> ConfigError {
+        let (file, text) = match &self.source {
+            Some(s) => (s.file.clone(), s.text.as_str()),
+            None => (std::path::PathBuf::from(format!("profile `{}`", self.name)), ""),
+        };
+        let doc = toml::de::DeTable::parse(text).ok();
+        let v = config::Validator::new(text, doc.as_ref().map(|d| d.get_ref()));
+        ConfigError::Invalid {
+            file,
+            problems: problems
+                .into_iter()
+                .map(|(path, message)| config::Problem {
+                    line: v.line_of(&path),
+                    path,
+                    message,
+                })
+                .collect(),
+        }
     }
 
     /// The reactive loop's configuration for this platform.

@@ -1,0 +1,66 @@
+//! `bujold.back_in`: the final zone (seed 004 §V: "lower and back in by dead
+//! reckoning"). Lowered, blind, by odometry: the entrance is about the decided camera
+//! distance less the camera-to-rear arm away, then the pouch, then `margin_m` before the
+//! miss is declared (event `missed`). The dock switch, not this schema, ends it docked.
+
+use super::memory::{Memory, lowered};
+use super::params::BackInParams;
+use crate::arbiter::Blackboard;
+use crate::geometry::Pose2;
+use crate::schemas::{Behavior, DeadReckoning, FailureReason, Inputs, MotorOutput, Step};
+
+/// See the module docs.
+pub struct BackIn {
+    name: String,
+    mem: Blackboard<Memory>,
+    params: BackInParams,
+    depth: f64,
+    mark: Pose2,
+}
+
+impl BackIn {
+    /// A leaf named `name`; `depth` is the pouch's depth, m.
+    pub fn new(name: &str, mem: Blackboard<Memory>, params: BackInParams, depth: f64) -> Self {
+        Self {
+            name: name.into(),
+            mem,
+            params,
+            depth,
+            mark: Pose2::default(),
+        }
+    }
+}
+
+impl Behavior for BackIn {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, _inputs: &Inputs<'_>) {
+        self.mark = self.mem.lock().odo;
+    }
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        let mem = self.mem.clone();
+        let mut m = mem.lock();
+        let p = self.params;
+        let est = m.samples_distance.max(p.min_distance_m);
+        let dr = DeadReckoning {
+            speed: m.geometry.drive_dir * p.speed_mps,
+            distance: (est - m.rear_behind_camera).max(0.0) + self.depth + p.margin_m,
+        };
+        Some(match dr.act(m.travelled(&self.mark)) {
+            Some(cmd) => Step::running(
+                MotorOutput {
+                    drive: cmd,
+                    aux: lowered(),
+                },
+                m.feedback("back_in"),
+            ),
+            None => {
+                m.failing = Some(FailureReason::FailedToControl);
+                Step::event("missed", MotorOutput::stop(), m.feedback("back_in"))
+            }
+        })
+    }
+}

@@ -1,0 +1,204 @@
+//! `bujold.decide`: the at-dock decision (seed 004 §V: "if the ratio of left to right
+//! pixel counts is close to one and the fiducial is centred, back in; otherwise move away
+//! and retry"), made metric by [`at_dock_decision`].
+//!
+//! Stops and averages `frames` views. Events: `aligned` (back in), `misaligned`
+//! (reposition, counting a retry), `retries_exhausted` (give up), `lost` (too few views
+//! within `lost_after_s`: back off and look again, counting a retry).
+
+use super::memory::{Memory, lowered};
+use super::params::DecideParams;
+use crate::arbiter::Blackboard;
+use crate::perception::two_block_pose::FiducialView;
+use crate::schemas::{Behavior, FailureReason, Inputs, MotorOutput, Step};
+
+/// The at-dock decision: average the views, predict the lateral error where the rear
+/// will reach the entrance, and back in only if that and the heading are within
+/// `fraction` of the profile's tolerances. The rear sits `rear_behind_camera` behind the
+/// camera along the heading θ and backs a further `to_go` to the entrance, so its lateral
+/// error there is the camera's, d·sin α, less (rear_behind_camera + to_go)·sin θ.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Decision {
+    /// Back in now.
+    pub back_in: bool,
+    /// Mean viewing angle, rad.
+    pub alpha: f64,
+    /// Mean heading, rad.
+    pub heading: f64,
+    /// Mean camera distance, m.
+    pub distance: f64,
+    /// Predicted lateral error at the entrance, m.
+    pub lateral_at_entrance: f64,
+}
+
+/// See [`Decision`]. An empty `samples` decides "no".
+pub fn at_dock_decision(
+    samples: &[FiducialView],
+    rear_behind_camera: f64,
+    tol_lateral: f64,
+    tol_heading: f64,
+    fraction: f64,
+) -> Decision {
+    let n = samples.len().max(1) as f64;
+    let alpha = samples.iter().map(|s| s.alpha).sum::<f64>() / n;
+    let heading = samples.iter().map(|s| s.heading).sum::<f64>() / n;
+    let distance = samples.iter().map(|s| s.distance).sum::<f64>() / n;
+    let to_go = (distance - rear_behind_camera).max(0.0);
+    let lateral_at_entrance = distance * alpha.sin() - (rear_behind_camera + to_go) * heading.sin();
+    Decision {
+        back_in: !samples.is_empty()
+            && lateral_at_entrance.abs() <= fraction * tol_lateral
+            && heading.abs() <= fraction * tol_heading,
+        alpha,
+        heading,
+        distance,
+        lateral_at_entrance,
+    }
+}
+
+/// See the module docs.
+pub struct Decide {
+    name: String,
+    mem: Blackboard<Memory>,
+    params: DecideParams,
+    tol_lateral: f64,
+    tol_heading: f64,
+    max_retries: u32,
+    started: f64,
+    samples: Vec<FiducialView>,
+}
+
+impl Decide {
+    /// A leaf named `name` with the profile's success tolerances (m, rad).
+    pub fn new(
+        name: &str,
+        mem: Blackboard<Memory>,
+        params: DecideParams,
+        tol_lateral: f64,
+        tol_heading: f64,
+        max_retries: u32,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            mem,
+            samples: Vec::with_capacity(params.frames.max(1)),
+            params,
+            tol_lateral,
+            tol_heading,
+            max_retries,
+            started: 0.0,
+        }
+    }
+}
+
+impl Behavior for Decide {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, inputs: &Inputs<'_>) {
+        self.started = inputs.now;
+        self.samples.clear();
+    }
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        let mem = self.mem.clone();
+        let mut m = mem.lock();
+        if let Some(v) = m.planning {
+            self.samples.push(v);
+        }
+        if self.samples.len() < self.params.frames {
+            if m.now - self.started > self.params.lost_after_s {
+                // Lost at the gate: back off and look again.
+                m.retries += 1;
+                return Some(Step::event("lost", m.hold("decide").output, m.feedback("decide")));
+            }
+            return Some(m.hold("decide"));
+        }
+        let d = at_dock_decision(
+            &self.samples,
+            m.rear_behind_camera,
+            self.tol_lateral,
+            self.tol_heading,
+            self.params.tolerance_fraction,
+        );
+        if d.back_in {
+            m.samples_distance = d.distance;
+            return Some(Step::event(
+                "aligned",
+                MotorOutput::stop().with_aux(lowered()),
+                m.feedback("decide"),
+            ));
+        }
+        m.retries += 1;
+        if m.retries > self.max_retries {
+            m.failing = Some(FailureReason::RetriesExhausted);
+            return Some(Step::event(
+                "retries_exhausted",
+                MotorOutput::stop(),
+                m.feedback("decide"),
+            ));
+        }
+        let mean = FiducialView {
+            alpha: d.alpha,
+            heading: d.heading,
+            distance: d.distance,
+            ..self.samples[0]
+        };
+        m.plan = Some(m.plan_reposition(&mean));
+        Some(Step::event("misaligned", m.hold("decide").output, m.feedback("decide")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn view(alpha_deg: f64, heading_deg: f64) -> FiducialView {
+        FiducialView {
+            distance: 0.38,
+            alpha: alpha_deg.to_radians(),
+            asym: 0.0,
+            offset_px: 0.0,
+            bearing: 0.0,
+            heading: heading_deg.to_radians(),
+            total_px: 4600,
+            height_px: 50.0,
+        }
+    }
+
+    fn decide(samples: &[FiducialView], tol_heading: f64) -> Decision {
+        at_dock_decision(samples, 0.15, 0.02, tol_heading, 0.8)
+    }
+
+    #[test]
+    fn centred_and_balanced_backs_in() {
+        let d = decide(&[view(0.5, 0.5); 5], 5f64.to_radians());
+        assert!(d.back_in, "{d:?}");
+    }
+
+    #[test]
+    fn off_axis_or_skewed_moves_away() {
+        // 3° off the axis at 0.38 m is 2 cm: beyond 80 % of the ±2 cm tolerance.
+        assert!(!decide(&[view(3.0, 0.0); 5], 5f64.to_radians()).back_in);
+        // On the axis but heading 4.5°: within 5° but beyond 80 % of it.
+        assert!(!decide(&[view(0.0, 4.5); 5], 5f64.to_radians()).back_in);
+        // A small offset cancelled by a heading that steers back onto the axis: backs in.
+        let d = decide(&[view(2.0, 2.0); 5], 5f64.to_radians());
+        assert!(d.lateral_at_entrance.abs() < 1e-12 && d.back_in, "{d:?}");
+        // The lever arm from camera to rear counts: 1° off with the heading 4° back toward
+        // the axis leaves the camera 6.6 mm off, but the rear reaches the entrance 20 mm
+        // past the axis (ignoring the 0.15 m arm would predict 10 mm and back in).
+        let d = decide(&[view(1.0, 4.0); 5], 5f64.to_radians());
+        let expected = 0.38 * 1f64.to_radians().sin() - 0.38 * 4f64.to_radians().sin();
+        assert!((d.lateral_at_entrance - expected).abs() < 1e-12, "{d:?}");
+        assert!(!d.back_in, "{d:?}");
+        assert!(!decide(&[], 0.1).back_in);
+    }
+
+    #[test]
+    fn averages_the_samples() {
+        let d = decide(&[view(2.0, 0.0), view(-2.0, 0.0)], 0.1);
+        assert!(d.alpha.abs() < 1e-12 && d.back_in);
+    }
+}

@@ -1,0 +1,156 @@
+//! The departure phases (seed 004 §IV.C): `undock` out of the pouch lowered, `drive_out`
+//! raised with the camera on the flap, stopping at the imprint distance to `imprint` the
+//! blocks' colours, then on out.
+
+use super::memory::{Memory, lowered};
+use super::params::{DriveOutParams, UndockParams};
+use crate::arbiter::Blackboard;
+use crate::schemas::{Behavior, DriveCommand, FailureReason, Inputs, MotorOutput, Outcome, Step};
+
+/// `bujold.undock`: drive out of the pouch front first, lowered, until clear of it;
+/// event `out`.
+pub struct Undock {
+    name: String,
+    mem: Blackboard<Memory>,
+    params: UndockParams,
+    depth: f64,
+}
+
+impl Undock {
+    /// A leaf named `name`; `depth` is the pouch's depth, m.
+    pub fn new(name: &str, mem: Blackboard<Memory>, params: UndockParams, depth: f64) -> Self {
+        Self {
+            name: name.into(),
+            mem,
+            params,
+            depth,
+        }
+    }
+}
+
+impl Behavior for Undock {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, _inputs: &Inputs<'_>) {
+        // Departure distances are measured from where it began.
+        self.mem.with(|m| m.departure_mark = m.odo);
+    }
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        let m = self.mem.lock();
+        let out = MotorOutput {
+            drive: DriveCommand::Straight {
+                v: -m.geometry.drive_dir * self.params.speed_mps,
+            },
+            aux: lowered(),
+        };
+        let feedback = m.feedback("undock");
+        Some(
+            if m.travelled(&m.departure_mark) >= self.depth + self.params.beyond_depth_m {
+                Step::event("out", out, feedback)
+            } else {
+                Step::running(out, feedback)
+            },
+        )
+    }
+}
+
+/// `bujold.drive_out`: drive away from the dock, raised; event `imprint` at the imprint
+/// distance (once), then done at the departure distance: completed when the imprint
+/// succeeded, failed (target never detected) otherwise.
+pub struct DriveOut {
+    name: String,
+    mem: Blackboard<Memory>,
+    params: DriveOutParams,
+    /// Travel from the departure's start at which to imprint, m.
+    imprint_at: f64,
+}
+
+impl DriveOut {
+    /// A leaf named `name`; imprints `imprint_at` m from where the departure began.
+    pub fn new(name: &str, mem: Blackboard<Memory>, params: DriveOutParams, imprint_at: f64) -> Self {
+        Self {
+            name: name.into(),
+            mem,
+            params,
+            imprint_at,
+        }
+    }
+}
+
+impl Behavior for DriveOut {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        let m = self.mem.lock();
+        let out = m.travelled(&m.departure_mark);
+        Some(if !m.imprinted && out >= self.imprint_at {
+            Step::event("imprint", m.hold("drive_out").output, m.feedback("drive_out"))
+        } else if out >= self.params.distance_m {
+            let outcome = if m.imprinted {
+                Outcome::Completed
+            } else {
+                Outcome::Failed(FailureReason::TargetNeverDetected)
+            };
+            Step::done(outcome, m.hold("drive_out").output, m.feedback("drive_out"))
+        } else {
+            m.drive_away(self.params.speed_mps, "drive_out")
+        })
+    }
+}
+
+/// `bujold.imprint`: stand still for the profile's `perception.imprint.frames` frames,
+/// sampling the middle of each block, then learn the colours; event `imprinted` either
+/// way (the departure's outcome says whether it worked).
+pub struct Imprint {
+    name: String,
+    mem: Blackboard<Memory>,
+    frames_wanted: u32,
+    frames: u32,
+}
+
+impl Imprint {
+    /// A leaf named `name` imprinting over `frames` frames.
+    pub fn new(name: &str, mem: Blackboard<Memory>, frames: u32) -> Self {
+        Self {
+            name: name.into(),
+            mem,
+            frames_wanted: frames,
+            frames: 0,
+        }
+    }
+}
+
+impl Behavior for Imprint {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, _inputs: &Inputs<'_>) {
+        self.frames = 0;
+    }
+
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+        let mut m = self.mem.lock();
+        if let Some(cam) = inputs.camera(0) {
+            m.schema.imprint_frame(&cam.image);
+        }
+        self.frames += 1;
+        if self.frames >= self.frames_wanted {
+            let now = m.now;
+            m.imprinted = m.schema.finish_imprint(now);
+            return Some(Step::event(
+                "imprinted",
+                m.hold("imprint").output,
+                m.feedback("imprint"),
+            ));
+        }
+        Some(m.hold("imprint"))
+    }
+}

@@ -1,0 +1,65 @@
+//! `bujold.move_away` and `bujold.give_up`: back off from the entrance, front first,
+//! `distance_m` (or for `timeout_s`). Moving away ends with event `done` (retry the
+//! approach); giving up ends the docking failed, with the reason the phase that gave up
+//! left in memory (a timeout when none did): every failure close to the dock first
+//! moves away from the entrance, then stops.
+
+use super::memory::{Memory, raised};
+use super::params::MoveAwayParams;
+use crate::arbiter::Blackboard;
+use crate::geometry::Pose2;
+use crate::schemas::{Behavior, FailureReason, Inputs, MotorOutput, Outcome, Step};
+
+/// See the module docs.
+pub struct MoveAway {
+    name: String,
+    mem: Blackboard<Memory>,
+    params: MoveAwayParams,
+    give_up: bool,
+    started: f64,
+    mark: Pose2,
+}
+
+impl MoveAway {
+    /// A leaf named `name`; `give_up` ends the docking failed instead of retrying.
+    pub fn new(name: &str, mem: Blackboard<Memory>, params: MoveAwayParams, give_up: bool) -> Self {
+        Self {
+            name: name.into(),
+            mem,
+            params,
+            give_up,
+            started: 0.0,
+            mark: Pose2::default(),
+        }
+    }
+}
+
+impl Behavior for MoveAway {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, inputs: &Inputs<'_>) {
+        self.started = inputs.now;
+        self.mark = self.mem.lock().odo;
+    }
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        let m = self.mem.lock();
+        let p = self.params;
+        let phase = if self.give_up { "give_up" } else { "move_away" };
+        if m.travelled(&self.mark) < p.distance_m && m.now - self.started <= p.timeout_s {
+            return Some(m.drive_away(p.speed_mps, phase));
+        }
+        Some(if self.give_up {
+            let reason = m.failing.unwrap_or(FailureReason::Timeout);
+            Step::done(
+                Outcome::Failed(reason),
+                MotorOutput::stop().with_aux(raised()),
+                m.feedback(phase),
+            )
+        } else {
+            Step::event("done", m.hold(phase).output, m.feedback(phase))
+        })
+    }
+}

@@ -1,0 +1,206 @@
+//! Tuning of Bujold's phase schemas, each read from its node's `params` table in
+//! `profiles/bujold.toml` (`[behavior.tree.nodes.<phase>.params]`). Every field has the
+//! default the campaigns were tuned with, so a profile states only what it changes; the
+//! shipped profile states them all, with where each value comes from.
+
+use serde::{Deserialize, Serialize};
+
+pub use crate::profile::BujoldTuning;
+
+/// `undock`: leave the pouch front first, lowered.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct UndockParams {
+    /// Speed, m/s.
+    pub speed_mps: f64,
+    /// Drive this far beyond the pouch's depth before raising, m.
+    pub beyond_depth_m: f64,
+}
+
+impl Default for UndockParams {
+    fn default() -> Self {
+        Self {
+            speed_mps: 0.05,
+            beyond_depth_m: 0.05,
+        }
+    }
+}
+
+/// `drive_out`: drive away from the dock, raised, imprinting on the way.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DriveOutParams {
+    /// Departure distance from where it began, m.
+    pub distance_m: f64,
+    /// Speed, m/s.
+    pub speed_mps: f64,
+}
+
+impl Default for DriveOutParams {
+    fn default() -> Self {
+        Self {
+            distance_m: 1.2,
+            speed_mps: 0.06,
+        }
+    }
+}
+
+/// `search`: rotate in place toward the side the fiducial was last seen.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SearchParams {
+    /// A view changing less than this (mean 8-bit levels per frame, see
+    /// [`FrameChange`](crate::perception::frame_change::FrameChange)) is still: pixel
+    /// noise of ±6 levels reads under 0.5, one tick of the search turn 3.6–8.2 on rendered
+    /// scenes (`tests/sim_render.rs`).
+    pub still_levels: f32,
+    /// The turn is jammed when the view stays still this long, s.
+    pub jammed_after_s: f64,
+    /// Unjamming manoeuvres allowed per docking attempt (the search stays bounded).
+    pub max_unjams: u32,
+}
+
+impl Default for SearchParams {
+    fn default() -> Self {
+        Self {
+            still_levels: 1.0,
+            jammed_after_s: 1.5,
+            max_unjams: 3,
+        }
+    }
+}
+
+/// `unjam`: turn back to the heading docking began with, drive out, search the other way.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct UnjamParams {
+    /// Close enough to the start heading, degrees.
+    pub heading_tolerance_deg: f64,
+    /// Longest turn back, s.
+    pub turn_timeout_s: f64,
+    /// How far to drive out, front first, m.
+    pub distance_m: f64,
+    /// Speed driving out, m/s.
+    pub speed_mps: f64,
+}
+
+impl Default for UnjamParams {
+    fn default() -> Self {
+        Self {
+            heading_tolerance_deg: 5.0,
+            turn_timeout_s: 20.0,
+            distance_m: 0.2,
+            speed_mps: 0.06,
+        }
+    }
+}
+
+/// `approach`: steer on the fiducial; reposition when clearly off the axis.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ApproachParams {
+    /// Back to search after the fiducial has been out of sight this long, s.
+    pub lost_after_s: f64,
+    /// A reliable view more than this far off the axis triggers repositioning, m.
+    pub reposition_lateral_m: f64,
+}
+
+impl Default for ApproachParams {
+    fn default() -> Self {
+        Self {
+            lost_after_s: 1.5,
+            reposition_lateral_m: 0.08,
+        }
+    }
+}
+
+/// `decide`: average views at the dock and decide to back in or retry.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DecideParams {
+    /// Views averaged.
+    pub frames: usize,
+    /// Lost at the gate: back off after this long without enough views, s.
+    pub lost_after_s: f64,
+    /// Back in only within this fraction of the profile's success tolerances.
+    pub tolerance_fraction: f64,
+}
+
+impl Default for DecideParams {
+    fn default() -> Self {
+        Self {
+            frames: 5,
+            lost_after_s: 3.0,
+            tolerance_fraction: 0.8,
+        }
+    }
+}
+
+/// `back_in`: lower and back in blind by odometry.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BackInParams {
+    /// Speed, m/s.
+    pub speed_mps: f64,
+    /// Distance beyond the pouch's depth before declaring a miss, m.
+    pub margin_m: f64,
+    /// Smallest camera distance trusted from the decision, m.
+    pub min_distance_m: f64,
+}
+
+impl Default for BackInParams {
+    fn default() -> Self {
+        Self {
+            speed_mps: 0.04,
+            margin_m: 0.15,
+            min_distance_m: 0.1,
+        }
+    }
+}
+
+/// `reposition` and `ballistic`: turn, drive and turn by odometry to a staging pose.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RepositionParams {
+    /// Heading tolerance of the turns, degrees.
+    pub heading_tolerance_deg: f64,
+    /// Close enough to the staging point to skip the drive, m.
+    pub arrive_m: f64,
+    /// The drive ends when the target is this close to abeam, m.
+    pub abeam_m: f64,
+    /// Beside the gate, drive straight out this far before turning, m.
+    pub clear_m: f64,
+}
+
+impl Default for RepositionParams {
+    fn default() -> Self {
+        Self {
+            heading_tolerance_deg: 3.0,
+            arrive_m: 0.03,
+            abeam_m: 0.02,
+            clear_m: 0.3,
+        }
+    }
+}
+
+/// `move_away` and `give_up`: back off from the entrance, front first.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MoveAwayParams {
+    /// How far, m.
+    pub distance_m: f64,
+    /// Speed, m/s.
+    pub speed_mps: f64,
+    /// Longest time, s (a blocked robot still ends the phase).
+    pub timeout_s: f64,
+}
+
+impl Default for MoveAwayParams {
+    fn default() -> Self {
+        Self {
+            distance_m: 0.35,
+            speed_mps: 0.06,
+            timeout_s: 20.0,
+        }
+    }
+}

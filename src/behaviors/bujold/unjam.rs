@@ -1,0 +1,71 @@
+//! `bujold.unjam`: the search turn is jammed against the body. Turn back to the heading
+//! the close dock began with (turning back over the ground just swept is free), then
+//! drive out front first; event `cleared` (the search then turns the other way, which
+//! swings the caught corner off the body).
+
+use super::memory::Memory;
+use super::params::UnjamParams;
+use crate::arbiter::Blackboard;
+use crate::geometry::{Pose2, wrap_angle};
+use crate::schemas::{Behavior, Inputs, Step};
+
+/// See the module docs.
+pub struct Unjam {
+    name: String,
+    mem: Blackboard<Memory>,
+    params: UnjamParams,
+    /// 0: turning back; 1: driving out.
+    stage: u8,
+    stage_start: f64,
+    mark: Pose2,
+}
+
+impl Unjam {
+    /// A leaf named `name`.
+    pub fn new(name: &str, mem: Blackboard<Memory>, params: UnjamParams) -> Self {
+        Self {
+            name: name.into(),
+            mem,
+            params,
+            stage: 0,
+            stage_start: 0.0,
+            mark: Pose2::default(),
+        }
+    }
+}
+
+impl Behavior for Unjam {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, inputs: &Inputs<'_>) {
+        self.stage = 0;
+        self.stage_start = inputs.now;
+        self.mark = self.mem.lock().odo;
+    }
+
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+        let mem = self.mem.clone();
+        let mut m = mem.lock();
+        // The frame-change cue keeps running so the search that follows compares its
+        // first frame with the one just before it.
+        m.observe_change(inputs);
+        let in_stage = m.now - self.stage_start;
+        let p = self.params;
+        if self.stage == 0 {
+            let err = wrap_angle(m.start_heading.unwrap_or(m.odo.theta) - m.odo.theta);
+            if err.abs() < p.heading_tolerance_deg.to_radians() || in_stage > p.turn_timeout_s {
+                self.stage = 1;
+                self.stage_start = m.now;
+                self.mark = m.odo;
+                return Some(m.hold("unjam"));
+            }
+            return Some(m.turn_by(err, "unjam"));
+        }
+        if m.travelled(&self.mark) >= p.distance_m || in_stage > 2.0 * p.distance_m / p.speed_mps {
+            return Some(Step::event("cleared", m.hold("unjam").output, m.feedback("unjam")));
+        }
+        Some(m.drive_away(p.speed_mps, "unjam"))
+    }
+}

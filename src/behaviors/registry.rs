@@ -1,0 +1,233 @@
+//! Named schemas, and building a profile's `[behavior.tree]` from them.
+//!
+//! A [`Registry`] maps the names a profile's leaves use (`bujold.search`) to factories
+//! that build the leaf from its `params` table. Factories receive a build context `C`
+//! chosen by whoever builds the tree: for a paper's robot, the handle on that robot's
+//! shared memory ([`crate::arbiter::Blackboard`]); for a user's robot, whatever its
+//! schemas share. A user's crate registers its own schemas next to the shipped ones:
+//!
+//! ```
+//! use marsupial::behaviors::registry::{LeafArgs, Registry};
+//! use marsupial::schemas::{Behavior, Feedback, Inputs, MotorOutput, Step};
+//!
+//! struct Creep(String, f64);
+//! impl Behavior for Creep {
+//!     fn name(&self) -> &str { &self.0 }
+//!     fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+//!         Some(Step::running(MotorOutput::twist(self.1, 0.0), Feedback::new("creep", inputs.now)))
+//!     }
+//! }
+//!
+//! #[derive(serde::Deserialize, Default)]
+//! #[serde(deny_unknown_fields, default)]
+//! struct CreepParams { speed_mps: f64 }
+//!
+//! let mut registry: Registry<()> = Registry::new();
+//! registry.register("my.creep", |_: &(), args: &LeafArgs<'_>| {
+//!     let p: CreepParams = args.params()?;
+//!     Ok(Box::new(Creep(args.node.to_string(), p.speed_mps)))
+//! });
+//! assert!(registry.names().any(|n| n == "my.creep"));
+//! ```
+
+use crate::arbiter::{Next, Priority, Sequencer, VectorSum};
+use crate::config::ConfigError;
+use crate::profile::Profile;
+use crate::profile::tree::{FINISH, NodeSpec, TreeSpec};
+use crate::schemas::Behavior;
+use serde::de::DeserializeOwned;
+use std::collections::BTreeMap;
+
+/// What a factory gets to build one leaf.
+pub struct LeafArgs<'a> {
+    /// The node's name in the tree: the leaf must report it as its [`Behavior::name`]
+    /// (sequencers find their states, and traces name them, by it).
+    pub node: &'a str,
+    /// The node's `params` table.
+    pub params: &'a toml::Table,
+    /// The whole profile (geometry, limits, perception).
+    pub profile: &'a Profile,
+}
+
+impl LeafArgs<'_> {
+    /// Deserializes the node's params into the schema's own tuning struct (use
+    /// `#[serde(deny_unknown_fields, default)]` so a misspelt field is refused and an
+    /// absent one keeps its default).
+    ///
+    /// # Errors
+    /// The deserializer's message, naming the field.
+    pub fn params<T: DeserializeOwned>(&self) -> Result<T, String> {
+        toml::Value::Table(self.params.clone())
+            .try_into()
+            .map_err(|e: toml::de::Error| format!("params: {}", e.message().trim()))
+    }
+}
+
+/// Builds one leaf; the error says what is wrong with its params or the profile.
+pub type LeafFactory<C> = dyn Fn(&C, &LeafArgs<'_>) -> Result<Box<dyn Behavior>, String> + Send + Sync;
+
+/// Schemas by name (see the module docs).
+pub struct Registry<C> {
+    leaves: BTreeMap<String, Box<LeafFactory<C>>>,
+}
+
+impl<C> Default for Registry<C> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<C> Registry<C> {
+    /// An empty registry.
+    pub fn new() -> Self {
+        Self {
+            leaves: BTreeMap::new(),
+        }
+    }
+
+    /// Registers (or replaces) the schema `name`.
+    pub fn register(
+        &mut self,
+        name: impl Into<String>,
+        factory: impl Fn(&C, &LeafArgs<'_>) -> Result<Box<dyn Behavior>, String> + Send + Sync + 'static,
+    ) -> &mut Self {
+        self.leaves.insert(name.into(), Box::new(factory));
+        self
+    }
+
+    /// The registered names, sorted.
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.leaves.keys().map(String::as_str)
+    }
+
+    /// Builds the profile's `[behavior.tree]` with context `ctx`.
+    ///
+    /// # Errors
+    /// [`ConfigError::Invalid`] naming the profile's line for an absent tree, an unknown
+    /// schema, params a schema refuses, or a leaf that misreports its name. (The tree's
+    /// structure was checked when the profile loaded.)
+    pub fn build(&self, profile: &Profile, ctx: &C) -> Result<Box<dyn Behavior>, ConfigError> {
+        let Some(tree) = &profile.behavior.tree else {
+            return Err(profile.problems(vec![(
+                "behavior".into(),
+                "this robot's behavior needs a [behavior.tree] table".into(),
+            )]));
+        };
+        let mut problems = Vec::new();
+        let root = self.node(tree, &tree.root, profile, ctx, &mut problems, 0);
+        match root {
+            Some(r) if problems.is_empty() => Ok(r),
+            _ => Err(profile.problems(problems)),
+        }
+    }
+
+    fn node(
+        &self,
+        tree: &TreeSpec,
+        name: &str,
+        profile: &Profile,
+        ctx: &C,
+        problems: &mut Vec<(String, String)>,
+        depth: usize,
+    ) -> Option<Box<dyn Behavior>> {
+        let path = format!("behavior.tree.nodes.{name}");
+        let Some(spec) = tree.nodes.get(name) else {
+            problems.push((path, format!("no node named `{name}`")));
+            return None;
+        };
+        if depth > tree.nodes.len() {
+            problems.push((path, format!("`{name}` contains itself")));
+            return None;
+        }
+        let children = |problems: &mut Vec<(String, String)>| -> Vec<Option<Box<dyn Behavior>>> {
+            spec.children()
+                .iter()
+                .map(|c| self.node(tree, c, profile, ctx, problems, depth + 1))
+                .collect()
+        };
+        match spec {
+            NodeSpec::Leaf { schema, params, .. } => {
+                let Some(factory) = self.leaves.get(schema) else {
+                    let known: Vec<&str> = self.names().collect();
+                    problems.push((
+                        format!("{path}.schema"),
+                        format!("unknown schema `{schema}` (registered: {})", known.join(", ")),
+                    ));
+                    return None;
+                };
+                let args = LeafArgs {
+                    node: name,
+                    params,
+                    profile,
+                };
+                match factory(ctx, &args) {
+                    Ok(b) if b.name() == name => Some(b),
+                    Ok(b) => {
+                        problems.push((
+                            format!("{path}.schema"),
+                            format!("schema `{schema}` named its leaf `{}`, expected `{name}`", b.name()),
+                        ));
+                        None
+                    }
+                    Err(e) => {
+                        let at = if e.starts_with("params") {
+                            format!("{path}.params")
+                        } else {
+                            format!("{path}.schema")
+                        };
+                        problems.push((at, format!("`{schema}`: {e}")));
+                        None
+                    }
+                }
+            }
+            NodeSpec::Priority { .. } => {
+                let built: Option<Vec<_>> = children(problems).into_iter().collect();
+                Some(Box::new(Priority::new(name, built?)))
+            }
+            NodeSpec::VectorSum {
+                gains,
+                max_speed_mps,
+                k_theta,
+                ..
+            } => {
+                let built: Option<Vec<_>> = children(problems).into_iter().collect();
+                let pairs = gains.iter().copied().zip(built?).collect();
+                Some(Box::new(VectorSum::new(name, pairs, *max_speed_mps, *k_theta)))
+            }
+            NodeSpec::Sequencer {
+                states,
+                state_timeout_s,
+                ..
+            } => {
+                let built: Option<Vec<_>> = children(problems).into_iter().collect();
+                let mut seq = Sequencer::new(name);
+                for (child, state) in states.iter().zip(built?) {
+                    let s = &tree.nodes[child];
+                    let i = seq.state(state, s.latched());
+                    // Declared trees say every way out: nothing leads on implicitly.
+                    seq.transitions(i, Next::Finish, Next::Finish);
+                    for (event, target) in s.transitions() {
+                        let next = if target == FINISH {
+                            Next::Finish
+                        } else {
+                            Next::Goto(states.iter().position(|x| x == target)?)
+                        };
+                        seq.on_event(i, event.clone(), next);
+                    }
+                    // The profile's `behavior.phase_timeout_s` bounds every phase that says
+                    // nothing (`timeout_s = inf` lifts it).
+                    let limit = s
+                        .timeout_s()
+                        .or(*state_timeout_s)
+                        .unwrap_or(profile.behavior.phase_timeout_s);
+                    if let Some(t) = Some(limit)
+                        && t.is_finite()
+                    {
+                        seq.timeout(i, t);
+                    }
+                }
+                Some(Box::new(seq))
+            }
+        }
+    }
+}

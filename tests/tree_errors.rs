@@ -1,0 +1,133 @@
+//! A malformed `[behavior.tree]` fails with the file, the line, the field and what was
+//! expected: when the profile loads (structure) or when the agent is built (schemas and
+//! their params). Never a panic.
+
+use marsupial::behaviors::{BuildError, agent_for};
+use marsupial::config::ConfigError;
+use marsupial::profile::Profile;
+use std::path::Path;
+
+fn shipped() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/bujold.toml")).unwrap()
+}
+
+/// The shipped Bujold profile with `from` replaced by `to` (which must occur once).
+fn edited(from: &str, to: &str) -> (String, usize) {
+    let src = shipped();
+    assert_eq!(src.matches(from).count(), 1, "`{from}` must occur once");
+    let line = src[..src.find(from).unwrap()].matches('\n').count() + 1;
+    (src.replacen(from, to, 1), line)
+}
+
+fn only_problem(e: &ConfigError) -> (&str, Option<usize>, &str) {
+    assert_eq!(e.problems().len(), 1, "{e}");
+    let p = &e.problems()[0];
+    (p.path.as_str(), p.line, p.message.as_str())
+}
+
+fn load_error(src: &str) -> ConfigError {
+    Profile::parse(src, Path::new("bujold-edited.toml")).expect_err("the profile must be refused")
+}
+
+fn build_error(src: &str) -> ConfigError {
+    let p = Profile::parse(src, Path::new("bujold-edited.toml")).expect("the profile loads");
+    match agent_for(&p).err().expect("the agent must not build") {
+        BuildError::Tree(e) => e,
+        other => panic!("expected a tree error, got {other}"),
+    }
+}
+
+#[test]
+fn the_shipped_tree_builds() {
+    let p = Profile::parse(&shipped(), Path::new("bujold.toml")).unwrap();
+    assert!(agent_for(&p).is_ok());
+}
+
+#[test]
+fn an_unknown_schema_names_its_line_and_the_registered_ones() {
+    let (src, line) = edited("schema = \"bujold.search\"", "schema = \"bujold.serch\"");
+    let e = build_error(&src);
+    let (path, at, msg) = only_problem(&e);
+    assert_eq!(path, "behavior.tree.nodes.search.schema");
+    assert_eq!(at, Some(line));
+    assert!(
+        msg.contains("unknown schema `bujold.serch`") && msg.contains("bujold.search"),
+        "{msg}"
+    );
+    assert!(
+        e.to_string().starts_with(&format!("bujold-edited.toml:{line}: ")),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_misspelt_param_is_refused_by_its_schema() {
+    let (src, line) = edited("still_levels = 1.0", "still_level = 1.0");
+    let e = build_error(&src);
+    let (path, at, msg) = only_problem(&e);
+    assert_eq!(path, "behavior.tree.nodes.search.params");
+    assert_eq!(at, Some(line));
+    assert!(msg.contains("unknown field `still_level`"), "{msg}");
+}
+
+#[test]
+fn a_transition_to_a_missing_state_names_the_event() {
+    let (src, line) = edited(
+        "on = { acquired = \"approach\", jammed = \"unjam\" }",
+        "on = { acquired = \"aproach\", jammed = \"unjam\" }",
+    );
+    let e = load_error(&src);
+    let (path, at, msg) = only_problem(&e);
+    assert_eq!(path, "behavior.tree.nodes.search.on.acquired");
+    assert_eq!(at, Some(line));
+    assert!(msg.contains("`aproach` is not a state of `close_dock`"), "{msg}");
+}
+
+#[test]
+fn a_node_that_contains_itself_is_a_cycle() {
+    let (src, _) = edited(
+        "children = [\"dock_switch\", \"close_dock\"]",
+        "children = [\"dock_switch\", \"close_dock\", \"bujold\"]",
+    );
+    let e = load_error(&src);
+    let all = e.to_string();
+    assert!(
+        all.contains("contains itself") || all.contains("is a child of"),
+        "{all}"
+    );
+    assert!(e.problems().iter().all(|p| p.line.is_some()), "{all}");
+}
+
+#[test]
+fn a_child_that_does_not_exist_and_a_node_outside_the_tree_are_named() {
+    let (src, line) = edited(
+        "states = [\"undock\", \"drive_out\", \"imprint\"]",
+        "states = [\"undock\", \"drive_out\", \"imprnt\"]",
+    );
+    let e = load_error(&src);
+    let msgs: Vec<String> = e
+        .problems()
+        .iter()
+        .map(|p| format!("{}|{:?}|{}", p.path, p.line, p.message))
+        .collect();
+    assert!(
+        msgs.iter().any(|m| m.starts_with(&format!(
+            "behavior.tree.nodes.departure.states[2]|Some({line})|no node named `imprnt`"
+        ))),
+        "{msgs:?}"
+    );
+    // `imprint` is now listed by no node (and `drive_out` still leads to it).
+    assert!(
+        msgs.iter().any(|m| m.contains("`imprint` is not part of the tree")),
+        "{msgs:?}"
+    );
+}
+
+#[test]
+fn a_leaf_with_a_sequencers_field_is_refused_at_its_line() {
+    let (src, line) = edited("schema = \"bujold.unjam\"", "schema = \"bujold.unjam\"\nstates = []");
+    let e = load_error(&src);
+    let (_, at, msg) = only_problem(&e);
+    assert!(msg.contains("unknown field `states`"), "{msg}");
+    assert!(at.is_some_and(|l| l >= line - 3 && l <= line + 1), "{at:?} vs {line}");
+}
