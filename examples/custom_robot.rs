@@ -69,7 +69,6 @@ color = "red"
 
 [behavior]
 approach = "none"
-coordination = "priority"
 max_retries = 0
 search_timeout_s = 20.0
 phase_timeout_s = 20.0

@@ -12,6 +12,7 @@ pub mod priority;
 pub mod reactive_loop;
 pub mod runtime;
 pub mod sequencer;
+pub mod trace;
 pub mod vector_sum;
 
 pub use blackboard::Blackboard;
@@ -21,4 +22,5 @@ pub use reactive_loop::{
     InputKind, LoopConfig, LoopCore, LoopStatus, ReactiveLoop, Staleness, StopReason, TickOutput, safe_stop_command,
 };
 pub use sequencer::{Next, Selector, Sequencer};
+pub use trace::{NodeTrace, Transition};
 pub use vector_sum::VectorSum;

@@ -58,6 +58,15 @@ impl Behavior for Priority {
         self.children.iter_mut().for_each(|c| c.reset());
     }
 
+    fn explain(&self, out: &mut Vec<super::NodeTrace>) {
+        out.push(super::trace::node_trace(&self.name, &self.decision, &|i| {
+            self.children[i].name()
+        }));
+        for c in self.decision.active() {
+            self.children[c].explain(out);
+        }
+    }
+
     /// Every child that has the state starts there (a priority node usually holds one
     /// sequence under its overrides).
     fn start(&mut self, state: &str) -> bool {

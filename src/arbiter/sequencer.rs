@@ -83,6 +83,10 @@ pub struct Sequencer {
     transitions: u64,
     /// Why the last transition fired (`"acquired"`, `"timeout"`, `"selected"`...).
     last_event: Option<&'static str>,
+    /// This tick's transitions (from, to, why), for traces.
+    tick_transitions: smallvec::SmallVec<[(usize, usize, &'static str); 4]>,
+    /// The state that ran this tick.
+    ran: Option<usize>,
     decision: Decision,
 }
 
@@ -100,6 +104,8 @@ impl Sequencer {
             selector: None,
             transitions: 0,
             last_event: None,
+            tick_transitions: smallvec::SmallVec::new(),
+            ran: None,
             decision: Decision::new(Strategy::Sequencer),
         }
     }
@@ -213,6 +219,7 @@ impl Sequencer {
             );
             self.transitions += 1;
         }
+        self.tick_transitions.push((self.current, i, why));
         self.current = i;
         self.last_event = Some(why);
         self.entered_at = inputs.now;
@@ -291,6 +298,8 @@ impl Behavior for Sequencer {
 
     fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
         self.decision.clear();
+        self.tick_transitions.clear();
+        self.ran = None;
         if self.states.is_empty() || self.finished {
             return None;
         }
@@ -322,11 +331,13 @@ impl Behavior for Sequencer {
                 None => Step::done(Outcome::Failed(FailureReason::Timeout), MotorOutput::stop(), feedback),
             };
             self.decision.push(cur, None);
+            self.decision.winner = Some(cur);
             let result = self.finish_state(cur, step, inputs);
             self.decision.output = Some(result.output);
             return Some(result);
         }
         let step = self.states[cur].behavior.tick(inputs);
+        self.ran = Some(cur);
         self.decision.push(cur, step.as_ref());
         self.decision.winner = Some(cur);
         let step = match step {
@@ -358,6 +369,24 @@ impl Behavior for Sequencer {
     fn enter(&mut self, inputs: &Inputs<'_>) {
         self.reset();
         self.enter(0, inputs, "started");
+    }
+
+    fn explain(&self, out: &mut Vec<super::NodeTrace>) {
+        let name = |i: usize| self.states.get(i).map_or("-", |s| s.behavior.name());
+        let mut t = super::trace::node_trace(&self.name, &self.decision, &name);
+        t.transitions = self
+            .tick_transitions
+            .iter()
+            .map(|&(from, to, event)| super::Transition {
+                from: name(from).to_string(),
+                to: name(to).to_string(),
+                event: event.to_string(),
+            })
+            .collect();
+        out.push(t);
+        if let Some(r) = self.ran {
+            self.states[r].behavior.explain(out);
+        }
     }
 
     fn start(&mut self, state: &str) -> bool {

@@ -102,6 +102,15 @@ impl Behavior for VectorSum {
         self.children.iter_mut().for_each(|(_, c)| c.reset());
     }
 
+    fn explain(&self, out: &mut Vec<super::NodeTrace>) {
+        out.push(super::trace::node_trace(&self.name, &self.decision, &|i| {
+            self.children[i].1.name()
+        }));
+        for c in self.decision.active() {
+            self.children[c].1.explain(out);
+        }
+    }
+
     fn start(&mut self, state: &str) -> bool {
         self.children
             .iter_mut()

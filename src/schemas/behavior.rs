@@ -178,6 +178,11 @@ pub trait Behavior: Send {
         let _ = state;
         false
     }
+    /// Appends this tick's decisions of the arbiters in this behavior (see
+    /// [`crate::arbiter::trace`]); a leaf has none.
+    fn explain(&self, out: &mut Vec<crate::arbiter::NodeTrace>) {
+        let _ = out;
+    }
 }
 
 impl<B: Behavior + ?Sized> Behavior for Box<B> {
@@ -195,6 +200,9 @@ impl<B: Behavior + ?Sized> Behavior for Box<B> {
     }
     fn start(&mut self, state: &str) -> bool {
         (**self).start(state)
+    }
+    fn explain(&self, out: &mut Vec<crate::arbiter::NodeTrace>) {
+        (**self).explain(out)
     }
 }
 

@@ -239,6 +239,10 @@ impl Behavior for BujoldAgent {
         Some(step)
     }
 
+    fn explain(&self, out: &mut Vec<crate::arbiter::NodeTrace>) {
+        self.tree.explain(out);
+    }
+
     fn reset(&mut self) {
         self.active = false;
         self.memory.with(|m| {
