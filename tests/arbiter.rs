@@ -213,3 +213,72 @@ fn latched_state_ignores_the_selector_until_done() {
     assert_eq!(&visited[..5], &[0, 1, 1, 1, 2]);
     assert_eq!(visited[5], 0);
 }
+
+/// Ends with a named event after `after` ticks.
+struct Emits {
+    name: &'static str,
+    event: &'static str,
+    after: u32,
+    ticks: u32,
+}
+
+impl Behavior for Emits {
+    fn name(&self) -> &str {
+        self.name
+    }
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+        self.ticks += 1;
+        let fb = Feedback::new(self.name, inputs.now);
+        let out = MotorOutput::twist(0.0, 0.3);
+        Some(if self.ticks >= self.after {
+            Step::event(self.event, out, fb)
+        } else {
+            Step::running(out, fb)
+        })
+    }
+    fn reset(&mut self) {
+        self.ticks = 0;
+    }
+}
+
+#[test]
+fn an_event_a_nested_sequence_finishes_on_is_routed_by_its_parent() {
+    let emits = |name, event, after| {
+        Box::new(Emits {
+            name,
+            event,
+            after,
+            ticks: 0,
+        })
+    };
+    // inner: turn → (turned) → look → (seen: finish); the parent routes `seen` to approach.
+    let mut inner = Sequencer::new("manoeuvre");
+    let turn = inner.state(emits("turn", "turned", 2), false);
+    let look = inner.state(emits("look", "seen", 1), false);
+    inner.on_event(turn, "turned", Next::Goto(look));
+    inner.on_event(look, "seen", Next::Finish);
+    let mut outer = Sequencer::new("servo");
+    let m = outer.state(Box::new(inner), true);
+    let approach = outer.state(
+        Box::new(Scripted::new("approach", 0.0, 1e9, MotorOutput::twist(0.1, 0.0))),
+        false,
+    );
+    outer.transitions(m, Next::Finish, Next::Finish);
+    outer.on_event(m, "seen", Next::Goto(approach));
+    let mut at = Vec::new();
+    for k in 0..5 {
+        let s = outer.tick(&Inputs::empty(0.1 * k as f64)).unwrap();
+        assert_eq!(s.status, Status::Running, "tick {k}");
+        at.push(outer.current());
+    }
+    // turn, turn (turned), look (seen, leaves the manoeuvre), approach, approach.
+    assert_eq!(at, vec![m, m, approach, approach, approach]);
+    assert_eq!(outer.last_event(), Some("seen"));
+
+    // An event the table does not declare still ends the sequence as failing to control.
+    let mut lone = Sequencer::new("lone");
+    lone.state(emits("turn", "turned", 1), false);
+    let s = lone.tick(&Inputs::empty(0.0)).unwrap();
+    assert_eq!(s.status, Status::Done(Outcome::Failed(FailureReason::FailedToControl)));
+    assert!(lone.is_finished());
+}

@@ -5,10 +5,11 @@
 mod common;
 
 use marsupial::arbiter::{NodeTrace, Strategy};
-use marsupial::behaviors::{Agent, agent_for};
+use marsupial::behaviors::agent_for;
 use marsupial::geometry::Pose2;
 use marsupial::perception::RgbImage;
 use marsupial::profile::Profile;
+use marsupial::schemas::Agent;
 use marsupial::schemas::{CameraInput, CameraInputs, Inputs, OdometryReading, Stamped};
 use std::path::Path;
 
@@ -53,7 +54,7 @@ fn node<'a>(trace: &'a [NodeTrace], name: &str) -> &'a NodeTrace {
 #[test]
 fn a_trace_names_the_leaf_the_proposals_the_winner_and_why_it_moved_on() {
     let mut a = agent(&shipped());
-    a.begin_docking();
+    a.begin(&marsupial::schemas::Mission::docking()).unwrap();
     let blank = common::background(256, 240);
     let seen = common::scene(256, 240, 0.25, 1);
     let first = tick(&mut a, 0.0, &blank, false);
@@ -92,7 +93,7 @@ fn a_trace_names_the_leaf_the_proposals_the_winner_and_why_it_moved_on() {
 /// plates close, for a profile text.
 fn run(src: &str) -> (Vec<NodeTrace>, Vec<NodeTrace>) {
     let mut a = agent(src);
-    a.begin_docking();
+    a.begin(&marsupial::schemas::Mission::docking()).unwrap();
     let seen = common::scene(256, 240, 0.25, 1);
     tick(&mut a, 0.0, &common::background(256, 240), false);
     let acquired = tick(&mut a, 0.1, &seen, false);
@@ -141,7 +142,7 @@ fn flipping_each_arbiter_choice_changes_the_trace() {
         1,
     );
     let mut a = agent(&hurried);
-    a.begin_docking();
+    a.begin(&marsupial::schemas::Mission::docking()).unwrap();
     let blank = common::background(256, 240);
     tick(&mut a, 0.0, &blank, false);
     let t = tick(&mut a, 0.1, &blank, false);

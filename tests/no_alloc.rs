@@ -190,7 +190,7 @@ fn composed_bujold_ticks_do_not_allocate() {
         common::scene(256, 240, 0.9, 2),
         common::background(256, 240),
     ];
-    let run = |agent: &mut Box<dyn marsupial::behaviors::Agent>, from: u64, to: u64| {
+    let run = |agent: &mut Box<dyn marsupial::schemas::Agent>, from: u64, to: u64| {
         let mut phases = 0u64;
         for k in from..to {
             let t = k as f64 * 0.1;
@@ -215,7 +215,7 @@ fn composed_bujold_ticks_do_not_allocate() {
         }
         phases
     };
-    agent.begin_docking();
+    agent.begin(&marsupial::schemas::Mission::docking()).unwrap();
     run(&mut agent, 0, 240); // warm-up: every phase's buffers sized once
     reset();
     COUNTING.with(|c| c.set(true));

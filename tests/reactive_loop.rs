@@ -185,8 +185,8 @@ fn same_inputs_same_commands_bit_for_bit() {
     assert!(a.contains("\"active\"") && a.contains("\"search\""));
 }
 
-fn one_tick(
-    lp: &mut ReactiveLoop,
+fn one_tick<B: marsupial::schemas::Behavior + ?Sized>(
+    lp: &mut ReactiveLoop<B>,
     now: f64,
     frame: Option<(&RgbImage, f64)>,
     odo: Option<OdometryReading>,

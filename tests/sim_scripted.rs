@@ -1,9 +1,12 @@
 //! The simulator end to end with a trivial scripted driver (no behavior logic in the
 //! simulator): dock and trials, determinism across job counts, resume, contact failures.
 
-use marsupial::behaviors::{Agent, BuildError};
+use marsupial::behaviors::BuildError;
 use marsupial::profile::Profile;
-use marsupial::schemas::{Auxiliary, Behavior, DriveCommand, Feedback, Inputs, MotorOutput, Outcome, Posture, Step};
+use marsupial::schemas::{
+    Agent, Auxiliary, Behavior, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Outcome, Posture,
+    Step,
+};
 use marsupial::sim::campaign::{self, CampaignOptions, Prepared};
 use marsupial::sim::scenario::Scenario;
 use std::path::{Path, PathBuf};
@@ -38,11 +41,18 @@ impl Behavior for Backer {
 }
 
 impl Agent for Backer {
-    fn begin_departure(&mut self) -> bool {
-        false
-    }
-    fn begin_docking(&mut self) {
-        self.started = None;
+    fn begin(&mut self, mission: &Mission) -> Result<(), MissionError> {
+        match mission {
+            Mission::Departure => Err(MissionError::Unavailable {
+                robot: "scripted_backer".into(),
+                mission: "departure",
+                why: "it only backs in".into(),
+            }),
+            Mission::Docking { .. } => {
+                self.started = None;
+                Ok(())
+            }
+        }
     }
 }
 

@@ -131,3 +131,14 @@ fn a_leaf_with_a_sequencers_field_is_refused_at_its_line() {
     assert!(msg.contains("unknown field `states`"), "{msg}");
     assert!(at.is_some_and(|l| l >= line - 3 && l <= line + 1), "{at:?} vs {line}");
 }
+
+#[test]
+fn an_unknown_selector_names_its_line() {
+    let from = "states = [\"ballistic\", \"search\"";
+    let (src, line) = edited(from, &format!("selector = \"bujold.nothing\"\n{from}"));
+    let e = build_error(&src);
+    let (path, at, msg) = only_problem(&e);
+    assert_eq!(path, "behavior.tree.nodes.close_dock.selector");
+    assert_eq!(at, Some(line));
+    assert!(msg.contains("unknown selector `bujold.nothing`"), "{msg}");
+}

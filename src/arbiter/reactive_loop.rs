@@ -8,7 +8,8 @@
 
 use crate::kinematics::{DriveLimits, DriveModel};
 use crate::schemas::{
-    Auxiliary, Behavior, DriveCommand, Feedback, Inputs, MotorOutput, Outcome, Status, TetherCommand,
+    Agent, Auxiliary, Behavior, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Outcome, Status,
+    TetherCommand,
 };
 use serde::Serialize;
 use std::fmt;
@@ -159,15 +160,19 @@ pub struct TickOutput {
     pub status: LoopStatus,
 }
 
-/// The reactive loop: a root behavior (usually an arbiter) plus input checks.
-pub struct ReactiveLoop {
-    root: Box<dyn Behavior>,
+/// The reactive loop: a root behavior (usually an arbiter, or a robot's composed
+/// [`Agent`]) plus input checks.
+///
+/// `B` is the root's type: `dyn Behavior` by default, `dyn Agent` for a robot that takes
+/// missions ([`ReactiveLoop::begin`]), or a concrete type to keep its own methods within
+/// reach ([`ReactiveLoop::root_mut`]).
+pub struct ReactiveLoop<B: Behavior + ?Sized = dyn Behavior> {
+    root: Box<B>,
     core: LoopCore,
 }
 
 /// The loop's own state (input checks, safe-stop and finish bookkeeping) without a root
-/// behavior, for callers that own the behavior themselves (the simulator ticks an agent
-/// through several phases with a fresh `LoopCore` each).
+/// behavior, for callers that own the behavior themselves.
 pub struct LoopCore {
     config: LoopConfig,
     last_now: Option<f64>,
@@ -197,9 +202,9 @@ pub fn safe_stop_command() -> MotorOutput {
     }
 }
 
-impl ReactiveLoop {
+impl<B: Behavior + ?Sized> ReactiveLoop<B> {
     /// Builds a loop around `root`.
-    pub fn new(root: Box<dyn Behavior>, config: LoopConfig) -> Self {
+    pub fn new(root: Box<B>, config: LoopConfig) -> Self {
         Self {
             root,
             core: LoopCore::new(config),
@@ -227,13 +232,31 @@ impl ReactiveLoop {
     }
 
     /// The root behavior.
-    pub fn root_mut(&mut self) -> &mut dyn Behavior {
-        self.root.as_mut()
+    pub fn root(&self) -> &B {
+        &self.root
+    }
+
+    /// The root behavior, to retune it between ticks.
+    pub fn root_mut(&mut self) -> &mut B {
+        &mut self.root
     }
 
     /// Runs one tick.
     pub fn tick(&mut self, inputs: &Inputs<'_>) -> TickOutput {
-        self.core.tick(self.root.as_mut(), inputs)
+        self.core.tick(&mut *self.root, inputs)
+    }
+}
+
+impl<B: Agent + ?Sized> ReactiveLoop<B> {
+    /// Starts `mission` on the root robot at the next tick. A loop whose previous mission
+    /// finished runs again; its clock may restart (a simulator placing the robot anew).
+    ///
+    /// # Errors
+    /// [`MissionError`] when the robot cannot do the mission; the loop is then unchanged.
+    pub fn begin(&mut self, mission: &Mission) -> Result<(), MissionError> {
+        self.root.begin(mission)?;
+        self.core.restart();
+        Ok(())
     }
 }
 
@@ -253,6 +276,12 @@ impl LoopCore {
     /// The configuration.
     pub fn config(&self) -> &LoopConfig {
         &self.config
+    }
+
+    /// Forgets the finished outcome and the clock, for a new mission (counters are kept).
+    pub fn restart(&mut self) {
+        self.finished = None;
+        self.last_now = None;
     }
 
     /// Ticks so far.
@@ -364,7 +393,7 @@ impl LoopCore {
     }
 
     /// Runs one tick of `root`.
-    pub fn tick(&mut self, root: &mut dyn Behavior, inputs: &Inputs<'_>) -> TickOutput {
+    pub fn tick<B: Behavior + ?Sized>(&mut self, root: &mut B, inputs: &Inputs<'_>) -> TickOutput {
         self.ticks += 1;
         if let Some(outcome) = self.finished {
             return TickOutput {

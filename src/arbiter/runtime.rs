@@ -14,7 +14,7 @@ use crate::kinematics::Odometry;
 use crate::perception::RgbImage;
 use crate::robot::{HardwareError, Robot, WheelTravel};
 use crate::schemas::{
-    CameraInput, CameraInputs, Inputs, MotorOutput, OdometryReading, Outcome, Stamped, TetherReading,
+    Behavior, CameraInput, CameraInputs, Inputs, MotorOutput, OdometryReading, Outcome, Stamped, TetherReading,
 };
 use crossbeam::channel::{Receiver, Sender, TrySendError, bounded};
 use std::sync::Arc;
@@ -137,7 +137,12 @@ fn sleep_until(deadline: Instant, stop: &StopHandle) {
 
 /// Runs `lp` on `robot` until its root behavior finishes, `stop` is raised, or
 /// `config.max_duration` passes. Always ends by commanding a stop.
-pub fn run(robot: &mut Robot, lp: &mut ReactiveLoop, config: &RuntimeConfig, stop: &StopHandle) -> RuntimeReport {
+pub fn run<B: Behavior + ?Sized>(
+    robot: &mut Robot,
+    lp: &mut ReactiveLoop<B>,
+    config: &RuntimeConfig,
+    stop: &StopHandle,
+) -> RuntimeReport {
     let t0 = Instant::now();
     let clock = move || t0.elapsed().as_secs_f64();
     let rate = lp.config().rate_hz.max(1e-3);

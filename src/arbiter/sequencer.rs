@@ -8,7 +8,10 @@
 //! A state ends in one of two ways, and the transition table says where each leads:
 //! * with a named **event** ([`Status::Event`]: `"acquired"`, `"lost"`, `"at_dock"`...):
 //!   this tick's output is still commanded and the next state is entered for the next
-//!   tick (an event with no entry in the table ends the sequence as failed to control);
+//!   tick. An event the table leads to [`Next::Finish`] ends the sequence and is reported
+//!   upward as the sequence's own event, so a nested sequence (RAPOSA's region-II
+//!   manoeuvre) can hand control back to its parent by name; an event with no entry in
+//!   the table ends the sequence as failed to control;
 //! * with an **outcome** ([`Status::Done`]): `on_success` / `on_failure` decide, or an
 //!   event entry named `"docked"`, `"completed"` or `"failed"` when one is declared.
 //!
@@ -24,12 +27,19 @@
 use super::decision::{Decision, Strategy};
 use crate::schemas::{Behavior, FailureReason, Feedback, Inputs, MotorOutput, Outcome, Status, Step};
 
+/// The transition target that ends a sequence (see [`Next::Finish`]), as profiles and
+/// traces name it.
+pub const FINISH: &str = "finish";
+
+/// The `to` of a recorded transition that left the sequence.
+const LEAVE: usize = usize::MAX;
+
 /// Where to go when a state ends.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Next {
     /// Enter the state with this index.
     Goto(usize),
-    /// End the sequence with the state's outcome.
+    /// End the sequence: with the state's outcome, or passing its event up.
     Finish,
 }
 
@@ -160,6 +170,11 @@ impl Sequencer {
         self
     }
 
+    /// Installs (or replaces) a reactive selector built elsewhere (by a registry).
+    pub fn set_selector(&mut self, selector: Box<dyn Selector>) {
+        self.selector = Some(selector);
+    }
+
     /// Index of the running state.
     pub fn current(&self) -> usize {
         self.current
@@ -236,31 +251,32 @@ impl Sequencer {
         }
     }
 
-    /// Where state `cur` goes when it ends with `status` (not `Running`).
-    fn next_for(&self, cur: usize, status: Status) -> Next {
+    /// Where state `cur` goes when it ends with `status` (not `Running`); `None` for an
+    /// event its table does not declare.
+    fn next_for(&self, cur: usize, status: Status) -> Option<Next> {
         let s = &self.states[cur];
         match status {
-            Status::Event(e) => s.event(e).unwrap_or(Next::Finish),
+            Status::Event(e) => s.event(e),
             Status::Done(outcome) => {
                 let named = match outcome {
                     Outcome::Docked => "docked",
                     Outcome::Completed => "completed",
                     Outcome::Failed(_) => "failed",
                 };
-                s.event(named).unwrap_or(if outcome.is_success() {
+                Some(s.event(named).unwrap_or(if outcome.is_success() {
                     s.on_success
                 } else {
                     s.on_failure
-                })
+                }))
             }
-            Status::Running => Next::Goto(cur),
+            Status::Running => Some(Next::Goto(cur)),
         }
     }
 
     /// Ends state `cur` with `status`, returning the sequence's step for this tick.
     fn finish_state(&mut self, cur: usize, step: Step, inputs: &Inputs<'_>) -> Step {
         let next = self.next_for(cur, step.status);
-        match self.resolve(next) {
+        match next.and_then(|n| self.resolve(n)) {
             Some(j) => {
                 let why = match step.status {
                     Status::Event(e) => e,
@@ -274,18 +290,20 @@ impl Sequencer {
                     ..step
                 }
             }
-            // `Finish`, or a `Goto` past the last state: the sequence ends with this
-            // state's outcome (an unhandled event counts as failing to control).
+            // The sequence ends: with the state's outcome; with its event, for the
+            // enclosing sequencer to route, when the table says `Finish` for it; as
+            // failing to control for an event the table does not declare.
             None => {
                 self.finished = true;
-                let outcome = match step.status {
-                    Status::Done(o) => o,
-                    _ => Outcome::Failed(FailureReason::FailedToControl),
+                let status = match (step.status, next) {
+                    (Status::Done(o), _) => Status::Done(o),
+                    (Status::Event(e), Some(_)) => Status::Event(e),
+                    _ => Status::Done(Outcome::Failed(FailureReason::FailedToControl)),
                 };
-                Step {
-                    status: Status::Done(outcome),
-                    ..step
+                if let Status::Event(e) = status {
+                    self.tick_transitions.push((cur, LEAVE, e));
                 }
+                Step { status, ..step }
             }
         }
     }
@@ -379,7 +397,11 @@ impl Behavior for Sequencer {
             .iter()
             .map(|&(from, to, event)| super::Transition {
                 from: name(from).to_string(),
-                to: name(to).to_string(),
+                to: if to == LEAVE {
+                    FINISH.to_string()
+                } else {
+                    name(to).to_string()
+                },
                 event: event.to_string(),
             })
             .collect();

@@ -1,34 +1,8 @@
-//! The agent abstraction and its construction from a profile.
+//! Building the robot a profile describes.
 
 use crate::profile::{ApproachKind, Profile};
-use crate::schemas::Behavior;
+use crate::schemas::Agent;
 use thiserror::Error;
-
-/// A robot's behaviors for one docking experiment.
-pub trait Agent: Behavior {
-    /// Switches to the departure phase (leave the dock, imprint on the way). Returns false
-    /// when the agent has none, in which case it stays ready to dock.
-    fn begin_departure(&mut self) -> bool;
-    /// Switches to the docking phase; the robot may have been moved since departure.
-    fn begin_docking(&mut self);
-    /// An a-priori estimate of the dock's pose (entrance, +x out along its axis) in the
-    /// odometry frame the next docking starts in: from GPS, or remembered from the
-    /// departure. With one, docking starts with a ballistic drive to the dock's approach
-    /// zone; without (`None`, the default), the robot is taken to be placed within sight
-    /// of the dock. Agents that cannot use it ignore it.
-    fn set_dock_hint(&mut self, _hint: Option<crate::geometry::Pose2>) {}
-    /// Counters of the current docking run (for campaign records).
-    fn stats(&self) -> AgentStats {
-        AgentStats::default()
-    }
-}
-
-/// Counters an agent keeps per docking run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct AgentStats {
-    /// Alignment manoeuvres started (RAPOSA's region-II iterations).
-    pub manoeuvres: u32,
-}
 
 /// Why no agent could be built for a profile.
 #[derive(Debug, Clone, Error)]
@@ -62,7 +36,7 @@ pub enum BuildError {
 pub fn agent_for(profile: &Profile) -> Result<Box<dyn Agent>, BuildError> {
     match profile.behavior.approach {
         ApproachKind::RatioSteering | ApproachKind::PotentialField if profile.fiducial.two_block.is_some() => {
-            Ok(Box::new(super::bujold::BujoldAgent::new(profile)?))
+            Ok(Box::new(super::bujold::agent(profile)?))
         }
         ApproachKind::SevenState if profile.fiducial.pyramid.is_some() => {
             Ok(Box::new(super::raposa::RaposaAgent::new(profile)?))

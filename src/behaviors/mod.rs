@@ -7,7 +7,9 @@
 
 pub mod agent;
 pub mod bujold;
+pub mod composed;
 pub mod raposa;
 pub mod registry;
 
-pub use agent::{Agent, AgentStats, BuildError, agent_for};
+pub use agent::{BuildError, agent_for};
+pub use composed::{Composed, SharedMemory};

@@ -1,4 +1,4 @@
-//! Named schemas, and building a profile's `[behavior.tree]` from them.
+//! Named schemas and selectors, and building a profile's `[behavior.tree]` from them.
 //!
 //! A [`Registry`] maps the names a profile's leaves use (`bujold.search`) to factories
 //! that build the leaf from its `params` table. Factories receive a build context `C`
@@ -30,7 +30,7 @@
 //! assert!(registry.names().any(|n| n == "my.creep"));
 //! ```
 
-use crate::arbiter::{Next, Priority, Sequencer, VectorSum};
+use crate::arbiter::{Next, Priority, Selector, Sequencer, VectorSum};
 use crate::config::ConfigError;
 use crate::profile::Profile;
 use crate::profile::tree::{FINISH, NodeSpec, TreeSpec};
@@ -66,9 +66,36 @@ impl LeafArgs<'_> {
 /// Builds one leaf; the error says what is wrong with its params or the profile.
 pub type LeafFactory<C> = dyn Fn(&C, &LeafArgs<'_>) -> Result<Box<dyn Behavior>, String> + Send + Sync;
 
-/// Schemas by name (see the module docs).
+/// What a factory gets to build a sequencer's selector.
+pub struct SelectorArgs<'a> {
+    /// The sequencer's name in the tree.
+    pub node: &'a str,
+    /// Its states, in order: the selector returns indices into this list.
+    pub states: &'a [String],
+    /// The whole profile.
+    pub profile: &'a Profile,
+}
+
+impl SelectorArgs<'_> {
+    /// Index of the state named `name`.
+    ///
+    /// # Errors
+    /// A message naming the missing state (the selector needs it).
+    pub fn state(&self, name: &str) -> Result<usize, String> {
+        self.states
+            .iter()
+            .position(|s| s == name)
+            .ok_or_else(|| format!("needs a state named `{name}` (states: {})", self.states.join(", ")))
+    }
+}
+
+/// Builds one selector; the error says what the sequencer lacks.
+pub type SelectorFactory<C> = dyn Fn(&C, &SelectorArgs<'_>) -> Result<Box<dyn Selector>, String> + Send + Sync;
+
+/// Schemas and selectors by name (see the module docs).
 pub struct Registry<C> {
     leaves: BTreeMap<String, Box<LeafFactory<C>>>,
+    selectors: BTreeMap<String, Box<SelectorFactory<C>>>,
 }
 
 impl<C> Default for Registry<C> {
@@ -82,6 +109,7 @@ impl<C> Registry<C> {
     pub fn new() -> Self {
         Self {
             leaves: BTreeMap::new(),
+            selectors: BTreeMap::new(),
         }
     }
 
@@ -92,6 +120,17 @@ impl<C> Registry<C> {
         factory: impl Fn(&C, &LeafArgs<'_>) -> Result<Box<dyn Behavior>, String> + Send + Sync + 'static,
     ) -> &mut Self {
         self.leaves.insert(name.into(), Box::new(factory));
+        self
+    }
+
+    /// Registers (or replaces) the sequencer selector `name` (a sequencer names it in
+    /// its `selector` field).
+    pub fn register_selector(
+        &mut self,
+        name: impl Into<String>,
+        factory: impl Fn(&C, &SelectorArgs<'_>) -> Result<Box<dyn Selector>, String> + Send + Sync + 'static,
+    ) -> &mut Self {
+        self.selectors.insert(name.into(), Box::new(factory));
         self
     }
 
@@ -197,10 +236,29 @@ impl<C> Registry<C> {
             NodeSpec::Sequencer {
                 states,
                 state_timeout_s,
+                selector,
                 ..
             } => {
                 let built: Option<Vec<_>> = children(problems).into_iter().collect();
                 let mut seq = Sequencer::new(name);
+                if let Some(sel) = selector {
+                    let args = SelectorArgs {
+                        node: name,
+                        states,
+                        profile,
+                    };
+                    match self.selectors.get(sel).map(|f| f(ctx, &args)) {
+                        Some(Ok(s)) => seq.set_selector(s),
+                        Some(Err(e)) => problems.push((format!("{path}.selector"), format!("`{sel}`: {e}"))),
+                        None => {
+                            let known: Vec<&str> = self.selectors.keys().map(String::as_str).collect();
+                            problems.push((
+                                format!("{path}.selector"),
+                                format!("unknown selector `{sel}` (registered: {})", known.join(", ")),
+                            ));
+                        }
+                    }
+                }
                 for (child, state) in states.iter().zip(built?) {
                     let s = &tree.nodes[child];
                     let i = seq.state(state, s.latched());

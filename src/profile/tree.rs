@@ -29,8 +29,7 @@ use crate::config::Validator;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-/// The transition target that ends the sequence (with the state's outcome).
-pub const FINISH: &str = "finish";
+pub use crate::arbiter::sequencer::FINISH;
 
 /// The `[behavior.tree]` table.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -84,6 +83,10 @@ pub enum NodeSpec {
         /// `behavior.phase_timeout_s`).
         #[serde(default)]
         state_timeout_s: Option<f64>,
+        /// A registered selector that picks the state to run each tick while the current
+        /// one is not latched (RAPOSA's seven-state selection); none: transitions only.
+        #[serde(default)]
+        selector: Option<String>,
         /// As a sequencer state: where its events lead.
         #[serde(default)]
         on: Transitions,

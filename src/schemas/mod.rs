@@ -8,6 +8,7 @@
 pub mod behavior;
 pub mod goto_point;
 pub mod inputs;
+pub mod mission;
 pub mod motor_output;
 pub mod percept;
 pub mod potential_field;
@@ -20,6 +21,7 @@ pub mod visual_servo;
 pub use behavior::{Behavior, FailureReason, Feedback, Outcome, Presence, SchemaBehavior, Status, Step};
 pub use goto_point::PointController;
 pub use inputs::{CameraInput, CameraInputs, Inputs, OdometryReading, TetherReading};
+pub use mission::{Agent, AgentStats, Mission, MissionError};
 pub use motor_output::{Auxiliary, DriveCommand, Guides, MotorOutput, Posture, TetherCommand};
 pub use percept::{Percept, Stamped};
 pub use potential_field::PotentialField;

@@ -14,11 +14,11 @@ use super::motion::Motion;
 use super::rng::Rng;
 use super::scenario::{Loaded, RunSpec, Scenario};
 use super::world::{self, World};
-use crate::behaviors::{Agent, BuildError};
+use crate::behaviors::BuildError;
 use crate::geometry::Pose2;
 use crate::perception::RgbImage;
 use crate::profile::Profile;
-use crate::schemas::{Behavior, Outcome};
+use crate::schemas::{Agent, Behavior, Mission, Outcome};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -195,7 +195,7 @@ pub fn run_one(
     );
     // Departure: undock and imprint (paired runs share it through `pair`).
     let mut imprinted = None;
-    if sc.imprint.enabled && agent.begin_departure() {
+    if sc.imprint.enabled && agent.begin(&Mission::Departure).is_ok() {
         let dep_light = match &sc.imprint.lighting {
             Some(name) => {
                 let l = sc.lighting_named(name);
@@ -242,21 +242,21 @@ pub fn run_one(
         profile.body.width_m,
     );
     sim.place(start, false);
-    if sc.ballistic.enabled {
+    let dock_hint = sc.ballistic.enabled.then(|| {
         // Odometry restarts at the placed pose: the dock's origin seen from there, with
         // the a-priori error (its own stream, so the other draws stay as they were).
         let mut r = Rng::new(spec.seed ^ 0xBA11_1571C);
         let exact = start.relative(&Pose2::default());
         let b = &sc.ballistic;
-        agent.set_dock_hint(Some(Pose2::new(
+        Pose2::new(
             exact.x + r.normal() * b.error_m,
             exact.y + r.normal() * b.error_m,
             exact.theta + r.normal() * b.heading_error_deg.to_radians(),
-        )));
-    } else {
-        agent.set_dock_hint(None);
-    }
-    agent.begin_docking();
+        )
+    });
+    agent
+        .begin(&Mission::Docking { dock_hint })
+        .map_err(|e| SimError::Unsupported(e.to_string()))?;
     let end = run_recorded(&mut sim, agent.as_mut(), sc.timeout_s, frames, "frame");
     let success = sim.docked();
     let outcome = match end {

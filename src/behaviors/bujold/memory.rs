@@ -3,19 +3,21 @@
 //! next.
 //!
 //! The perceptual schema runs once per tick for the whole tree ([`Memory::perceive`],
-//! called by the root [`super::BujoldAgent`] before the arbiters), so colour adaptation
+//! called by the robot's [`Composed`](crate::behaviors::composed::Composed) root before the
+//! arbiters), so colour adaptation
 //! follows the light whichever phase runs; the phase schemas then read the views.
 
 use super::params::BujoldTuning;
 use crate::behaviors::BuildError;
+use crate::behaviors::composed::SharedMemory;
 use crate::geometry::Pose2;
 use crate::perception::TwoBlockSchema;
 use crate::perception::frame_change::FrameChange;
 use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
 use crate::profile::{ApproachKind, Profile};
 use crate::schemas::{
-    Auxiliary, DriveCommand, Feedback, Inputs, MotorOutput, Percept, PerceptualSchema, Posture, PotentialField,
-    RatioSteering, Step,
+    Auxiliary, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Percept, PerceptualSchema, Posture,
+    PotentialField, RatioSteering, Step,
 };
 
 /// Largest median window the repositioning decision may look back over, frames.
@@ -376,6 +378,38 @@ impl Memory {
     /// Distance travelled from `mark` to this tick's odometry pose, m.
     pub fn travelled(&self, mark: &Pose2) -> f64 {
         (self.odo.x - mark.x).hypot(self.odo.y - mark.y)
+    }
+}
+
+impl SharedMemory for Memory {
+    fn perceive(&mut self, inputs: &Inputs<'_>) {
+        Memory::perceive(self, inputs);
+    }
+
+    fn begin(&mut self, mission: &Mission) -> Result<(), MissionError> {
+        self.run_start = None;
+        match mission {
+            Mission::Departure => self.imprinted = false,
+            Mission::Docking { dock_hint } => {
+                self.alpha_filtered = None;
+                self.alpha_window.clear();
+                self.retries = 0;
+                self.unjams = 0;
+                self.ever_seen = false;
+                self.last_seen = None;
+                self.failing = None;
+                self.plan = None;
+                self.dock_hint = *dock_hint;
+                // Ballistic region: the drive by odometry ends facing along the axis at the
+                // staging point; unjamming turns back to that heading.
+                self.start_heading = dock_hint.map(|dock| {
+                    dock.compose(&Pose2::new(self.tuning.ballistic_staging_m, 0.0, 0.0))
+                        .theta
+                });
+                self.docking_first_tick = true;
+            }
+        }
+        Ok(())
     }
 }
 

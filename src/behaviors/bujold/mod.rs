@@ -7,13 +7,13 @@
 //! * **departure** (sequencer): `undock` lowered, `drive_out` raised, `imprint` the
 //!   blocks' colours at the profile's imprint distance, drive on out;
 //! * **docking** (priority): the `dock_switch` subsumes the **close dock** (sequencer):
-//!   `ballistic` (only with an a-priori dock pose, [`Agent::set_dock_hint`]) → `search`
+//!   `ballistic` (only with an a-priori dock pose, [`Mission::Docking`](crate::schemas::Mission)) → `search`
 //!   ⇄ `unjam` → `approach` → `decide` → `back_in`, with `reposition`, `move_away` and
 //!   `give_up` as the retry loops, and per-state timeouts.
 //!
-//! The root, [`BujoldAgent`], runs the two-block perceptual schema once per tick into the
-//! shared [`Memory`](memory::Memory) and then ticks the tree; [`register`] puts the
-//! phase schemas in a [`Registry`] under `bujold.*` names.
+//! The robot, [`BujoldAgent`] (a [`Composed`] behavior), runs the two-block perceptual
+//! schema once per tick into the shared [`Memory`] and then ticks the tree; [`register`]
+//! puts the phase schemas in a [`Registry`] under `bujold.*` names.
 
 pub mod approach;
 pub mod back_in;
@@ -29,15 +29,14 @@ pub mod unjam;
 
 pub use decide::{Decision, at_dock_decision};
 
-use super::agent::{Agent, BuildError};
+use super::agent::BuildError;
+use super::composed::Composed;
 use super::registry::{LeafArgs, Registry};
 use crate::arbiter::Blackboard;
-use crate::geometry::Pose2;
-use crate::perception::TwoBlockSchema;
 use crate::perception::two_block_pose::TwoBlockGeometry;
 use crate::profile::Profile;
-use crate::schemas::{Behavior, Inputs, SearchRotation, Status, Step};
-use memory::Memory;
+use crate::schemas::SearchRotation;
+pub use memory::Memory;
 use reposition::PlanFrom;
 
 /// Registers Bujold's phase schemas (`bujold.undock`, `bujold.search`, ...) in `registry`;
@@ -164,135 +163,26 @@ fn imprint_distance(profile: &Profile) -> Option<f64> {
     Some(profile.perception.imprint.at_distance_m + profile.dock?.depth_m - rear_behind_camera(profile, &g)?)
 }
 
-/// Bujold's robot: the two-block perceptual schema and the composed tree.
-pub struct BujoldAgent {
-    memory: Blackboard<Memory>,
-    tree: Box<dyn Behavior>,
-    departure: Option<String>,
-    docking: String,
-    ballistic: Option<String>,
-    /// A departure or a docking is running.
-    active: bool,
+/// Bujold's robot: the two-block perceptual schema in the shared [`Memory`] and the tree
+/// of `[behavior.tree]`.
+pub type BujoldAgent = Composed<Memory>;
+
+/// Builds Bujold's robot from a profile with a `[fiducial.two_block]`,
+/// `[behavior.ratio_steering]` (and `[behavior.potential_field]` when selected) and a
+/// `[behavior.tree]` of Bujold's schemas (or the user's, registered in `registry`).
+///
+/// # Errors
+/// [`BuildError`] when something it needs is missing or the tree does not build.
+pub fn agent_with(profile: &Profile, registry: &Registry<Blackboard<Memory>>) -> Result<BujoldAgent, BuildError> {
+    Composed::build(profile, registry, Memory::from_profile(profile)?)
 }
 
-impl BujoldAgent {
-    /// Builds the agent from a profile with a `[fiducial.two_block]`,
-    /// `[behavior.ratio_steering]` (and `[behavior.potential_field]` when selected) and a
-    /// `[behavior.tree]` of Bujold's schemas (or the user's, registered in `registry`).
-    ///
-    /// # Errors
-    /// [`BuildError`] when something it needs is missing or the tree does not build.
-    pub fn with_registry(profile: &Profile, registry: &Registry<Blackboard<Memory>>) -> Result<Self, BuildError> {
-        let tree_spec = profile.behavior.tree.as_ref().ok_or_else(|| BuildError::Profile {
-            profile: profile.name.clone(),
-            what: "needs [behavior.tree]".into(),
-        })?;
-        let memory = Blackboard::new(Memory::from_profile(profile)?);
-        let tree = registry.build(profile, &memory).map_err(BuildError::Tree)?;
-        Ok(Self {
-            memory,
-            tree,
-            departure: tree_spec.departure.clone(),
-            docking: tree_spec.docking.clone(),
-            ballistic: tree_spec.ballistic.clone(),
-            active: false,
-        })
-    }
-
-    /// Builds the agent with Bujold's own schemas (see [`BujoldAgent::with_registry`]).
-    ///
-    /// # Errors
-    /// As [`BujoldAgent::with_registry`].
-    pub fn new(profile: &Profile) -> Result<Self, BuildError> {
-        let mut registry = Registry::new();
-        register(&mut registry);
-        Self::with_registry(profile, &registry)
-    }
-
-    /// The perceptual schema's state (colour model, last detection), read under the
-    /// memory's lock.
-    pub fn with_schema<R>(&self, f: impl FnOnce(&TwoBlockSchema) -> R) -> R {
-        f(&self.memory.lock().schema)
-    }
-
-    /// True once a departure imprinted successfully.
-    pub fn imprinted(&self) -> bool {
-        self.memory.lock().imprinted
-    }
-}
-
-impl Behavior for BujoldAgent {
-    fn name(&self) -> &str {
-        "bujold"
-    }
-
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
-        // Perception runs every tick, so adaptation follows the light in every phase.
-        self.memory.with(|m| m.perceive(inputs));
-        if !self.active {
-            return None;
-        }
-        let step = self.tree.tick(inputs)?;
-        if matches!(step.status, Status::Done(_)) {
-            self.active = false;
-        }
-        Some(step)
-    }
-
-    fn explain(&self, out: &mut Vec<crate::arbiter::NodeTrace>) {
-        self.tree.explain(out);
-    }
-
-    fn reset(&mut self) {
-        self.active = false;
-        self.memory.with(|m| {
-            m.run_start = None;
-            m.retries = 0;
-        });
-    }
-}
-
-impl Agent for BujoldAgent {
-    fn begin_departure(&mut self) -> bool {
-        let Some(state) = self.departure.clone() else {
-            return false;
-        };
-        self.memory.with(|m| {
-            m.run_start = None;
-            m.imprinted = false;
-        });
-        self.active = self.tree.start(&state);
-        self.active
-    }
-
-    fn begin_docking(&mut self) {
-        let staging = self.memory.with(|m| {
-            m.run_start = None;
-            m.alpha_filtered = None;
-            m.alpha_window.clear();
-            m.retries = 0;
-            m.unjams = 0;
-            m.ever_seen = false;
-            m.last_seen = None;
-            m.failing = None;
-            m.plan = None;
-            // Ballistic region: drive by odometry to the approach zone's staging point and
-            // face along the axis, then look.
-            let staging = m
-                .dock_hint
-                .map(|dock| dock.compose(&Pose2::new(m.tuning.ballistic_staging_m, 0.0, 0.0)));
-            m.start_heading = staging.map(|t| t.theta);
-            m.docking_first_tick = true;
-            staging
-        });
-        let state = match (&staging, &self.ballistic) {
-            (Some(_), Some(b)) => b.clone(),
-            _ => self.docking.clone(),
-        };
-        self.active = self.tree.start(&state);
-    }
-
-    fn set_dock_hint(&mut self, hint: Option<Pose2>) {
-        self.memory.with(|m| m.dock_hint = hint);
-    }
+/// Builds Bujold's robot with Bujold's own schemas (see [`agent_with`]).
+///
+/// # Errors
+/// As [`agent_with`].
+pub fn agent(profile: &Profile) -> Result<BujoldAgent, BuildError> {
+    let mut registry = Registry::new();
+    register(&mut registry);
+    agent_with(profile, &registry)
 }

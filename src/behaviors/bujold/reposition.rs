@@ -20,7 +20,7 @@ use std::f64::consts::FRAC_PI_2;
 pub enum PlanFrom {
     /// The plan the previous phase left in memory.
     Memory,
-    /// The a-priori dock pose (`Agent::set_dock_hint`).
+    /// The a-priori dock pose ([`Mission::Docking`](crate::schemas::Mission)).
     DockHint,
 }
 

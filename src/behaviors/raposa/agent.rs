@@ -2,13 +2,13 @@
 
 use super::region2::{Region2Plan, plan, robot_in_ball_frame};
 use super::states::{ServoState, select_state};
-use crate::behaviors::agent::{Agent, AgentStats, BuildError};
+use crate::behaviors::agent::BuildError;
 use crate::geometry::{Pose2, Twist, wrap_angle};
 use crate::perception::{PyramidPercept, PyramidSchema};
 use crate::profile::{Profile, SegmentationMode, SevenStateGains};
 use crate::schemas::{
-    Auxiliary, Behavior, DriveCommand, FailureReason, Feedback, Guides, Inputs, MotorOutput, Outcome, PerceptualSchema,
-    PointController, SearchRotation, ServoLaw, Step,
+    Agent, AgentStats, Auxiliary, Behavior, DriveCommand, FailureReason, Feedback, Guides, Inputs, Mission,
+    MissionError, MotorOutput, Outcome, PerceptualSchema, PointController, SearchRotation, ServoLaw, Step,
 };
 
 /// Frames without anything seen before state 5 starts searching (a single dropped frame
@@ -565,14 +565,18 @@ impl Behavior for RaposaAgent {
     }
 }
 
-impl Agent for RaposaAgent {
+impl RaposaAgent {
     /// Departure (seed 001's robot leaves the pyramid to explore): drive straight out
     /// until the camera is `imprint_distance_m` from the ball, stop, and imprint the
     /// pyramid's colours. In `fixed` segmentation there is nothing to imprint and the
     /// agent has no departure.
-    fn begin_departure(&mut self) -> bool {
+    fn begin_departure(&mut self) -> Result<(), MissionError> {
         if self.schema.mode() == SegmentationMode::Fixed {
-            return false;
+            return Err(MissionError::Unavailable {
+                robot: "raposa".into(),
+                mission: "departure",
+                why: "fixed segmentation has nothing to imprint".into(),
+            });
         }
         self.imprinted = false;
         self.run_start = None;
@@ -580,7 +584,7 @@ impl Agent for RaposaAgent {
         // ball, and the body's forward direction leads away from it.
         let travel = (self.schema.imprint_distance() - self.socket_inset).max(0.0);
         self.enter(Phase::Depart { target: (travel, 0.0) }, 0.0);
-        true
+        Ok(())
     }
 
     fn begin_docking(&mut self) {
@@ -598,6 +602,18 @@ impl Agent for RaposaAgent {
         };
         self.manoeuvres = 0;
         self.schema.reset();
+    }
+}
+
+impl Agent for RaposaAgent {
+    fn begin(&mut self, mission: &Mission) -> Result<(), MissionError> {
+        match mission {
+            Mission::Departure => self.begin_departure(),
+            Mission::Docking { .. } => {
+                self.begin_docking();
+                Ok(())
+            }
+        }
     }
 
     fn stats(&self) -> AgentStats {

@@ -1,0 +1,160 @@
+//! A robot's composed behavior: its shared memory, the tree its profile declares, and the
+//! missions that start it.
+//!
+//! Every robot this crate ships, and any a user composes, runs the same way: each tick the
+//! robot's perceptual schemas run once into its [`SharedMemory`] (so colour adaptation
+//! follows the light whichever phase runs, and between missions too), then the tree of
+//! arbiters built from `[behavior.tree]` by a [`Registry`] decides. A [`Mission`] starts
+//! the tree at the state the profile names for it (`departure`, `docking`, or `ballistic`
+//! for a docking with an a-priori dock pose); the mission ends when the tree reports an
+//! outcome.
+
+use super::agent::BuildError;
+use super::registry::Registry;
+use crate::arbiter::{Blackboard, NodeTrace};
+use crate::profile::Profile;
+use crate::schemas::{Agent, AgentStats, Behavior, Inputs, Mission, MissionError, Status, Step};
+
+/// What one robot's schemas share (see the module docs).
+pub trait SharedMemory: Send + 'static {
+    /// Runs the robot's perceptual schemas on this tick's inputs, before the tree ticks.
+    fn perceive(&mut self, inputs: &Inputs<'_>);
+
+    /// Forgets what a new mission must not inherit (retries, plans, the last sighting) and
+    /// takes the mission's data (the dock hint).
+    ///
+    /// # Errors
+    /// [`MissionError::Unavailable`] when the robot cannot do `mission` as configured.
+    fn begin(&mut self, mission: &Mission) -> Result<(), MissionError>;
+
+    /// Counters of the current mission.
+    fn stats(&self) -> AgentStats {
+        AgentStats::default()
+    }
+}
+
+/// A memory for trees whose schemas share nothing.
+impl SharedMemory for () {
+    fn perceive(&mut self, _inputs: &Inputs<'_>) {}
+    fn begin(&mut self, _mission: &Mission) -> Result<(), MissionError> {
+        Ok(())
+    }
+}
+
+/// The states of the tree each mission starts in (`[behavior.tree]`'s `departure`,
+/// `docking` and `ballistic`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct Entries {
+    departure: Option<String>,
+    docking: String,
+    ballistic: Option<String>,
+}
+
+/// A robot's composed behavior (see the module docs).
+pub struct Composed<M: SharedMemory> {
+    name: String,
+    memory: Blackboard<M>,
+    tree: Box<dyn Behavior>,
+    entries: Entries,
+    /// A mission is running.
+    active: bool,
+}
+
+impl<M: SharedMemory> Composed<M> {
+    /// Builds the profile's `[behavior.tree]` with the schemas of `registry`, each given a
+    /// handle on `memory`.
+    ///
+    /// # Errors
+    /// [`BuildError::Profile`] without a tree, [`BuildError::Tree`] when it does not build
+    /// (an unknown schema, params a schema refuses; the error names the profile's line).
+    pub fn build(profile: &Profile, registry: &Registry<Blackboard<M>>, memory: M) -> Result<Self, BuildError> {
+        let spec = profile.behavior.tree.as_ref().ok_or_else(|| BuildError::Profile {
+            profile: profile.name.clone(),
+            what: "needs [behavior.tree]".into(),
+        })?;
+        let memory = Blackboard::new(memory);
+        let tree = registry.build(profile, &memory).map_err(BuildError::Tree)?;
+        Ok(Self {
+            name: profile.name.clone(),
+            memory,
+            tree,
+            entries: Entries {
+                departure: spec.departure.clone(),
+                docking: spec.docking.clone(),
+                ballistic: spec.ballistic.clone(),
+            },
+            active: false,
+        })
+    }
+
+    /// The shared memory (to inspect the perceptual schemas' state, or retune them).
+    pub fn memory(&self) -> &Blackboard<M> {
+        &self.memory
+    }
+
+    /// True while a mission runs.
+    pub fn is_active(&self) -> bool {
+        self.active
+    }
+}
+
+impl<M: SharedMemory> Behavior for Composed<M> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+        self.memory.with(|m| m.perceive(inputs));
+        if !self.active {
+            return None;
+        }
+        let step = self.tree.tick(inputs)?;
+        if matches!(step.status, Status::Done(_)) {
+            self.active = false;
+        }
+        Some(step)
+    }
+
+    fn reset(&mut self) {
+        self.active = false;
+    }
+
+    fn explain(&self, out: &mut Vec<NodeTrace>) {
+        self.tree.explain(out);
+    }
+}
+
+impl<M: SharedMemory> Agent for Composed<M> {
+    fn begin(&mut self, mission: &Mission) -> Result<(), MissionError> {
+        let entry = match mission {
+            Mission::Departure => self
+                .entries
+                .departure
+                .clone()
+                .ok_or_else(|| MissionError::Unavailable {
+                    robot: self.name.clone(),
+                    mission: mission.name(),
+                    why: "its [behavior.tree] declares no `departure` state".into(),
+                })?,
+            Mission::Docking { dock_hint } => match (dock_hint, &self.entries.ballistic) {
+                (Some(_), Some(b)) => b.clone(),
+                _ => self.entries.docking.clone(),
+            },
+        };
+        self.memory.with(|m| m.begin(mission))?;
+        self.active = self.tree.start(&entry);
+        if self.active {
+            Ok(())
+        } else {
+            Err(MissionError::Unavailable {
+                robot: self.name.clone(),
+                mission: mission.name(),
+                why: format!("no state `{entry}` in its tree"),
+            })
+        }
+    }
+
+    fn stats(&self) -> AgentStats {
+        self.memory.lock().stats()
+    }
+}
