@@ -18,7 +18,7 @@
 //!
 //! Run it with `cargo run --example custom_robot`.
 
-use marsupial::arbiter::runtime::{RuntimeConfig, RuntimeEvent, StopHandle, run};
+use marsupial::arbiter::runtime::{RuntimeConfig, StopHandle, run};
 use marsupial::arbiter::{Priority, ReactiveLoop};
 use marsupial::geometry::{Pose2, Twist, integrate_twist};
 use marsupial::perception::RgbImage;
@@ -316,12 +316,7 @@ fn main() {
     let report = run(&mut robot, &mut lp, &config, &StopHandle::new());
 
     for e in &report.events {
-        match e {
-            RuntimeEvent::SafeStop { t, reason } => println!("  {t:6.2} s  safe stop: {reason}"),
-            RuntimeEvent::Resumed { t } => println!("  {t:6.2} s  resumed"),
-            RuntimeEvent::Finished { t, outcome } => println!("  {t:6.2} s  finished: {outcome:?}"),
-            RuntimeEvent::HardwareError { t, device, error } => println!("  {t:6.2} s  {device}: {error}"),
-        }
+        println!("{e}");
     }
     let pose = world.lock().map(|w| w.pose).unwrap_or_default();
     println!(

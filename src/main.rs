@@ -19,7 +19,8 @@ enum Command {
     ///
     /// Prints one line (or, with --json, the run record: start, outcome, time_s, path_m,
     /// entrance errors, track …). With --out DIR, writes DIR/trajectory.csv and every Nth
-    /// camera frame (the scenario's [record] frames_every) to DIR/frames/.
+    /// camera frame (the scenario's [record] frames_every) to DIR/frames/. With --trace
+    /// FILE, writes each tick's decision (see `timeline`).
     Dock(marsupial::cli::sim_cmds::DockOptions),
     /// Run a scenario's whole trial campaign in the simulator, in parallel.
     ///
@@ -66,6 +67,15 @@ enum Command {
     /// right_px, total_px, ratio, left_centroid, right_centroid, offset_px, mode
     /// (adapted / imprinted / table) and us_per_frame (median over --repeat runs).
     Detect(marsupial::cli::detect::DetectOptions),
+    /// Print the phase timeline of a run from its decision trace (`dock --trace`).
+    ///
+    /// One line per sequencer transition: mission, time, sequencer, from → to and the
+    /// event that fired it; and one per mission's end with its outcome.
+    Timeline {
+        /// The trace (JSON lines).
+        #[arg(value_name = "TRACE.jsonl")]
+        trace: PathBuf,
+    },
 }
 
 /// Exit status of a subcommand: success, or the error on stderr and status 1.
@@ -104,5 +114,6 @@ fn main() -> ExitCode {
             exit_code(marsupial::cli::sim_cmds::trials(&opts, &mut std::io::stdout()))
         }
         Command::Detect(opts) => exit_code(marsupial::cli::detect::run(&opts, &mut std::io::stdout())),
+        Command::Timeline { trace } => exit_code(marsupial::cli::timeline::run(&trace, &mut std::io::stdout())),
     }
 }

@@ -21,6 +21,7 @@ fn opts(index: Option<usize>, out: Option<PathBuf>, frames_every: Option<u32>) -
         json: false,
         out,
         frames_every,
+        trace: None,
     }
 }
 
@@ -66,4 +67,49 @@ fn a_start_inside_the_mothers_body_is_refused() {
     assert!(e.contains("overlapping the dock's body"), "{e}");
     o.at = Some((0.9, 0.0, 0.0));
     assert!(dock(&o, &mut Vec::new()).is_ok());
+}
+
+#[test]
+fn the_trace_has_every_tick_and_the_timeline_reads_it() {
+    let path = std::env::temp_dir().join(format!("marsupial-trace-{}.jsonl", std::process::id()));
+    let mut o = opts(Some(0), None, None);
+    o.trace = Some(path.clone());
+    let rec = dock(&o, &mut Vec::new()).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let lines: Vec<serde_json::Value> = text.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let ticks = |m: &str| {
+        lines
+            .iter()
+            .filter(|l| l["mission"] == m && l["nodes"].is_array())
+            .count()
+    };
+    // One line per loop tick of each mission (10 Hz): the docking's match the run's time.
+    assert!(ticks("departure") > 100, "{}", ticks("departure"));
+    let docking = ticks("docking") as f64;
+    assert!(
+        (docking - rec.time_s * 10.0).abs() <= 2.0,
+        "{docking} ticks for {} s",
+        rec.time_s
+    );
+    // Every tick names the root sequencer and the leaf that won.
+    let first = &lines[0]["nodes"];
+    assert_eq!(first[0]["node"], "bujold");
+    assert_eq!(first[1]["winner"], "undock");
+    assert_eq!(lines.last().unwrap()["world"], rec.outcome.as_str());
+
+    let mut out = Vec::new();
+    let n = marsupial::cli::timeline::run(&path, &mut out).unwrap();
+    let out = String::from_utf8(out).unwrap();
+    assert!(n >= 5, "{out}");
+    assert!(out.contains("departure: undock → drive_out (out)"), "{out}");
+    assert!(out.contains("close_dock: search → approach (acquired)"), "{out}");
+    assert!(out.contains("finished: completed"), "{out}");
+
+    // Not a trace: the file and line are named.
+    std::fs::write(&path, "{\"mission\":\"docking\",\"t\":0.0,\"nodes\":[]}\nnot json\n").unwrap();
+    let e = marsupial::cli::timeline::run(&path, &mut Vec::new())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains(":2: not a decision-trace line"), "{e}");
+    let _ = std::fs::remove_file(&path);
 }

@@ -146,6 +146,7 @@ fn run(seed: u64) -> String {
         camera: Some(0.5),
         odometry: None,
         tether: None,
+        sensors: Vec::new(),
     });
     let mut log = String::new();
     for (k, f) in fs.iter().enumerate() {
@@ -166,6 +167,7 @@ fn run(seed: u64) -> String {
             )),
             tether: None,
             dock_contact: None,
+            sensors: &[],
         };
         let out = lp.tick(&inputs);
         log.push_str(&serde_json::to_string(&out).unwrap());
@@ -198,6 +200,7 @@ fn one_tick<B: marsupial::schemas::Behavior + ?Sized>(
         odometry: odo.map(|o| Stamped::new(now, o)),
         tether: None,
         dock_contact: None,
+        sensors: &[],
     };
     let out = lp.tick(&inputs);
     if matches!(
@@ -216,6 +219,7 @@ fn stale_missing_and_bad_inputs_stop_then_resume() {
         camera: Some(0.5),
         odometry: None,
         tether: None,
+        sensors: Vec::new(),
     });
     assert_eq!(
         one_tick(&mut lp, 0.0, None, None),
@@ -299,6 +303,7 @@ fn required_odometry_must_be_fresh() {
         camera: None,
         odometry: Some(0.2),
         tether: None,
+        sensors: Vec::new(),
     });
     assert_eq!(
         one_tick(&mut lp, 0.0, Some((&f, 0.0)), None),

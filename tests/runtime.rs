@@ -1,12 +1,14 @@
 //! The threaded runtime: latest-frame-wins delivery, stale-input safe stop and resume,
 //! clean shutdown with a final stop command.
 
-use marsupial::arbiter::runtime::{RuntimeConfig, RuntimeEvent, StopHandle, run};
+use marsupial::arbiter::runtime::{RuntimeConfig, RuntimeEvent, StopHandle, run, run_missions};
 use marsupial::arbiter::{InputKind, LoopConfig, ReactiveLoop, Staleness, StopReason};
 use marsupial::kinematics::{Differential, DriveLimits, DriveModel};
 use marsupial::perception::RgbImage;
-use marsupial::robot::{Camera, Drive, HardwareError, Robot};
-use marsupial::schemas::{Behavior, DriveCommand, Feedback, Inputs, MotorOutput, Step};
+use marsupial::robot::{Actuator, Camera, Drive, HardwareError, Robot, Sensor};
+use marsupial::schemas::{
+    Agent, Behavior, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Outcome, Step,
+};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -73,6 +75,7 @@ fn loop_config() -> LoopConfig {
             camera: Some(0.25),
             odometry: None,
             tether: None,
+            sensors: Vec::new(),
         },
         frame_sizes: vec![(8, 6)],
         drive: DriveModel::Differential(Differential { track: 0.3 }),
@@ -200,4 +203,157 @@ fn stop_handle_ends_the_run() {
     t.join().unwrap();
     assert!(report.elapsed_s < 2.0);
     assert_eq!(drive.0.lock().unwrap().last(), Some(&DriveCommand::Stop));
+}
+
+/// A robot with two missions: each drives for `ticks` ticks and completes; the second
+/// ("docking") also reads sensor 0 and commands actuator 0 with the sum of its values.
+struct TwoMissions {
+    mission: Option<Mission>,
+    ticks: u32,
+    started: Vec<&'static str>,
+    sums: Arc<Mutex<Vec<f64>>>,
+}
+
+impl Behavior for TwoMissions {
+    fn name(&self) -> &str {
+        "two_missions"
+    }
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+        let m = self.mission?;
+        self.ticks += 1;
+        let mut out = MotorOutput::twist(0.1, 0.0);
+        if let (Mission::Docking { .. }, Some(s)) = (m, inputs.sensor(0)) {
+            let sum: f64 = s.values.iter().sum();
+            self.sums.lock().unwrap().push(sum);
+            out.aux.actuators[0] = Some(sum);
+        }
+        let fb = Feedback::new(m.name(), inputs.now);
+        Some(if self.ticks >= 5 {
+            self.mission = None;
+            Step::done(Outcome::Completed, out, fb)
+        } else {
+            Step::running(out, fb)
+        })
+    }
+}
+
+impl Agent for TwoMissions {
+    fn begin(&mut self, mission: &Mission) -> Result<(), MissionError> {
+        if self.started.len() >= 2 {
+            return Err(MissionError::Unavailable {
+                robot: "two_missions".into(),
+                mission: mission.name(),
+                why: "only two missions a day".into(),
+            });
+        }
+        self.started.push(mission.name());
+        self.mission = Some(*mission);
+        self.ticks = 0;
+        Ok(())
+    }
+}
+
+/// Reads three ones.
+struct Ones;
+impl Sensor for Ones {
+    fn read(&mut self, values: &mut Vec<f64>) -> Result<(), HardwareError> {
+        values.extend([1.0, 1.0, 1.0]);
+        Ok(())
+    }
+}
+
+#[derive(Clone, Default)]
+struct LogActuator(Arc<Mutex<Vec<f64>>>);
+impl Actuator for LogActuator {
+    fn apply(&mut self, value: f64) -> Result<(), HardwareError> {
+        self.0.lock().unwrap().push(value);
+        Ok(())
+    }
+}
+
+#[test]
+fn missions_run_one_after_the_other_and_custom_devices_reach_the_behavior() {
+    let cam = GappyCamera {
+        start: None,
+        fps: 100.0,
+        gap: (10.0, 10.0),
+        count: 0,
+    };
+    let drive = LogDrive::default();
+    let actuator = LogActuator::default();
+    let mut robot = Robot::new(vec![Box::new(cam)], Box::new(drive.clone()));
+    robot.sensors.push(Box::new(Ones));
+    robot.actuators.push(Box::new(actuator.clone()));
+    let sums = Arc::new(Mutex::new(Vec::new()));
+    let agent = TwoMissions {
+        mission: None,
+        ticks: 0,
+        started: Vec::new(),
+        sums: sums.clone(),
+    };
+    let mut config = loop_config();
+    config.staleness.sensors = vec![Some(0.25)];
+    let mut lp = ReactiveLoop::new(Box::new(agent), config);
+    let cfg = RuntimeConfig {
+        max_duration: Some(Duration::from_secs(5)),
+        sensor_rate_hz: 100.0,
+    };
+    let missions = [Mission::Departure, Mission::docking(), Mission::docking()];
+    let report = run_missions(&mut robot, &mut lp, &missions, &cfg, &StopHandle::new());
+    let kinds: Vec<String> = report
+        .events
+        .iter()
+        .filter(|e| !matches!(e, RuntimeEvent::SafeStop { .. } | RuntimeEvent::Resumed { .. }))
+        .map(|e| e.to_string().split("  ").last().unwrap_or_default().to_string())
+        .collect();
+    assert_eq!(
+        kinds,
+        [
+            "departure started",
+            "finished: Completed",
+            "docking started",
+            "finished: Completed",
+            "refused: `two_missions` cannot start a docking: only two missions a day",
+        ],
+        "{:#?}",
+        report.events
+    );
+    assert_eq!(lp.root().started, ["departure", "docking"]);
+    // The sensor's readings reached the docking mission, and its commands the actuator.
+    let sums = sums.lock().unwrap().clone();
+    assert!(!sums.is_empty() && sums.iter().all(|&s| s == 3.0), "{sums:?}");
+    let applied = actuator.0.lock().unwrap().clone();
+    assert!(!applied.is_empty() && applied.iter().all(|&v| v == 3.0), "{applied:?}");
+}
+
+#[test]
+fn a_mission_the_robot_refuses_runs_nothing() {
+    let mut robot = Robot::new(
+        vec![Box::new(GappyCamera {
+            start: None,
+            fps: 100.0,
+            gap: (10.0, 10.0),
+            count: 0,
+        })],
+        Box::new(LogDrive::default()),
+    );
+    let agent = TwoMissions {
+        mission: None,
+        ticks: 0,
+        started: vec!["a", "b"],
+        sums: Arc::default(),
+    };
+    let mut lp = ReactiveLoop::new(Box::new(agent), loop_config());
+    let report = run_missions(
+        &mut robot,
+        &mut lp,
+        &[Mission::Departure],
+        &RuntimeConfig::default(),
+        &StopHandle::new(),
+    );
+    assert_eq!(report.ticks, 0);
+    assert!(
+        matches!(report.events[..], [RuntimeEvent::MissionRefused { .. }]),
+        "{report:?}"
+    );
 }

@@ -8,6 +8,7 @@
 
 pub mod blackboard;
 pub mod decision;
+pub mod lockstep;
 pub mod priority;
 pub mod reactive_loop;
 pub mod runtime;
@@ -17,6 +18,7 @@ pub mod vector_sum;
 
 pub use blackboard::Blackboard;
 pub use decision::{Candidate, Decision, Strategy};
+pub use lockstep::Lockstep;
 pub use priority::Priority;
 pub use reactive_loop::{
     InputKind, LoopConfig, LoopCore, LoopStatus, ReactiveLoop, Staleness, StopReason, TickOutput, safe_stop_command,

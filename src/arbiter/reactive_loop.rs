@@ -24,6 +24,8 @@ pub enum InputKind {
     Odometry,
     /// Tether sensor.
     Tether,
+    /// The `[[sensors]]` entry with this index (profile order).
+    Sensor(usize),
     /// The loop clock itself.
     Clock,
 }
@@ -34,6 +36,7 @@ impl fmt::Display for InputKind {
             InputKind::Camera(i) => write!(f, "camera {i}"),
             InputKind::Odometry => f.write_str("odometry"),
             InputKind::Tether => f.write_str("tether"),
+            InputKind::Sensor(i) => write!(f, "sensor {i}"),
             InputKind::Clock => f.write_str("clock"),
         }
     }
@@ -102,7 +105,7 @@ impl fmt::Display for StopReason {
 }
 
 /// Staleness limits (s) of the required inputs; `None` means the input is optional.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Staleness {
     /// Limit for every camera.
     pub camera: Option<f64>,
@@ -110,6 +113,8 @@ pub struct Staleness {
     pub odometry: Option<f64>,
     /// Limit for the tether sensor.
     pub tether: Option<f64>,
+    /// Limit per `[[sensors]]` entry (profile order).
+    pub sensors: Vec<Option<f64>>,
 }
 
 /// Static configuration of a loop (built from a profile by
@@ -362,6 +367,23 @@ impl LoopCore {
                 inputs.tether.map(|t| t.stamp),
             ),
         ];
+        for (i, limit) in self.config.staleness.sensors.iter().enumerate() {
+            let input = InputKind::Sensor(i);
+            match (inputs.sensor(i), limit) {
+                (Some(s), _) if !(s.stamp.is_finite() && s.values.iter().all(|x| x.is_finite())) => {
+                    return Some(StopReason::NonFinite { input });
+                }
+                (None, Some(_)) => return Some(StopReason::Missing { input }),
+                (Some(s), Some(limit)) if !is_fresh(now - s.stamp, *limit) => {
+                    return Some(StopReason::Stale {
+                        input,
+                        age_s: now - s.stamp,
+                        limit_s: *limit,
+                    });
+                }
+                _ => {}
+            }
+        }
         for (input, limit, stamp) in checks {
             if let Some(limit) = limit {
                 match stamp {

@@ -2,19 +2,20 @@
 //!
 //! One thread per camera captures into pooled buffers and hands frames to the loop over a
 //! one-slot crossbeam channel where the newest frame replaces an unread older one
-//! (latest-frame-wins). One sensor thread polls the encoders (integrated into odometry with
-//! the profile's kinematics) and the dock switch. One actuator thread applies commands and
-//! also reads the tether reel, which is one device for both. The calling thread runs the loop at the profile's fixed rate, counting
+//! (latest-frame-wins). One sensor thread polls the odometer (or the encoders, integrated
+//! into odometry with the profile's kinematics), the dock switch and the `[[sensors]]`.
+//! One actuator thread applies commands and also reads the tether reel, which is one
+//! device for both. [`run_missions`] starts a robot's missions one after the other. The calling thread runs the loop at the profile's fixed rate, counting
 //! overruns (ticks that started late). Stamps come from one monotonic clock started with
 //! the run, so `Inputs::now − stamp` is a true age and the staleness check works.
 
+use super::lockstep::OdometrySource;
 use super::reactive_loop::{LoopStatus, ReactiveLoop, StopReason, TickOutput};
-use crate::geometry::Pose2;
-use crate::kinematics::Odometry;
 use crate::perception::RgbImage;
-use crate::robot::{HardwareError, Robot, WheelTravel};
+use crate::robot::{HardwareError, Robot};
 use crate::schemas::{
-    Behavior, CameraInput, CameraInputs, Inputs, MotorOutput, OdometryReading, Outcome, Stamped, TetherReading,
+    Agent, Behavior, CameraInput, CameraInputs, Inputs, Mission, MissionError, MotorOutput, OdometryReading, Outcome,
+    SensorInput, SensorInputs, Stamped, TetherReading,
 };
 use crossbeam::channel::{Receiver, Sender, TrySendError, bounded};
 use std::sync::Arc;
@@ -62,6 +63,22 @@ pub enum RuntimeEvent {
         /// How.
         outcome: Outcome,
     },
+    /// A mission started ([`run_missions`]).
+    MissionStarted {
+        /// Run time, s.
+        t: f64,
+        /// Which (`departure`, `docking`).
+        mission: &'static str,
+    },
+    /// The robot could not start a mission ([`run_missions`]); the run ends.
+    MissionRefused {
+        /// Run time, s.
+        t: f64,
+        /// Which.
+        mission: &'static str,
+        /// Why.
+        error: MissionError,
+    },
     /// A device reported a fault.
     HardwareError {
         /// Run time, s.
@@ -71,6 +88,35 @@ pub enum RuntimeEvent {
         /// The error.
         error: HardwareError,
     },
+}
+
+impl RuntimeEvent {
+    /// When it happened, run time in s.
+    pub fn time(&self) -> f64 {
+        match self {
+            RuntimeEvent::SafeStop { t, .. }
+            | RuntimeEvent::Resumed { t }
+            | RuntimeEvent::Finished { t, .. }
+            | RuntimeEvent::MissionStarted { t, .. }
+            | RuntimeEvent::MissionRefused { t, .. }
+            | RuntimeEvent::HardwareError { t, .. } => *t,
+        }
+    }
+}
+
+impl std::fmt::Display for RuntimeEvent {
+    /// `  12.30 s  safe stop: camera 0: last data 0.612 s old (limit 0.500 s)`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:7.2} s  ", self.time())?;
+        match self {
+            RuntimeEvent::SafeStop { reason, .. } => write!(f, "safe stop: {reason}"),
+            RuntimeEvent::Resumed { .. } => f.write_str("resumed"),
+            RuntimeEvent::Finished { outcome, .. } => write!(f, "finished: {outcome:?}"),
+            RuntimeEvent::MissionStarted { mission, .. } => write!(f, "{mission} started"),
+            RuntimeEvent::MissionRefused { error, .. } => write!(f, "refused: {error}"),
+            RuntimeEvent::HardwareError { device, error, .. } => write!(f, "{device}: {error}"),
+        }
+    }
 }
 
 /// Summary of a run.
@@ -143,6 +189,73 @@ pub fn run<B: Behavior + ?Sized>(
     config: &RuntimeConfig,
     stop: &StopHandle,
 ) -> RuntimeReport {
+    run_with(robot, lp, config, stop, &mut |_, _| false)
+}
+
+/// Runs `missions` one after the other on the robot `lp` drives: each is started with
+/// [`ReactiveLoop::begin`] when the one before it succeeded (a departure that completed,
+/// say, before the docking). Returns when the last finishes, one fails, `stop` is raised
+/// or `config.max_duration` passes; [`RuntimeEvent::MissionStarted`] marks each start.
+/// A mission the robot cannot start ends the run with nothing commanded but a stop.
+pub fn run_missions<B: Agent + ?Sized>(
+    robot: &mut Robot,
+    lp: &mut ReactiveLoop<B>,
+    missions: &[Mission],
+    config: &RuntimeConfig,
+    stop: &StopHandle,
+) -> RuntimeReport {
+    let Some((first, rest)) = missions.split_first() else {
+        return RuntimeReport::default();
+    };
+    if let Err(e) = lp.begin(first) {
+        return RuntimeReport {
+            events: vec![RuntimeEvent::MissionRefused {
+                t: 0.0,
+                mission: first.name(),
+                error: e,
+            }],
+            ..RuntimeReport::default()
+        };
+    }
+    let mut events = vec![RuntimeEvent::MissionStarted {
+        t: 0.0,
+        mission: first.name(),
+    }];
+    let mut next = rest.iter();
+    let mut report = run_with(robot, lp, config, stop, &mut |lp, t| {
+        let Some(m) = next.next() else { return false };
+        match lp.begin(m) {
+            Ok(()) => {
+                events.push(RuntimeEvent::MissionStarted { t, mission: m.name() });
+                true
+            }
+            Err(e) => {
+                events.push(RuntimeEvent::MissionRefused {
+                    t,
+                    mission: m.name(),
+                    error: e,
+                });
+                false
+            }
+        }
+    });
+    events.append(&mut report.events);
+    // In time order; at one instant a mission's end comes before the next one's start.
+    let rank = |e: &RuntimeEvent| u8::from(!matches!(e, RuntimeEvent::Finished { .. }));
+    events.sort_by(|a, b| a.time().total_cmp(&b.time()).then(rank(a).cmp(&rank(b))));
+    report.events = events;
+    report
+}
+
+/// The loop, with `next_mission` asked after each successful finish whether to go on
+/// (it starts the next mission on the loop and returns true).
+fn run_with<B: Behavior + ?Sized>(
+    robot: &mut Robot,
+    lp: &mut ReactiveLoop<B>,
+    config: &RuntimeConfig,
+    stop: &StopHandle,
+    next_mission: &mut dyn FnMut(&mut ReactiveLoop<B>, f64) -> bool,
+) -> RuntimeReport {
     let t0 = Instant::now();
     let clock = move || t0.elapsed().as_secs_f64();
     let rate = lp.config().rate_hz.max(1e-3);
@@ -151,12 +264,14 @@ pub fn run<B: Behavior + ?Sized>(
     let (event_tx, event_rx) = crossbeam::channel::unbounded::<RuntimeEvent>();
     let done = StopHandle::new();
     let mut report = RuntimeReport::default();
+    let (cameras, sensing, mut actuation) = robot.split();
+    let n_sensors = sensing.sensors.len();
 
     std::thread::scope(|s| {
         // Cameras: latest-frame-wins with a small buffer pool.
         let mut frame_rx = Vec::new();
         let mut recycle_tx = Vec::new();
-        for cam in robot.cameras.iter_mut() {
+        for cam in cameras.iter_mut() {
             let (full_tx, full_rx) = bounded::<(f64, RgbImage)>(1);
             let (empty_tx, empty_rx) = bounded::<RgbImage>(3);
             let (w, h) = cam.resolution();
@@ -196,64 +311,52 @@ pub fn run<B: Behavior + ?Sized>(
             recycle_tx.push(empty_tx);
         }
 
-        // Slow sensors.
+        // Slow sensors: odometry, dock switch and the [[sensors]] (their value buffers
+        // come back through `values_back` to be reused).
         let (odo_tx, odo_rx) = bounded::<Stamped<OdometryReading>>(1);
         let (teth_tx, teth_rx) = bounded::<Stamped<TetherReading>>(1);
         let (dock_tx, dock_rx) = bounded::<Stamped<bool>>(1);
+        let (values_tx, values_rx) = bounded::<(usize, f64, Vec<f64>)>(4 * n_sensors.max(1));
+        let (values_back_tx, values_back_rx) = bounded::<Vec<f64>>(4 * n_sensors.max(1));
         {
-            let encoders = robot.encoders.as_mut();
-            let dock = robot.dock_sensor.as_mut();
+            let mut sensing = sensing;
             let done = done.clone();
             let events = event_tx.clone();
             let sensor_period = Duration::from_secs_f64(1.0 / config.sensor_rate_hz.max(1e-3));
             let (odo_rx2, dock_rx2) = (odo_rx.clone(), dock_rx.clone());
-            // The tether reel is shared with the actuator thread; it is read there.
             s.spawn(move || {
-                let mut encoders = encoders;
-                let mut dock = dock;
-                let mut odo = Odometry::new(drive_model, Pose2::default());
-                let mut last: Option<(f64, WheelTravel)> = None;
+                let mut odometry = OdometrySource::new(drive_model);
                 let mut next = Instant::now();
+                let fault = |t: f64, device: &'static str, error: HardwareError| {
+                    if error != HardwareError::NotReady {
+                        let _ = events.send(RuntimeEvent::HardwareError { t, device, error });
+                    }
+                };
                 while !done.is_stopped() {
                     let t = clock();
-                    if let Some(enc) = encoders.as_mut() {
-                        match enc.read() {
-                            Ok(w) => {
-                                if let Some((t_prev, prev)) = last
-                                    && t > t_prev
-                                {
-                                    odo.update_wheels(w.left - prev.left, w.right - prev.right, t - t_prev);
-                                }
-                                last = Some((t, w));
-                                let reading = OdometryReading {
-                                    pose: odo.pose(),
-                                    twist: odo.twist(),
-                                };
-                                send_latest(&odo_tx, &odo_rx2, Stamped::new(t, reading));
-                            }
-                            Err(HardwareError::NotReady) => {}
-                            Err(error) => {
-                                let _ = events.send(RuntimeEvent::HardwareError {
-                                    t,
-                                    device: "encoders",
-                                    error,
-                                });
-                            }
+                    match odometry.read(&mut sensing, t) {
+                        Some(Ok(reading)) => {
+                            send_latest(&odo_tx, &odo_rx2, Stamped::new(t, reading));
                         }
+                        Some(Err(e)) => fault(t, "odometry", e),
+                        None => {}
                     }
-                    if let Some(d) = dock.as_mut() {
+                    if let Some(d) = sensing.dock_sensor.as_mut() {
                         match d.in_contact() {
                             Ok(c) => {
                                 send_latest(&dock_tx, &dock_rx2, Stamped::new(t, c));
                             }
-                            Err(HardwareError::NotReady) => {}
-                            Err(error) => {
-                                let _ = events.send(RuntimeEvent::HardwareError {
-                                    t,
-                                    device: "dock_sensor",
-                                    error,
-                                });
+                            Err(e) => fault(t, "dock_sensor", e),
+                        }
+                    }
+                    for (i, sensor) in sensing.sensors.iter_mut().enumerate() {
+                        let mut buf = values_back_rx.try_recv().unwrap_or_default();
+                        buf.clear();
+                        match sensor.read(&mut buf) {
+                            Ok(()) => {
+                                let _ = values_tx.try_send((i, t, buf));
                             }
+                            Err(e) => fault(t, "sensor", e),
                         }
                     }
                     next += sensor_period;
@@ -265,48 +368,22 @@ pub fn run<B: Behavior + ?Sized>(
         // Actuators (and the tether reel's sensor, which shares the device).
         let (cmd_tx, cmd_rx) = bounded::<MotorOutput>(4);
         {
-            let drive = &mut robot.drive;
-            let mut tether = robot.tether.as_mut();
-            let mut arm = robot.arm.as_mut();
-            let mut lights = robot.lights.as_mut();
-            let mut guides = robot.guides.as_mut();
-            let mut posture = robot.posture.as_mut();
             let events = event_tx.clone();
             let teth_rx2 = teth_rx.clone();
             s.spawn(move || {
-                let report = |device: &'static str, r: Result<(), HardwareError>| {
-                    if let Err(error) = r {
-                        let _ = events.send(RuntimeEvent::HardwareError {
-                            t: clock(),
-                            device,
-                            error,
-                        });
-                    }
-                };
                 loop {
                     match cmd_rx.recv_timeout(Duration::from_millis(20)) {
-                        Ok(cmd) => {
-                            report("drive", drive.apply(&cmd.drive));
-                            if let (Some(t), Some(c)) = (tether.as_mut(), cmd.aux.tether) {
-                                report("tether", t.command(&c));
-                            }
-                            if let (Some(a), Some(p)) = (arm.as_mut(), cmd.aux.arm) {
-                                report("arm", a.set_position(p));
-                            }
-                            if let (Some(l), Some(on)) = (lights.as_mut(), cmd.aux.lights) {
-                                report("lights", l.set(on));
-                            }
-                            if let (Some(g), Some(gc)) = (guides.as_mut(), cmd.aux.guides) {
-                                report("guides", g.set(gc));
-                            }
-                            if let (Some(p), Some(pc)) = (posture.as_mut(), cmd.aux.posture) {
-                                report("posture", p.set(pc));
-                            }
-                        }
+                        Ok(cmd) => actuation.apply(&cmd, |device, error| {
+                            let _ = events.send(RuntimeEvent::HardwareError {
+                                t: clock(),
+                                device,
+                                error,
+                            });
+                        }),
                         Err(crossbeam::channel::RecvTimeoutError::Timeout) => {}
                         Err(crossbeam::channel::RecvTimeoutError::Disconnected) => break,
                     }
-                    if let Some(t) = tether.as_mut() {
+                    if let Some(t) = actuation.tether.as_mut() {
                         match t.read() {
                             Ok(r) => {
                                 send_latest(&teth_tx, &teth_rx2, Stamped::new(clock(), r));
@@ -327,6 +404,7 @@ pub fn run<B: Behavior + ?Sized>(
 
         // The loop itself, on this thread.
         let mut frames: Vec<Option<(f64, RgbImage)>> = (0..frame_rx.len()).map(|_| None).collect();
+        let mut sensor_values: Vec<Option<(f64, Vec<f64>)>> = (0..n_sensors).map(|_| None).collect();
         let mut odometry = None;
         let mut tether = None;
         let mut dock_contact = None;
@@ -341,6 +419,11 @@ pub fn run<B: Behavior + ?Sized>(
                     if let Some((_, old)) = slot.replace(f) {
                         let _ = recycle.try_send(old);
                     }
+                }
+            }
+            while let Ok((i, t, v)) = values_rx.try_recv() {
+                if let Some((_, old)) = sensor_values[i].replace((t, v)) {
+                    let _ = values_back_tx.try_send(old);
                 }
             }
             while let Ok(o) = odo_rx.try_recv() {
@@ -361,6 +444,10 @@ pub fn run<B: Behavior + ?Sized>(
                     })
                 })
                 .collect();
+            let sensors: SensorInputs<'_> = sensor_values
+                .iter()
+                .map(|v| v.as_ref().map(|(stamp, values)| SensorInput { stamp: *stamp, values }))
+                .collect();
             let now = clock();
             let inputs = Inputs {
                 now,
@@ -368,6 +455,7 @@ pub fn run<B: Behavior + ?Sized>(
                 odometry,
                 tether,
                 dock_contact,
+                sensors: &sensors,
             };
             let started = Instant::now();
             let TickOutput { command, status } = lp.tick(&inputs);
@@ -385,7 +473,9 @@ pub fn run<B: Behavior + ?Sized>(
                 LoopStatus::Finished { outcome } => {
                     report.events.push(RuntimeEvent::Finished { t: now, outcome });
                     report.outcome = Some(outcome);
-                    break;
+                    if !(outcome.is_success() && next_mission(lp, now)) {
+                        break;
+                    }
                 }
                 _ => {
                     if was_stopped {

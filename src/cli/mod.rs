@@ -6,3 +6,4 @@ pub mod check;
 pub mod detect;
 pub mod image_io;
 pub mod sim_cmds;
+pub mod timeline;

@@ -2,7 +2,7 @@
 
 use crate::behaviors::agent_for;
 use crate::sim::SimError;
-use crate::sim::campaign::{self, CampaignOptions, GroupSummary, RunRecord, Summary};
+use crate::sim::campaign::{self, CampaignOptions, GroupSummary, Recording, RunRecord, Summary};
 use crate::sim::paper::cell;
 use crate::sim::scenario::Scenario;
 use std::io::Write;
@@ -34,6 +34,11 @@ pub struct DockOptions {
     /// Output folder (trajectory CSV, frames).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Write the decision trace, one JSON object per tick: the mission, the loop status,
+    /// the command, and each arbiter that ran (active children, their proposals, the
+    /// winner, transitions with the events that fired them).
+    #[arg(long, value_name = "FILE.jsonl")]
+    pub trace: Option<PathBuf>,
     /// With --out, save every Nth camera frame (departure included), overriding the
     /// scenario's `[record] frames_every`; 0 saves none.
     #[arg(long, value_name = "N", requires = "out")]
@@ -106,7 +111,26 @@ pub fn dock(opts: &DockOptions, out: &mut dyn Write) -> Result<RunRecord, SimErr
     let every = opts
         .frames_every
         .unwrap_or(prepared.loaded.scenario.record.frames_every);
-    let rec = campaign::run_one(&prepared, &spec, &agent_for, frames_dir.as_deref().map(|d| (d, every)))?;
+    let mut trace = match &opts.trace {
+        Some(path) => Some(std::io::BufWriter::new(std::fs::File::create(path).map_err(
+            |source| SimError::Io {
+                path: path.display().to_string(),
+                source,
+            },
+        )?)),
+        None => None,
+    };
+    let mut recording = Recording {
+        frames: frames_dir.as_deref().map(|d| (d, every)),
+        trace: trace.as_mut().map(|w| w as &mut dyn Write),
+    };
+    let rec = campaign::run_one(&prepared, &spec, &agent_for, &mut recording)?;
+    if let (Some(w), Some(path)) = (trace.as_mut(), &opts.trace) {
+        w.flush().map_err(|source| SimError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+    }
     if let Some(d) = &opts.out {
         let p = d.join("trajectory.csv");
         campaign::write_track_csv(&p, &rec).map_err(|source| SimError::Io {

@@ -12,6 +12,7 @@
 
 pub mod behavior;
 pub mod camera;
+pub mod devices;
 pub mod drive;
 pub mod fiducial;
 pub mod geometry;
@@ -24,6 +25,7 @@ pub use behavior::{
     TwoArcGains,
 };
 pub use camera::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount};
+pub use devices::{ActuatorSpec, RANGE_KIND, RangeParams, SensorSpec};
 pub use drive::{DriveKind, DriveSpec};
 pub use fiducial::{CirclePlacement, CirclesSpec, FiducialSpec, MarkersSpec, NamedColor, PyramidSpec, TwoBlockSpec};
 pub use geometry::{BodySpec, DockSpec, SuccessSpec, TetherSpec};
@@ -72,6 +74,12 @@ pub struct Profile {
     /// Tether (absent for untethered robots).
     #[serde(default)]
     pub tether: Option<TetherSpec>,
+    /// Sensors beyond cameras, odometry, tether and dock switch (see [`devices`]).
+    #[serde(default)]
+    pub sensors: Vec<SensorSpec>,
+    /// Actuators beyond drive, tether, arm, lights, guides and posture (see [`devices`]).
+    #[serde(default)]
+    pub actuators: Vec<ActuatorSpec>,
     /// Behavior selection and gains.
     pub behavior: BehaviorSpec,
     /// Loop timing.
@@ -107,6 +115,7 @@ impl Validate for Profile {
         if let Some(t) = &self.tether {
             geometry::validate_tether(t, v);
         }
+        devices::validate_devices(&self.sensors, &self.actuators, v);
         behavior::validate_behavior(&self.behavior, v);
         behavior::validate_loop(&self.loop_, v);
         geometry::validate_success(&self.success, v);
@@ -171,6 +180,7 @@ impl Profile {
                 camera: self.loop_.camera_stale_s,
                 odometry: self.loop_.odometry_stale_s,
                 tether: self.loop_.tether_stale_s,
+                sensors: self.sensors.iter().map(|s| s.stale_s).collect(),
             },
             frame_sizes: self.cameras.iter().map(|c| (c.width_px, c.height_px)).collect(),
             drive: self.drive.model(),

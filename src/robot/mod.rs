@@ -1,17 +1,23 @@
 //! The hardware interface: the traits you implement to run marsupial's behaviors on a
-//! real robot (the simulator implements the same traits).
+//! real robot. The simulator implements the same traits (`sim::robot`), and its campaigns
+//! drive the simulated robot through them.
 //!
 //! Implement [`Camera`] and [`Drive`] at least; the rest are optional and only needed by
-//! behaviors that use them. Put the parts in a [`Robot`] and hand it to
-//! [`crate::arbiter::runtime::run`]. `examples/custom_robot.rs` is a complete, runnable
-//! starting point.
+//! behaviors that use them. Odometry comes either from [`WheelEncoders`] (the runtime
+//! integrates them with the profile's kinematics) or from an [`Odometer`] (a base
+//! controller that integrates its own, as ROS's `/odom`). Devices the crate has no field
+//! for are [`Sensor`]s and [`Actuator`]s declared by kind in the profile's `[[sensors]]`
+//! and `[[actuators]]` ([`crate::profile::devices`]). Put the parts in a [`Robot`] and
+//! hand it to [`crate::arbiter::runtime::run`] (threads, wall clock) or step it with
+//! [`crate::arbiter::lockstep::Lockstep`] (one thread, your clock).
+//! `examples/custom_robot.rs` is a complete, runnable starting point.
 //!
 //! Every method returns quickly: a camera's `capture` blocks for at most about one frame
 //! period and returns [`HardwareError::NotReady`] when no new frame came, so the runtime
 //! can shut down promptly.
 
 use crate::perception::RgbImage;
-use crate::schemas::{DriveCommand, Guides, Posture, TetherCommand, TetherReading};
+use crate::schemas::{DriveCommand, Guides, MotorOutput, OdometryReading, Posture, TetherCommand, TetherReading};
 use thiserror::Error;
 
 /// A hardware fault or a "nothing new yet".
@@ -75,6 +81,36 @@ pub trait WheelEncoders: Send {
     /// # Errors
     /// On an encoder fault.
     fn read(&mut self) -> Result<WheelTravel, HardwareError>;
+}
+
+/// A base that integrates its own odometry (a motor controller's `/odom`).
+pub trait Odometer: Send {
+    /// Reads the current estimate (pose in the odometry frame, body twist).
+    ///
+    /// # Errors
+    /// On a fault.
+    fn read(&mut self) -> Result<OdometryReading, HardwareError>;
+}
+
+/// A sensor declared in the profile's `[[sensors]]` (a range finder, an IMU...).
+pub trait Sensor: Send {
+    /// Writes its latest reading into `values` (cleared before the call); what the values
+    /// mean is the sensor's kind's business.
+    ///
+    /// # Errors
+    /// [`HardwareError::NotReady`] when nothing new came; a fault otherwise.
+    fn read(&mut self, values: &mut Vec<f64>) -> Result<(), HardwareError>;
+}
+
+/// An actuator declared in the profile's `[[actuators]]` (a gripper, a beacon...),
+/// commanded by one number per tick
+/// ([`Auxiliary::actuators`](crate::schemas::Auxiliary::actuators)).
+pub trait Actuator: Send {
+    /// Applies a command until the next one.
+    ///
+    /// # Errors
+    /// On a fault.
+    fn apply(&mut self, value: f64) -> Result<(), HardwareError>;
 }
 
 /// A tether reel.
@@ -142,8 +178,10 @@ pub struct Robot {
     pub cameras: Vec<Box<dyn Camera>>,
     /// The base.
     pub drive: Box<dyn Drive>,
-    /// Wheel encoders.
+    /// Wheel encoders (integrated into odometry when there is no [`Odometer`]).
     pub encoders: Option<Box<dyn WheelEncoders>>,
+    /// The base's own odometry (preferred over the encoders when both are given).
+    pub odometer: Option<Box<dyn Odometer>>,
     /// Tether reel.
     pub tether: Option<Box<dyn TetherReel>>,
     /// Arm.
@@ -156,6 +194,77 @@ pub struct Robot {
     pub posture: Option<Box<dyn BodyPosture>>,
     /// Dock contact sensor.
     pub dock_sensor: Option<Box<dyn DockSensor>>,
+    /// The profile's `[[sensors]]`, in order.
+    pub sensors: Vec<Box<dyn Sensor>>,
+    /// The profile's `[[actuators]]`, in order.
+    pub actuators: Vec<Box<dyn Actuator>>,
+}
+
+/// The robot's sensing side, borrowed apart from its actuation (the threaded runtime
+/// polls it on its own thread).
+pub struct Sensing<'a> {
+    /// Wheel encoders.
+    pub encoders: Option<&'a mut Box<dyn WheelEncoders>>,
+    /// The base's own odometry.
+    pub odometer: Option<&'a mut Box<dyn Odometer>>,
+    /// Dock contact sensor.
+    pub dock_sensor: Option<&'a mut Box<dyn DockSensor>>,
+    /// `[[sensors]]`.
+    pub sensors: &'a mut [Box<dyn Sensor>],
+}
+
+/// The robot's actuation side (and the tether reel, which is one device for reading and
+/// commanding).
+pub struct Actuation<'a> {
+    /// The base.
+    pub drive: &'a mut Box<dyn Drive>,
+    /// Tether reel.
+    pub tether: Option<&'a mut Box<dyn TetherReel>>,
+    /// Arm.
+    pub arm: Option<&'a mut Box<dyn Arm>>,
+    /// Lights.
+    pub lights: Option<&'a mut Box<dyn Lights>>,
+    /// Dock guides.
+    pub guides: Option<&'a mut Box<dyn DockGuides>>,
+    /// Posture actuator.
+    pub posture: Option<&'a mut Box<dyn BodyPosture>>,
+    /// `[[actuators]]`.
+    pub actuators: &'a mut [Box<dyn Actuator>],
+}
+
+impl Actuation<'_> {
+    /// Sends `command` to every device it has an opinion for (the drive always; an
+    /// auxiliary only when the command sets it, so `None` leaves the device as it is).
+    /// `report` hears each device that failed, by name.
+    pub fn apply(&mut self, command: &MotorOutput, mut report: impl FnMut(&'static str, HardwareError)) {
+        let mut check = |device: &'static str, r: Result<(), HardwareError>| {
+            if let Err(e) = r {
+                report(device, e);
+            }
+        };
+        check("drive", self.drive.apply(&command.drive));
+        let aux = &command.aux;
+        if let (Some(t), Some(c)) = (self.tether.as_mut(), aux.tether) {
+            check("tether", t.command(&c));
+        }
+        if let (Some(a), Some(p)) = (self.arm.as_mut(), aux.arm) {
+            check("arm", a.set_position(p));
+        }
+        if let (Some(l), Some(on)) = (self.lights.as_mut(), aux.lights) {
+            check("lights", l.set(on));
+        }
+        if let (Some(g), Some(gc)) = (self.guides.as_mut(), aux.guides) {
+            check("guides", g.set(gc));
+        }
+        if let (Some(p), Some(pc)) = (self.posture.as_mut(), aux.posture) {
+            check("posture", p.set(pc));
+        }
+        for (a, v) in self.actuators.iter_mut().zip(aux.actuators) {
+            if let Some(v) = v {
+                check("actuator", a.apply(v));
+            }
+        }
+    }
 }
 
 impl Robot {
@@ -165,12 +274,37 @@ impl Robot {
             cameras,
             drive,
             encoders: None,
+            odometer: None,
             tether: None,
             arm: None,
             lights: None,
             guides: None,
             posture: None,
             dock_sensor: None,
+            sensors: Vec::new(),
+            actuators: Vec::new(),
         }
+    }
+
+    /// Borrows the cameras, the sensing side and the actuation side apart.
+    pub fn split(&mut self) -> (&mut [Box<dyn Camera>], Sensing<'_>, Actuation<'_>) {
+        (
+            &mut self.cameras,
+            Sensing {
+                encoders: self.encoders.as_mut(),
+                odometer: self.odometer.as_mut(),
+                dock_sensor: self.dock_sensor.as_mut(),
+                sensors: &mut self.sensors,
+            },
+            Actuation {
+                drive: &mut self.drive,
+                tether: self.tether.as_mut(),
+                arm: self.arm.as_mut(),
+                lights: self.lights.as_mut(),
+                guides: self.guides.as_mut(),
+                posture: self.posture.as_mut(),
+                actuators: &mut self.actuators,
+            },
+        )
     }
 }

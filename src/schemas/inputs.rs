@@ -19,6 +19,20 @@ pub struct CameraInput<'a> {
 /// (Axel's stereo pair is the most; `tests/no_alloc.rs`).
 pub type CameraInputs<'a> = smallvec::SmallVec<[Option<CameraInput<'a>>; 4]>;
 
+/// One reading of a `[[sensors]]` entry (see [`crate::profile::devices`]): what the
+/// values mean is the sensor's kind's business (a range finder: one distance per beam).
+#[derive(Debug, Clone, Copy)]
+pub struct SensorInput<'a> {
+    /// Capture time, seconds on the loop clock.
+    pub stamp: f64,
+    /// The values.
+    pub values: &'a [f64],
+}
+
+/// The `[[sensors]]` readings of one tick, inline for up to four sensors (building it
+/// allocates nothing for such robots).
+pub type SensorInputs<'a> = smallvec::SmallVec<[Option<SensorInput<'a>>; 4]>;
+
 /// An odometry estimate: pose in the odometry frame plus the current body twist.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct OdometryReading {
@@ -55,6 +69,8 @@ pub struct Inputs<'a> {
     pub tether: Option<Stamped<TetherReading>>,
     /// Latest dock contact switch (pressure plates) reading.
     pub dock_contact: Option<Stamped<bool>>,
+    /// Latest reading per `[[sensors]]` entry, in profile order (`None`: none yet).
+    pub sensors: &'a [Option<SensorInput<'a>>],
 }
 
 impl<'a> Inputs<'a> {
@@ -66,12 +82,18 @@ impl<'a> Inputs<'a> {
             odometry: None,
             tether: None,
             dock_contact: None,
+            sensors: &[],
         }
     }
 
     /// Camera `i`'s latest frame, if any.
     pub fn camera(&self, i: usize) -> Option<&CameraInput<'a>> {
         self.cameras.get(i).and_then(Option::as_ref)
+    }
+
+    /// Sensor `i`'s (profile `[[sensors]]` order) latest reading, if any.
+    pub fn sensor(&self, i: usize) -> Option<&SensorInput<'a>> {
+        self.sensors.get(i).and_then(Option::as_ref)
     }
 
     /// True when the dock contact switch reads closed.

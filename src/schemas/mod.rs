@@ -20,7 +20,7 @@ pub mod visual_servo;
 
 pub use behavior::{Behavior, FailureReason, Feedback, Outcome, Presence, SchemaBehavior, Status, Step};
 pub use goto_point::PointController;
-pub use inputs::{CameraInput, CameraInputs, Inputs, OdometryReading, TetherReading};
+pub use inputs::{CameraInput, CameraInputs, Inputs, OdometryReading, SensorInput, SensorInputs, TetherReading};
 pub use mission::{Agent, AgentStats, Mission, MissionError};
 pub use motor_output::{Auxiliary, DriveCommand, Guides, MotorOutput, Posture, TetherCommand};
 pub use percept::{Percept, Stamped};

@@ -63,6 +63,10 @@ impl DriveCommand {
     }
 }
 
+/// Most `[[actuators]]` a profile may declare: their commands travel in a fixed array,
+/// so a tick's output never allocates.
+pub const MAX_ACTUATORS: usize = 4;
+
 /// Command for a tether reel.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct TetherCommand {
@@ -97,15 +101,28 @@ pub enum Posture {
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Auxiliary {
     /// Tether reel command.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tether: Option<TetherCommand>,
     /// Arm position, radians (RAPOSA's front arm; positive raises).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub arm: Option<f64>,
     /// Lights on or off.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lights: Option<bool>,
     /// Dock guides.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub guides: Option<Guides>,
     /// Body posture.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub posture: Option<Posture>,
+    /// Commands for the profile's `[[actuators]]`, by index (a gripper's position, a
+    /// beacon's power...): what a value means is the actuator's kind's business.
+    #[serde(default, skip_serializing_if = "no_commands")]
+    pub actuators: [Option<f64>; MAX_ACTUATORS],
+}
+
+fn no_commands(a: &[Option<f64>; MAX_ACTUATORS]) -> bool {
+    a.iter().all(Option::is_none)
 }
 
 impl Auxiliary {
@@ -117,12 +134,15 @@ impl Auxiliary {
             lights: self.lights.or(other.lights),
             guides: self.guides.or(other.guides),
             posture: self.posture.or(other.posture),
+            actuators: std::array::from_fn(|i| self.actuators[i].or(other.actuators[i])),
         }
     }
 
     /// True when every number in the command is finite.
     pub fn is_finite(&self) -> bool {
-        self.tether.is_none_or(|t| t.reel_rate.is_finite()) && self.arm.is_none_or(f64::is_finite)
+        self.tether.is_none_or(|t| t.reel_rate.is_finite())
+            && self.arm.is_none_or(f64::is_finite)
+            && self.actuators.iter().all(|a| a.is_none_or(f64::is_finite))
     }
 }
 

@@ -8,17 +8,13 @@
 //! instant, same placement error and the same imprint, as in the paper's paired protocol.
 
 use super::SimError;
-use super::engine::{PhaseEnd, Sim};
-use super::lighting::LightingRun;
-use super::motion::Motion;
-use super::rng::Rng;
-use super::scenario::{Loaded, RunSpec, Scenario};
+pub use super::run::{Recording, run_one};
+use super::scenario::{Loaded, RunSpec};
 use super::world::{self, World};
 use crate::behaviors::BuildError;
-use crate::geometry::Pose2;
 use crate::perception::RgbImage;
 use crate::profile::Profile;
-use crate::schemas::{Agent, Behavior, Mission, Outcome};
+use crate::schemas::Agent;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -96,8 +92,8 @@ pub struct CampaignOptions {
 pub struct Prepared {
     /// Scenario and profile.
     pub loaded: Loaded,
-    /// The built world.
-    pub world: World,
+    /// The built world (shared by every run's simulation).
+    pub world: Arc<World>,
     /// Every run.
     pub runs: Vec<RunSpec>,
 }
@@ -131,178 +127,10 @@ pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
             p.theta.to_degrees()
         )));
     }
-    Ok(Prepared { loaded, world, runs })
-}
-
-/// Runs one phase of a run, saving every Nth frame as `DIR/{prefix}-{tick:05}-cam{i}.png`
-/// when `frames` is (DIR, N) with N > 0.
-fn run_recorded(
-    sim: &mut Sim<'_>,
-    behavior: &mut dyn Behavior,
-    max_s: f64,
-    frames: Option<(&Path, u32)>,
-    prefix: &str,
-) -> PhaseEnd {
-    match frames {
-        Some((dir, every)) if every > 0 => {
-            let mut hook = |n: u64, _t: f64, fr: &[RgbImage]| {
-                if n.is_multiple_of(every as u64) {
-                    for (i, f) in fr.iter().enumerate() {
-                        let _ = crate::cli::image_io::save_png(&dir.join(format!("{prefix}-{n:05}-cam{i}.png")), f);
-                    }
-                }
-            };
-            sim.run_phase(behavior, max_s, Some(&mut hook))
-        }
-        _ => sim.run_phase(behavior, max_s, None),
-    }
-}
-
-/// Runs one run of a prepared campaign. `frames` (folder, every N) records camera frames.
-///
-/// # Errors
-/// [`SimError::Unsupported`] when no agent can be built.
-pub fn run_one(
-    p: &Prepared,
-    spec: &RunSpec,
-    make_agent: &AgentFactory,
-    frames: Option<(&Path, u32)>,
-) -> Result<RunRecord, SimError> {
-    let sc: &Scenario = &p.loaded.scenario;
-    let mut profile = p.loaded.profile.clone();
-    profile.perception.mode = spec.segmentation;
-    let mut agent = make_agent(&profile).map_err(|e| SimError::Unsupported(e.to_string()))?;
-    let mut pair = Rng::new(spec.pair_seed);
-    let lighting = sc.lighting_named(&spec.lighting);
-    let run_light = LightingRun::new(lighting.clone(), &mut pair, sc.timeout_s + 120.0);
-    let sensor = sc.sensor_params(&lighting);
-    let motion = Motion::new(
-        profile.drive.model(),
-        profile.drive.limits(),
-        sc.slip(spec.terrain),
-        sc.motion.latency_s,
-        sc.motion.accel_mps2,
-        sc.motion.yaw_accel_dps2.to_radians(),
-    );
-    let mut sim = Sim::new(
-        &profile,
-        &p.world,
-        run_light.clone(),
-        sensor,
-        motion,
-        sc.dt_s,
-        spec.seed,
-    );
-    // Departure: undock and imprint (paired runs share it through `pair`).
-    let mut imprinted = None;
-    if sc.imprint.enabled && agent.begin(&Mission::Departure).is_ok() {
-        let dep_light = match &sc.imprint.lighting {
-            Some(name) => {
-                let l = sc.lighting_named(name);
-                (
-                    LightingRun::new(l.clone(), &mut Rng::new(spec.pair_seed ^ 0xD0), 120.0),
-                    sc.sensor_params(&l),
-                )
-            }
-            None => (run_light.clone(), sensor),
-        };
-        sim.set_lighting(dep_light.0, dep_light.1);
-        let inside = Pose2::new(-p.world.dock.depth + profile.body.length_m / 2.0, 0.0, 0.0);
-        let open = p.world.dock.open;
-        // An open dock (a target on the ground) is left from 1 cm outside the socket's
-        // mouth zone, where the dock judge would count the robot as docked again.
-        sim.place(
-            if open {
-                Pose2::new(
-                    profile.body.length_m / 2.0 + p.world.dock.mouth_reach(0.0) + 0.01,
-                    0.0,
-                    0.0,
-                )
-            } else {
-                inside
-            },
-            !open,
-        );
-        let end = run_recorded(&mut sim, agent.as_mut(), 90.0, frames, "depart");
-        imprinted = Some(matches!(end, PhaseEnd::Finished(Outcome::Completed)));
-        let mut light = run_light;
-        light.advance_session(sc.imprint.sleep_s);
-        sim.set_lighting(light, sensor);
-    }
-    // Placement with the proctor's error.
-    let s = &spec.start;
-    let jx = pair.normal() * sc.starts.position_jitter_m;
-    let jy = pair.normal() * sc.starts.position_jitter_m;
-    let jt = pair.normal() * sc.starts.heading_jitter_deg.to_radians();
-    // `prepare` refused nominal starts inside the body; the jitter may still push one in.
-    let start = super::dock::slid_clear(
-        &p.world.dock,
-        Pose2::new(s.pose.x + jx, s.pose.y + jy, s.pose.theta + jt),
-        profile.body.length_m,
-        profile.body.width_m,
-    );
-    sim.place(start, false);
-    let dock_hint = sc.ballistic.enabled.then(|| {
-        // Odometry restarts at the placed pose: the dock's origin seen from there, with
-        // the a-priori error (its own stream, so the other draws stay as they were).
-        let mut r = Rng::new(spec.seed ^ 0xBA11_1571C);
-        let exact = start.relative(&Pose2::default());
-        let b = &sc.ballistic;
-        Pose2::new(
-            exact.x + r.normal() * b.error_m,
-            exact.y + r.normal() * b.error_m,
-            exact.theta + r.normal() * b.heading_error_deg.to_radians(),
-        )
-    });
-    agent
-        .begin(&Mission::Docking { dock_hint })
-        .map_err(|e| SimError::Unsupported(e.to_string()))?;
-    let end = run_recorded(&mut sim, agent.as_mut(), sc.timeout_s, frames, "frame");
-    let success = sim.docked();
-    let outcome = match end {
-        PhaseEnd::Docked => "docked".to_string(),
-        PhaseEnd::Finished(Outcome::Docked) if success => "docked".to_string(),
-        PhaseEnd::Finished(Outcome::Docked | Outcome::Completed) => "false_dock".to_string(),
-        PhaseEnd::Finished(Outcome::Failed(r)) => r.as_str().to_string(),
-        PhaseEnd::Stuck { .. } => "stuck_contact".to_string(),
-        PhaseEnd::Timeout => "timeout".to_string(),
-    };
-    let time_s = sim.time();
-    let path_m = sim.path_m;
-    Ok(RunRecord {
-        index: spec.index,
-        start: s.label.clone(),
-        lighting: spec.lighting.clone(),
-        segmentation: spec.segmentation.as_str().into(),
-        terrain: spec.terrain.as_str().into(),
-        trial: spec.trial,
-        seed: spec.seed,
-        distance_m: s.distance,
-        angle_deg: s.angle_deg,
-        success,
-        outcome,
-        time_s,
-        path_m,
-        v_eff_cmps: if success && time_s > 0.0 {
-            s.distance / time_s * 100.0
-        } else {
-            0.0
-        },
-        commands_per_m: if path_m > 0.01 {
-            sim.drive_changes as f64 / path_m
-        } else {
-            0.0
-        },
-        entrance_lateral_m: sim.entrance.map(|e| e.0),
-        entrance_heading_deg: sim.entrance.map(|e| e.1.to_degrees()),
-        safe_stops: sim.safe_stops,
-        imprinted,
-        manoeuvres: agent.stats().manoeuvres,
-        track: sim
-            .track
-            .iter()
-            .map(|t| [(t[1] * 1000.0).round() as i32, (t[2] * 1000.0).round() as i32])
-            .collect(),
+    Ok(Prepared {
+        loaded,
+        world: Arc::new(world),
+        runs,
     })
 }
 
@@ -505,7 +333,11 @@ pub fn run_campaign(
                         let _ = std::fs::create_dir_all(d);
                     }
                     let every = p.loaded.scenario.record.frames_every;
-                    let rec = run_one(p, spec, make_agent, frames_dir.as_deref().map(|d| (d, every)));
+                    let mut rec_opts = Recording {
+                        frames: frames_dir.as_deref().map(|d| (d, every)),
+                        trace: None,
+                    };
+                    let rec = run_one(p, spec, make_agent, &mut rec_opts);
                     if let (Ok(r), Some(d)) = (&rec, &frames_dir) {
                         let _ = write_track_csv(&d.join("trajectory.csv"), r);
                     }

@@ -1,10 +1,11 @@
-//! One simulated docking run, stepped synchronously against the pure reactive loop.
-//!
-//! Each loop tick: render every camera at the current true pose under the lighting of
-//! this instant, hand the frames with odometry, tether and dock-switch readings to the
-//! loop, queue the resulting command on the motors, then advance the physics in small
-//! steps (motion with latency and slip, tether pull, contact and the docking judge). Time
-//! and randomness are the run's own: the same seed reproduces the run bit for bit.
+//! The simulated world of one run: the robot's true pose and motion, its cameras'
+//! renderers, the lighting, tether and dock contact. No behavior runs here: the robot is
+//! driven through the hardware traits ([`super::robot`]), stepped in lockstep with the
+//! reactive loop by the campaign. Each tick the cameras render at the current true pose
+//! under the lighting of this instant, the loop decides, the commands are queued on the
+//! motors, then [`Sim::advance`] moves the physics in small steps (motion with latency and
+//! slip, tether pull, contact and the docking judge). Time and randomness are the run's
+//! own: the same seed reproduces the run bit for bit.
 
 use super::camera::camera_pose;
 use super::dock::{Contact, judge};
@@ -14,16 +15,13 @@ use super::render::{Renderer, SensorParams};
 use super::rng::Rng;
 use super::tether::Tether;
 use super::world::World;
-use crate::arbiter::{LoopCore, LoopStatus};
 use crate::geometry::Pose2;
 use crate::kinematics::Odometry;
 use crate::perception::RgbImage;
 use crate::perception::camera_model::CameraModel;
 use crate::profile::Profile;
-use crate::schemas::{
-    Behavior, CameraInput, CameraInputs, DriveCommand, Inputs, OdometryReading, Outcome, Posture, Stamped,
-    TetherCommand,
-};
+use crate::schemas::{DriveCommand, OdometryReading, Outcome, Posture, TetherCommand, TetherReading};
+use std::sync::Arc;
 
 /// How a phase of a run ended.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -43,22 +41,23 @@ pub enum PhaseEnd {
     Timeout,
 }
 
-/// Per-frame observer (for recording frames).
-pub type FrameHook<'a> = dyn FnMut(u64, f64, &[RgbImage]) + 'a;
-
 /// A running simulation.
-pub struct Sim<'w> {
-    profile: &'w Profile,
-    world: &'w World,
+pub struct Sim {
+    profile: Arc<Profile>,
+    world: Arc<World>,
     renderers: Vec<Renderer>,
-    frames: Vec<RgbImage>,
     sensor: SensorParams,
     light: LightingRun,
+    /// This tick's lighting (filled when camera 0 renders; its lists keep their
+    /// allocation).
+    light_now: LightState,
     motion: Motion,
     pose: Pose2,
     odometry: Odometry,
     tether: Option<Tether>,
     posture: Posture,
+    /// The reel's last command.
+    reel: Option<TetherCommand>,
     inside: bool,
     docked: bool,
     rng: Rng,
@@ -75,16 +74,18 @@ pub struct Sim<'w> {
     /// True pose samples (t, x, y, θ) every `track_every` s.
     pub track: Vec<[f64; 4]>,
     track_every: f64,
+    /// When the next track sample is due, s.
+    next_track: f64,
     /// Ticks spent in safe stop.
     pub safe_stops: u64,
     encoder_ref: (f64, f64),
 }
 
-impl<'w> Sim<'w> {
+impl Sim {
     /// A simulation of `profile` in `world`.
     pub fn new(
-        profile: &'w Profile,
-        world: &'w World,
+        profile: Arc<Profile>,
+        world: Arc<World>,
         light: LightingRun,
         sensor: SensorParams,
         motion: Motion,
@@ -104,11 +105,6 @@ impl<'w> Sim<'w> {
                 )
             })
             .collect();
-        let frames = profile
-            .cameras
-            .iter()
-            .map(|c| RgbImage::new(c.width_px, c.height_px))
-            .collect();
         let tether = profile.tether.map(|t| {
             Tether::new(
                 (0.0, 0.0),
@@ -118,18 +114,20 @@ impl<'w> Sim<'w> {
                 profile.body.length_m / 2.0,
             )
         });
+        let drive_model = profile.drive.model();
         Self {
             profile,
             world,
             renderers,
-            frames,
             sensor,
             light,
+            light_now: LightState::uniform(0.0),
             motion,
             pose: Pose2::default(),
-            odometry: Odometry::new(profile.drive.model(), Pose2::default()),
+            odometry: Odometry::new(drive_model, Pose2::default()),
             tether,
             posture: Posture::Raised,
+            reel: None,
             inside: false,
             docked: false,
             rng: Rng::new(seed),
@@ -142,6 +140,7 @@ impl<'w> Sim<'w> {
             entrance: None,
             track: Vec::new(),
             track_every: 0.5,
+            next_track: 0.0,
             safe_stops: 0,
             encoder_ref: (0.0, 0.0),
         }
@@ -186,6 +185,7 @@ impl<'w> Sim<'w> {
         self.drive_changes = 0;
         self.entrance = None;
         self.track.clear();
+        self.next_track = 0.0;
         self.safe_stops = 0;
         let last = self.motion.encoders();
         self.encoder_ref = (last.left, last.right);
@@ -227,142 +227,133 @@ impl<'w> Sim<'w> {
         });
     }
 
-    /// Runs `behavior` from the current state until it finishes, the robot docks or gets
-    /// stuck, or `max_s` of simulated time pass. `hook` sees every frame.
-    pub fn run_phase(
-        &mut self,
-        behavior: &mut dyn Behavior,
-        max_s: f64,
-        mut hook: Option<&mut FrameHook<'_>>,
-    ) -> PhaseEnd {
-        let mut core = LoopCore::new(self.profile.loop_config());
+    /// The profile simulated.
+    pub fn profile(&self) -> &Profile {
+        &self.profile
+    }
+
+    /// The world simulated.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// Frames rendered so far (ticks whose cameras all rendered).
+    pub fn frame_count(&self) -> u64 {
+        self.frame_count
+    }
+
+    /// Renders camera `i` at the true pose into `frame`. Cameras render in order each
+    /// tick: camera 0 computes the lighting of this instant, the last one counts the frame.
+    pub fn render(&mut self, i: usize, frame: &mut RgbImage) {
+        let Some(spec) = self.profile.cameras.get(i) else {
+            return;
+        };
+        if i == 0 {
+            self.light.fill(self.t, &mut self.light_now);
+            let mut light = std::mem::replace(&mut self.light_now, LightState::uniform(0.0));
+            self.robot_shadow(&mut light);
+            self.light_now = light;
+        }
+        let pose = camera_pose(&self.pose, &spec.mount);
+        frame.resize(spec.width_px, spec.height_px);
+        let seed = self.rng.next_u64() ^ self.frame_count;
+        self.renderers[i].render(&self.world.scene, &pose, &self.light_now, &self.sensor, seed, frame);
+        if i + 1 == self.profile.cameras.len() {
+            self.frame_count += 1;
+        }
+    }
+
+    /// The base's odometry (integrated at the physics rate from the simulated wheels, as
+    /// a motor controller would).
+    pub fn odometry(&self) -> OdometryReading {
+        OdometryReading {
+            pose: self.odometry.pose(),
+            twist: self.odometry.twist(),
+        }
+    }
+
+    /// The tether's length and tension (`None` without a tether).
+    pub fn tether_reading(&self) -> Option<TetherReading> {
+        self.tether.map(|t| t.reading())
+    }
+
+    /// Queues a drive command on the motors (counting command changes).
+    pub fn command_drive(&mut self, drive: DriveCommand) {
+        if drive != self.last_drive && !(drive.is_stop() && self.last_drive.is_stop()) {
+            self.drive_changes += 1;
+        }
+        self.last_drive = drive;
+        self.motion.command(self.t, drive);
+    }
+
+    /// Sets the reel's command (kept until the next).
+    pub fn command_reel(&mut self, reel: TetherCommand) {
+        self.reel = Some(reel);
+    }
+
+    /// Changes the body's posture.
+    pub fn set_posture(&mut self, posture: Posture) {
+        self.posture = posture;
+    }
+
+    /// Advances the physics by one loop tick (in substeps of the scenario's `dt`); `Some`
+    /// when the robot docked or caught the entrance edge.
+    pub fn advance(&mut self) -> Option<PhaseEnd> {
         let tick_dt = 1.0 / self.profile.loop_.rate_hz;
         let substeps = ((tick_dt / self.dt).round() as usize).max(1);
         let dt = tick_dt / substeps as f64;
-        let t_end = self.t + max_s;
         let (length, width) = (self.profile.body.length_m, self.profile.body.width_m);
-        let mut next_track = self.t;
-        // Refilled every tick: its shadow and flasher lists keep their allocation.
-        let mut light = LightState::uniform(0.0);
-        loop {
-            if self.t >= t_end - 1e-9 {
-                return PhaseEnd::Timeout;
+        for _ in 0..substeps {
+            let from = self.pose;
+            let mut to = self.motion.step(self.t, dt, &from, &mut self.rng);
+            if let Some(t) = &mut self.tether {
+                to = t.step(dt, &to, self.reel);
             }
-            // Sense.
-            self.light.fill(self.t, &mut light);
-            self.robot_shadow(&mut light);
-            for (i, spec) in self.profile.cameras.iter().enumerate() {
-                let pose = camera_pose(&self.pose, &spec.mount);
-                self.renderers[i].render(
-                    &self.world.scene,
-                    &pose,
-                    &light,
-                    &self.sensor,
-                    self.rng.next_u64() ^ self.frame_count,
-                    &mut self.frames[i],
-                );
-            }
-            self.frame_count += 1;
-            if let Some(h) = hook.as_mut() {
-                h(self.frame_count, self.t, &self.frames);
-            }
-            let cams: CameraInputs<'_> = self
-                .frames
-                .iter()
-                .map(|f| {
-                    Some(CameraInput {
-                        stamp: self.t,
-                        image: f.view(),
-                    })
-                })
-                .collect();
-            let inputs = Inputs {
-                now: self.t,
-                cameras: &cams,
-                odometry: Some(Stamped::new(
-                    self.t,
-                    OdometryReading {
-                        pose: self.odometry.pose(),
-                        twist: self.odometry.twist(),
-                    },
-                )),
-                tether: self.tether.map(|t| Stamped::new(self.t, t.reading())),
-                dock_contact: Some(Stamped::new(self.t, self.docked)),
-            };
-            // Decide.
-            let out = core.tick(behavior, &inputs);
-            drop(cams);
-            if matches!(out.status, LoopStatus::SafeStop { .. }) {
-                self.safe_stops += 1;
-            }
-            let drive = out.command.drive;
-            if drive != self.last_drive && !(drive.is_stop() && self.last_drive.is_stop()) {
-                self.drive_changes += 1;
-            }
-            self.last_drive = drive;
-            self.motion.command(self.t, drive);
-            if let Some(p) = out.command.aux.posture {
-                self.posture = p;
-            }
-            let reel: Option<TetherCommand> = out.command.aux.tether;
-            if let LoopStatus::Finished { outcome } = out.status {
-                return PhaseEnd::Finished(outcome);
-            }
-            // Act: physics.
-            for _ in 0..substeps {
-                let from = self.pose;
-                let mut to = self.motion.step(self.t, dt, &from, &mut self.rng);
-                if let Some(t) = &mut self.tether {
-                    to = t.step(dt, &to, reel);
+            let lowered = self.posture == Posture::Lowered;
+            match judge(&self.world.dock, self.inside, &from, &to, length, width, lowered) {
+                Contact::Free => {
+                    self.pose = to;
+                    self.inside = false;
                 }
-                let lowered = self.posture == Posture::Lowered;
-                match judge(&self.world.dock, self.inside, &from, &to, length, width, lowered) {
-                    Contact::Free => {
-                        self.pose = to;
-                        self.inside = false;
+                Contact::Blocked => {}
+                Contact::Inside => {
+                    if !self.inside {
+                        self.entrance =
+                            Some((to.to_world(-length / 2.0, 0.0).1, crate::geometry::wrap_angle(to.theta)));
                     }
-                    Contact::Blocked => {}
-                    Contact::Inside => {
-                        if !self.inside {
-                            self.entrance =
-                                Some((to.to_world(-length / 2.0, 0.0).1, crate::geometry::wrap_angle(to.theta)));
-                        }
-                        self.inside = true;
-                        // The pouch's walls guide the robot: it keeps its entrance offset
-                        // within the clearance and moves only along the axis.
-                        let (lat, _) = self.entrance.unwrap_or((0.0, 0.0));
-                        let clearance = (self.world.dock.entrance_half - width / 2.0).max(0.0);
-                        self.pose = Pose2::new(to.x, lat.clamp(-clearance, clearance), 0.0);
-                    }
-                    Contact::Docked => {
-                        self.pose = to;
-                        if self.world.dock.open && self.entrance.is_none() {
-                            self.entrance =
-                                Some((to.to_world(-length / 2.0, 0.0).1, crate::geometry::wrap_angle(to.theta)));
-                        }
-                        self.docked = true;
-                        self.motion.halt();
-                    }
-                    Contact::Stuck { lateral, heading } => {
-                        self.entrance = Some((lateral, heading));
-                        self.motion.halt();
-                        return PhaseEnd::Stuck { lateral, heading };
-                    }
+                    self.inside = true;
+                    // The pouch's walls guide the robot: it keeps its entrance offset
+                    // within the clearance and moves only along the axis.
+                    let (lat, _) = self.entrance.unwrap_or((0.0, 0.0));
+                    let clearance = (self.world.dock.entrance_half - width / 2.0).max(0.0);
+                    self.pose = Pose2::new(to.x, lat.clamp(-clearance, clearance), 0.0);
                 }
-                let enc = self.motion.encoders();
-                let (dl, dr) = (enc.left - self.encoder_ref.0, enc.right - self.encoder_ref.1);
-                self.encoder_ref = (enc.left, enc.right);
-                self.odometry.update_wheels(dl, dr, dt);
-                self.path_m += (self.pose.x - from.x).hypot(self.pose.y - from.y);
-                self.t += dt;
-                if self.t >= next_track {
-                    self.track.push([self.t, self.pose.x, self.pose.y, self.pose.theta]);
-                    next_track += self.track_every;
+                Contact::Docked => {
+                    self.pose = to;
+                    if self.world.dock.open && self.entrance.is_none() {
+                        self.entrance =
+                            Some((to.to_world(-length / 2.0, 0.0).1, crate::geometry::wrap_angle(to.theta)));
+                    }
+                    self.docked = true;
+                    self.motion.halt();
+                }
+                Contact::Stuck { lateral, heading } => {
+                    self.entrance = Some((lateral, heading));
+                    self.motion.halt();
+                    return Some(PhaseEnd::Stuck { lateral, heading });
                 }
             }
-            if self.docked {
-                return PhaseEnd::Docked;
+            let enc = self.motion.encoders();
+            let (dl, dr) = (enc.left - self.encoder_ref.0, enc.right - self.encoder_ref.1);
+            self.encoder_ref = (enc.left, enc.right);
+            self.odometry.update_wheels(dl, dr, dt);
+            self.path_m += (self.pose.x - from.x).hypot(self.pose.y - from.y);
+            self.t += dt;
+            if self.t >= self.next_track {
+                self.track.push([self.t, self.pose.x, self.pose.y, self.pose.theta]);
+                self.next_track += self.track_every;
             }
         }
+        self.docked.then_some(PhaseEnd::Docked)
     }
 }

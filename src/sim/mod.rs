@@ -41,5 +41,7 @@ pub mod engine;
 pub mod motion;
 pub mod paper;
 pub mod plot;
+pub mod robot;
+pub mod run;
 pub mod scenario;
 pub mod tether;

@@ -1,0 +1,203 @@
+//! `[[sensors]]` and `[[actuators]]`: devices beyond the ones every docking robot has.
+//!
+//! Cameras, odometry, the tether and the dock switch have their own tables and fields in
+//! [`Inputs`](crate::schemas::Inputs). Anything else (a range finder, an IMU, a gripper)
+//! is declared here by name and *kind*: the kind says what the readings mean and which
+//! `params` it takes. Kinds are open: the crate ships [`RANGE_KIND`], and a user's crate
+//! registers its own with
+//! [`Registry::register_sensor_kind`](crate::behaviors::registry::Registry::register_sensor_kind)
+//! (or `register_actuator_kind`), so a new device needs no change to marsupial. Readings
+//! reach the schemas as [`Inputs::sensor`](crate::schemas::Inputs::sensor), indexed in
+//! this list's order; commands leave through
+//! [`Auxiliary::actuators`](crate::schemas::Auxiliary::actuators), indexed in
+//! `[[actuators]]` order.
+//!
+//! ```toml
+//! [[sensors]]
+//! name = "bumper_ranges"
+//! kind = "range"
+//! stale_s = 0.3                  # required: safe stop when older (omit: optional)
+//! params = { beams = 9, fov_deg = 120.0, max_range_m = 1.5 }
+//! ```
+
+use crate::config::Validator;
+use serde::{Deserialize, Serialize};
+
+/// The range-finder kind the crate ships: a planar fan of beams, each reading the distance
+/// to the nearest obstacle along it (m), `max_range_m` when nothing is in range.
+pub const RANGE_KIND: &str = "range";
+
+pub use crate::schemas::motor_output::MAX_ACTUATORS;
+
+/// Most `[[sensors]]` a profile may declare without a tick allocating (more are allowed;
+/// the per-tick list then spills to the heap).
+pub const INLINE_SENSORS: usize = 4;
+
+/// One `[[sensors]]` entry.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorSpec {
+    /// Name, unique among the sensors (logs, errors).
+    pub name: String,
+    /// What it measures (a registered kind, e.g. [`RANGE_KIND`]).
+    pub kind: String,
+    /// Staleness limit, s: when set the sensor is required, and the loop stops the robot
+    /// safely while its last reading is older, missing or not finite.
+    #[serde(default)]
+    pub stale_s: Option<f64>,
+    /// The kind's own settings, checked by the kind when the behavior is built.
+    #[serde(default)]
+    pub params: toml::Table,
+}
+
+/// One `[[actuators]]` entry.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ActuatorSpec {
+    /// Name, unique among the actuators.
+    pub name: String,
+    /// What it does (a registered kind).
+    pub kind: String,
+    /// The kind's own settings.
+    #[serde(default)]
+    pub params: toml::Table,
+}
+
+/// The built-in range finder's `params`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RangeParams {
+    /// Number of beams, spread evenly over `fov_deg` (one beam points along `yaw_deg`).
+    pub beams: usize,
+    /// Fan width, degrees.
+    pub fov_deg: f64,
+    /// Longest range, m: beams that hit nothing read this.
+    pub max_range_m: f64,
+    /// Mount: forward of the body centre, m.
+    pub x_m: f64,
+    /// Mount: left of the body centre, m.
+    pub y_m: f64,
+    /// Mount: direction of the fan's centre beam, degrees CCW from the body's forward axis
+    /// (180: looks backwards).
+    pub yaw_deg: f64,
+}
+
+impl Default for RangeParams {
+    fn default() -> Self {
+        Self {
+            beams: 9,
+            fov_deg: 120.0,
+            max_range_m: 1.5,
+            x_m: 0.0,
+            y_m: 0.0,
+            yaw_deg: 0.0,
+        }
+    }
+}
+
+impl RangeParams {
+    /// Reads and checks a `[[sensors]]` entry's params.
+    ///
+    /// # Errors
+    /// A message naming the field.
+    pub fn from_table(params: &toml::Table) -> Result<Self, String> {
+        let p: Self = toml::Value::Table(params.clone())
+            .try_into()
+            .map_err(|e: toml::de::Error| format!("params: {}", e.message().trim()))?;
+        if p.beams == 0 || p.beams > 360 {
+            return Err(format!("params.beams: expected 1 to 360 beams, got {}", p.beams));
+        }
+        if !(p.fov_deg > 0.0 && p.fov_deg <= 360.0) {
+            return Err(format!("params.fov_deg: expected (0, 360], got {}", p.fov_deg));
+        }
+        if !(p.max_range_m > 0.0 && p.max_range_m.is_finite()) {
+            return Err(format!(
+                "params.max_range_m: expected a positive distance, got {}",
+                p.max_range_m
+            ));
+        }
+        Ok(p)
+    }
+
+    /// Direction of beam `i` in the body frame, rad.
+    pub fn beam_angle(&self, i: usize) -> f64 {
+        let yaw = self.yaw_deg.to_radians();
+        if self.beams == 1 {
+            return yaw;
+        }
+        let fov = self.fov_deg.to_radians();
+        // A full circle does not repeat its first beam at the end.
+        let span = if self.fov_deg >= 360.0 {
+            fov * (self.beams - 1) as f64 / self.beams as f64
+        } else {
+            fov
+        };
+        yaw - span / 2.0 + span * i as f64 / (self.beams - 1) as f64
+    }
+}
+
+/// Checks names (non-empty, unique), staleness limits and the actuator count.
+pub(super) fn validate_devices(sensors: &[SensorSpec], actuators: &[ActuatorSpec], v: &mut Validator<'_>) {
+    let mut seen: Vec<&str> = Vec::new();
+    for (i, s) in sensors.iter().enumerate() {
+        let at = format!("sensors[{i}]");
+        check_name(&s.name, &s.kind, &at, &mut seen, v);
+        if let Some(t) = s.stale_s {
+            v.positive(&format!("{at}.stale_s"), t);
+        }
+    }
+    seen.clear();
+    for (i, a) in actuators.iter().enumerate() {
+        check_name(&a.name, &a.kind, &format!("actuators[{i}]"), &mut seen, v);
+    }
+    v.require(actuators.len() <= MAX_ACTUATORS, "actuators", || {
+        format!(
+            "expected at most {MAX_ACTUATORS} [[actuators]], got {}",
+            actuators.len()
+        )
+    });
+}
+
+fn check_name<'a>(name: &'a str, kind: &str, at: &str, seen: &mut Vec<&'a str>, v: &mut Validator<'_>) {
+    v.require(!name.trim().is_empty(), &format!("{at}.name"), || {
+        "expected a non-empty name".into()
+    });
+    v.require(!kind.trim().is_empty(), &format!("{at}.kind"), || {
+        "expected a non-empty kind".into()
+    });
+    if seen.contains(&name) {
+        v.problem(&format!("{at}.name"), format!("`{name}` is declared twice"));
+    }
+    seen.push(name);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn beams_spread_over_the_fan_and_a_full_circle_does_not_repeat() {
+        let p = RangeParams {
+            beams: 3,
+            fov_deg: 90.0,
+            ..RangeParams::default()
+        };
+        let a: Vec<f64> = (0..3).map(|i| p.beam_angle(i).to_degrees()).collect();
+        assert!((a[0] + 45.0).abs() < 1e-9 && a[1].abs() < 1e-9 && (a[2] - 45.0).abs() < 1e-9);
+        let ring = RangeParams {
+            beams: 4,
+            fov_deg: 360.0,
+            ..RangeParams::default()
+        };
+        let last = ring.beam_angle(3).to_degrees() - ring.beam_angle(0).to_degrees();
+        assert!((last - 270.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn bad_range_params_name_the_field() {
+        let t: toml::Table = toml::from_str("beams = 0").unwrap();
+        assert!(RangeParams::from_table(&t).unwrap_err().contains("params.beams"));
+        let t: toml::Table = toml::from_str("max_range = 2.0").unwrap();
+        assert!(RangeParams::from_table(&t).unwrap_err().contains("max_range"));
+    }
+}

@@ -1,0 +1,279 @@
+//! The simulated robot behind the same hardware traits a real one implements.
+//!
+//! [`SimRobot`] shares one [`Sim`] between its devices: [`SimRobot::robot`] hands out a
+//! [`Robot`] whose cameras render the simulated world, whose drive queues commands on the
+//! simulated motors, whose odometer reads the wheels' integrated odometry, and so on. The
+//! campaign steps that `Robot` in lockstep with the reactive loop
+//! ([`Lockstep`](crate::arbiter::Lockstep)) and advances the physics between ticks; the
+//! threaded runtime can drive it too, with [`SimRobot::run_physics`] advancing the world
+//! on the wall clock (`examples/bujold_on_threads.rs`).
+//!
+//! Devices the profile declares in `[[sensors]]` are built by kind from a
+//! [`SimDevices`] table; a user's crate adds simulated devices for its own kinds.
+
+use super::engine::{PhaseEnd, Sim};
+use crate::perception::RgbImage;
+use crate::profile::SensorSpec;
+use crate::robot::{
+    BodyPosture, Camera, DockGuides, DockSensor, Drive, HardwareError, Lights, Odometer, Robot, Sensor, TetherReel,
+};
+use crate::schemas::{DriveCommand, Guides, OdometryReading, Posture, TetherCommand, TetherReading};
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+/// A simulation shared by the devices of one simulated robot.
+#[derive(Clone)]
+pub struct SimRobot(Arc<Mutex<Sim>>);
+
+/// Builds the simulated device for a `[[sensors]]` entry.
+pub type SensorFactory = dyn Fn(&SimRobot, &SensorSpec) -> Result<Box<dyn Sensor>, String> + Send + Sync;
+
+/// Simulated devices by kind (see the module docs).
+#[derive(Default)]
+pub struct SimDevices {
+    sensors: BTreeMap<String, Box<SensorFactory>>,
+}
+
+
+impl SimDevices {
+    /// Registers (or replaces) how the simulator simulates sensor kind `kind`.
+    pub fn register_sensor(
+        &mut self,
+        kind: impl Into<String>,
+        factory: impl Fn(&SimRobot, &SensorSpec) -> Result<Box<dyn Sensor>, String> + Send + Sync + 'static,
+    ) -> &mut Self {
+        self.sensors.insert(kind.into(), Box::new(factory));
+        self
+    }
+}
+
+fn lock(sim: &Arc<Mutex<Sim>>) -> MutexGuard<'_, Sim> {
+    // A device that panicked mid-update leaves the world as it was; go on with it.
+    sim.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+impl SimRobot {
+    /// Shares `sim` between devices.
+    pub fn new(sim: Sim) -> Self {
+        Self(Arc::new(Mutex::new(sim)))
+    }
+
+    /// Runs `f` on the simulation (the proctor's hand: placing the robot, reading the
+    /// ground truth).
+    pub fn with<R>(&self, f: impl FnOnce(&mut Sim) -> R) -> R {
+        f(&mut lock(&self.0))
+    }
+
+    /// Advances the physics by one loop tick (see [`Sim::advance`]).
+    pub fn advance(&self) -> Option<PhaseEnd> {
+        self.with(Sim::advance)
+    }
+
+    /// The robot's hardware: cameras, drive, odometer, dock switch, posture, lights,
+    /// guides, arm, the tether reel when the profile has a tether, and the profile's
+    /// `[[sensors]]` built by `devices`.
+    ///
+    /// # Errors
+    /// A message naming a sensor whose kind `devices` cannot simulate, or whose params it
+    /// refuses.
+    pub fn robot(&self, devices: &SimDevices) -> Result<Robot, String> {
+        self.build_robot(devices, false)
+    }
+
+    /// As [`SimRobot::robot`], with cameras that deliver a frame only once the simulated
+    /// clock has moved on since their last (for the threaded runtime with
+    /// [`SimRobot::run_physics`], where a camera thread would otherwise render the same
+    /// instant over and over).
+    ///
+    /// # Errors
+    /// As [`SimRobot::robot`].
+    pub fn realtime_robot(&self, devices: &SimDevices) -> Result<Robot, String> {
+        self.build_robot(devices, true)
+    }
+
+    fn build_robot(&self, devices: &SimDevices, paced: bool) -> Result<Robot, String> {
+        let (cameras, tether, specs) = self.with(|s| {
+            let p = s.profile();
+            (p.cameras.len(), p.tether.is_some(), p.sensors.clone())
+        });
+        let mut robot = Robot::new(
+            (0..cameras)
+                .map(|i| {
+                    Box::new(if paced {
+                        SimCamera::paced(self.clone(), i)
+                    } else {
+                        SimCamera::new(self.clone(), i)
+                    }) as Box<dyn Camera>
+                })
+                .collect(),
+            Box::new(SimDrive(self.clone())),
+        );
+        robot.odometer = Some(Box::new(SimOdometer(self.clone())));
+        robot.dock_sensor = Some(Box::new(SimDockSwitch(self.clone())));
+        robot.posture = Some(Box::new(SimPosture(self.clone())));
+        robot.lights = Some(Box::new(Switch));
+        robot.guides = Some(Box::new(Switch));
+        if tether {
+            robot.tether = Some(Box::new(SimReel(self.clone())));
+        }
+        for (i, spec) in specs.iter().enumerate() {
+            let factory = devices.sensors.get(&spec.kind).ok_or_else(|| {
+                let known: Vec<&str> = devices.sensors.keys().map(String::as_str).collect();
+                format!(
+                    "sensors[{i}] `{}`: the simulator cannot simulate kind `{}` (it simulates: {})",
+                    spec.name,
+                    spec.kind,
+                    known.join(", ")
+                )
+            })?;
+            robot
+                .sensors
+                .push(factory(self, spec).map_err(|e| format!("sensors[{i}] `{}`: {e}", spec.name))?);
+        }
+        Ok(robot)
+    }
+
+    /// Advances the physics on the wall clock, one loop tick per tick period, until
+    /// `until` says stop or the robot docks or catches the entrance edge (returned), so
+    /// the threaded runtime can drive the simulated robot in real time.
+    pub fn run_physics(&self, until: impl Fn() -> bool) -> Option<PhaseEnd> {
+        let period = Duration::from_secs_f64(self.with(|s| 1.0 / s.profile().loop_.rate_hz));
+        let mut next = Instant::now();
+        while !until() {
+            if let Some(end) = self.advance() {
+                return Some(end);
+            }
+            next += period;
+            if let Some(wait) = next.checked_duration_since(Instant::now()) {
+                std::thread::sleep(wait);
+            }
+        }
+        None
+    }
+}
+
+/// A simulated camera: renders the world at the robot's true pose.
+pub struct SimCamera {
+    sim: SimRobot,
+    index: usize,
+    /// With `paced`, the simulated time of the last frame: a capture waits for the clock
+    /// to move on (real time), as a real camera waits for its next exposure.
+    last: Option<f64>,
+    paced: bool,
+}
+
+impl SimCamera {
+    /// Camera `index` of the profile.
+    pub fn new(sim: SimRobot, index: usize) -> Self {
+        Self {
+            sim,
+            index,
+            last: None,
+            paced: false,
+        }
+    }
+
+    /// A camera that delivers a new frame only after the simulated clock has moved on (for
+    /// the threaded runtime with [`SimRobot::run_physics`]).
+    pub fn paced(sim: SimRobot, index: usize) -> Self {
+        Self {
+            paced: true,
+            ..Self::new(sim, index)
+        }
+    }
+}
+
+impl Camera for SimCamera {
+    fn resolution(&self) -> (usize, usize) {
+        self.sim.with(|s| {
+            s.profile()
+                .cameras
+                .get(self.index)
+                .map_or((0, 0), |c| (c.width_px, c.height_px))
+        })
+    }
+
+    fn capture(&mut self, frame: &mut RgbImage) -> Result<(), HardwareError> {
+        if self.paced {
+            let t = self.sim.with(|s| s.time());
+            if self.last.is_some_and(|last| t <= last) {
+                std::thread::sleep(Duration::from_millis(5));
+                return Err(HardwareError::NotReady);
+            }
+            self.last = Some(t);
+        }
+        let i = self.index;
+        self.sim.with(|s| s.render(i, frame));
+        Ok(())
+    }
+}
+
+/// The simulated motors.
+pub struct SimDrive(SimRobot);
+
+impl Drive for SimDrive {
+    fn apply(&mut self, command: &DriveCommand) -> Result<(), HardwareError> {
+        self.0.with(|s| s.command_drive(*command));
+        Ok(())
+    }
+}
+
+/// The simulated base's odometry (integrated from the simulated wheels at the physics
+/// rate, as a motor controller does).
+pub struct SimOdometer(SimRobot);
+
+impl Odometer for SimOdometer {
+    fn read(&mut self) -> Result<OdometryReading, HardwareError> {
+        Ok(self.0.with(|s| s.odometry()))
+    }
+}
+
+/// The pressure plates (or the open dock's contact).
+pub struct SimDockSwitch(SimRobot);
+
+impl DockSensor for SimDockSwitch {
+    fn in_contact(&mut self) -> Result<bool, HardwareError> {
+        Ok(self.0.with(|s| s.docked()))
+    }
+}
+
+/// Raising and lowering the body (the dock judge admits a lowered robot into the pouch).
+pub struct SimPosture(SimRobot);
+
+impl BodyPosture for SimPosture {
+    fn set(&mut self, posture: Posture) -> Result<(), HardwareError> {
+        self.0.with(|s| s.set_posture(posture));
+        Ok(())
+    }
+}
+
+/// The tether reel.
+pub struct SimReel(SimRobot);
+
+impl TetherReel for SimReel {
+    fn command(&mut self, command: &TetherCommand) -> Result<(), HardwareError> {
+        self.0.with(|s| s.command_reel(*command));
+        Ok(())
+    }
+
+    fn read(&mut self) -> Result<TetherReading, HardwareError> {
+        self.0.with(|s| s.tether_reading()).ok_or(HardwareError::NotReady)
+    }
+}
+
+/// Lights and guides: accepted, with no effect on the planar world (the simulator does
+/// not render the robot's own lights).
+pub struct Switch;
+
+impl Lights for Switch {
+    fn set(&mut self, _on: bool) -> Result<(), HardwareError> {
+        Ok(())
+    }
+}
+
+impl DockGuides for Switch {
+    fn set(&mut self, _guides: Guides) -> Result<(), HardwareError> {
+        Ok(())
+    }
+}

@@ -1,0 +1,327 @@
+//! One run of a campaign: the robot departs from the dock (imprinting on the way), the
+//! proctor places it at the run's start, and it docks.
+//!
+//! The robot is a [`SimRobot`] behind the hardware traits, stepped in lockstep with a
+//! [`ReactiveLoop`] over the profile's composed behavior ([`Lockstep`]): each tick its
+//! cameras render, the loop decides, the commands reach the simulated motors, then the
+//! physics advance. Both missions are started the way a real robot's are
+//! ([`ReactiveLoop::begin`]); only the proctor's placement between them is the
+//! simulator's.
+
+use super::SimError;
+use super::campaign::{AgentFactory, Prepared, RunRecord};
+use super::engine::{PhaseEnd, Sim};
+use super::lighting::LightingRun;
+use super::motion::Motion;
+use super::render::SensorParams;
+use super::rng::Rng;
+use super::robot::{SimDevices, SimRobot};
+use super::scenario::{RunSpec, Scenario};
+use crate::arbiter::{Lockstep, LoopStatus, NodeTrace, ReactiveLoop, TickOutput};
+use crate::geometry::Pose2;
+use crate::perception::RgbImage;
+use crate::robot::Robot;
+use crate::schemas::{Agent, Mission, Outcome};
+use serde::Serialize;
+use std::io::Write;
+use std::path::Path;
+use std::sync::Arc;
+
+/// What a run records besides its `runs.jsonl` line.
+#[derive(Default)]
+pub struct Recording<'a> {
+    /// Save every Nth camera frame as `DIR/{depart,frame}-{tick:05}-cam{i}.png` (N > 0).
+    pub frames: Option<(&'a Path, u32)>,
+    /// Write the decision trace here, one JSON object per tick ([`TraceLine`]).
+    pub trace: Option<&'a mut dyn Write>,
+}
+
+/// One line of a decision trace (`marsupial dock --trace`).
+#[derive(Debug, Clone, Serialize)]
+pub struct TraceLine<'a> {
+    /// The mission running: `departure` or `docking`.
+    pub mission: &'static str,
+    /// Loop time, s (each mission's clock starts at 0 when the proctor places the robot).
+    pub t: f64,
+    /// The loop's status: running (with the phase's feedback), safe stop, finished...
+    pub status: &'a LoopStatus,
+    /// The command sent to the robot.
+    pub command: &'a crate::schemas::MotorOutput,
+    /// Every arbiter that ran this tick, outermost first: active children, proposals,
+    /// winner, transitions and the events that fired them.
+    pub nodes: &'a [NodeTrace],
+}
+
+impl Recording<'_> {
+    /// A last trace line when the simulator, not the behavior, ended the mission: the
+    /// plates closed (`docked`), the robot caught the entrance (`stuck_contact`), or time
+    /// ran out (`timeout`).
+    fn end(&mut self, mission: &'static str, t: f64, end: &PhaseEnd) {
+        let Some(w) = self.trace.as_mut() else { return };
+        let what = match end {
+            PhaseEnd::Docked => "docked",
+            PhaseEnd::Stuck { .. } => "stuck_contact",
+            PhaseEnd::Timeout => "timeout",
+            PhaseEnd::Finished(_) => return,
+        };
+        let line = serde_json::json!({ "mission": mission, "t": t, "world": what });
+        let _ = writeln!(w, "{line}");
+    }
+
+    fn frame(&mut self, prefix: &str, n: u64, frames: &[RgbImage]) {
+        if let Some((dir, every)) = self.frames
+            && every > 0
+            && n.is_multiple_of(every as u64)
+        {
+            for (i, f) in frames.iter().enumerate() {
+                let path = dir.join(format!("{prefix}-{n:05}-cam{i}.png"));
+                if let Err(e) = crate::cli::image_io::save_png(&path, f) {
+                    tracing::warn!(target: "marsupial::sim", path = %path.display(), %e, "frame not saved");
+                }
+            }
+        }
+    }
+
+    fn tick(&mut self, mission: &'static str, t: f64, root: &dyn Agent, out: &TickOutput, nodes: &mut Vec<NodeTrace>) {
+        let Some(w) = self.trace.as_mut() else { return };
+        nodes.clear();
+        root.explain(nodes);
+        let line = TraceLine {
+            mission,
+            t,
+            status: &out.status,
+            command: &out.command,
+            nodes,
+        };
+        if let Ok(json) = serde_json::to_string(&line) {
+            let _ = writeln!(w, "{json}");
+        }
+    }
+}
+
+/// The simulated robot and the loop that drives it through one run.
+struct Rig {
+    sim: SimRobot,
+    robot: Robot,
+    lp: ReactiveLoop<dyn Agent>,
+    step: Lockstep,
+}
+
+impl Rig {
+    /// Runs the mission just begun until the behavior reports an outcome, the robot docks
+    /// or catches the entrance edge, or `max_s` of simulated time pass.
+    fn run(&mut self, mission: &'static str, max_s: f64, rec: &mut Recording<'_>) -> PhaseEnd {
+        let t_end = self.sim.with(|s| s.time()) + max_s;
+        let prefix = if mission == "departure" { "depart" } else { "frame" };
+        let mut nodes = Vec::new();
+        loop {
+            let now = self.sim.with(|s| s.time());
+            if now >= t_end - 1e-9 {
+                rec.end(mission, now, &PhaseEnd::Timeout);
+                return PhaseEnd::Timeout;
+            }
+            let out = self.step.tick(&mut self.robot, &mut self.lp, now);
+            for (t, device, e) in self.step.take_errors() {
+                tracing::warn!(target: "marsupial::sim", t, device, %e, "device fault");
+            }
+            rec.frame(prefix, self.sim.with(|s| s.frame_count()), self.step.frames());
+            rec.tick(mission, now, self.lp.root(), &out, &mut nodes);
+            match out.status {
+                LoopStatus::SafeStop { .. } => self.sim.with(|s| s.safe_stops += 1),
+                LoopStatus::Finished { outcome } => return PhaseEnd::Finished(outcome),
+                _ => {}
+            }
+            if let Some(end) = self.sim.advance() {
+                rec.end(mission, self.sim.with(|s| s.time()), &end);
+                return end;
+            }
+        }
+    }
+}
+
+/// The simulated world of run `spec`: its lighting (drawn from `pair`, the stream paired
+/// runs share), sensor, terrain and seed, with the run's profile (its segmentation mode).
+/// Returns the run's lighting and sensor too (the departure may run under others).
+fn simulation(p: &Prepared, spec: &RunSpec, pair: &mut Rng) -> (Sim, LightingRun, SensorParams) {
+    let sc: &Scenario = &p.loaded.scenario;
+    let mut profile = p.loaded.profile.clone();
+    profile.perception.mode = spec.segmentation;
+    let lighting = sc.lighting_named(&spec.lighting);
+    let run_light = LightingRun::new(lighting.clone(), pair, sc.timeout_s + 120.0);
+    let sensor = sc.sensor_params(&lighting);
+    let motion = Motion::new(
+        profile.drive.model(),
+        profile.drive.limits(),
+        sc.slip(spec.terrain),
+        sc.motion.latency_s,
+        sc.motion.accel_mps2,
+        sc.motion.yaw_accel_dps2.to_radians(),
+    );
+    let sim = Sim::new(
+        Arc::new(profile),
+        Arc::clone(&p.world),
+        run_light.clone(),
+        sensor,
+        motion,
+        sc.dt_s,
+        spec.seed,
+    );
+    (sim, run_light, sensor)
+}
+
+/// Puts the robot where a departure starts: in the dock, or, for an open dock (a target
+/// on the ground), 1 cm outside the socket's mouth zone, where the dock judge would count
+/// it as docked again.
+fn place_docked(s: &mut Sim) {
+    let dock = s.world().dock;
+    let length = s.profile().body.length_m;
+    let at = if dock.open {
+        Pose2::new(length / 2.0 + dock.mouth_reach(0.0) + 0.01, 0.0, 0.0)
+    } else {
+        Pose2::new(-dock.depth + length / 2.0, 0.0, 0.0)
+    };
+    s.place(at, !dock.open);
+}
+
+/// The simulated robot of run `spec` (its lighting, sensor, terrain and seed), docked and
+/// ready to depart: to drive it with the threaded runtime or your own loop.
+pub fn docked_robot(p: &Prepared, spec: &RunSpec) -> SimRobot {
+    let (mut sim, _, _) = simulation(p, spec, &mut Rng::new(spec.pair_seed));
+    place_docked(&mut sim);
+    SimRobot::new(sim)
+}
+
+/// Runs one run of a prepared campaign (see the module docs).
+///
+/// # Errors
+/// [`SimError::Unsupported`] when no agent can be built, the robot refuses to dock, or a
+/// `[[sensors]]` kind cannot be simulated.
+pub fn run_one(
+    p: &Prepared,
+    spec: &RunSpec,
+    make_agent: &AgentFactory,
+    rec: &mut Recording<'_>,
+) -> Result<RunRecord, SimError> {
+    let sc: &Scenario = &p.loaded.scenario;
+    let mut profile = p.loaded.profile.clone();
+    profile.perception.mode = spec.segmentation;
+    let agent = make_agent(&profile).map_err(|e| SimError::Unsupported(e.to_string()))?;
+    let mut pair = Rng::new(spec.pair_seed);
+    let (sim, run_light, sensor) = simulation(p, spec, &mut pair);
+    let (length, width) = (profile.body.length_m, profile.body.width_m);
+    let config = profile.loop_config();
+    let sim = SimRobot::new(sim);
+    let robot = sim.robot(&SimDevices::default()).map_err(SimError::Unsupported)?;
+    let mut rig = Rig {
+        step: Lockstep::new(&robot, &config),
+        lp: ReactiveLoop::new(agent, config),
+        sim,
+        robot,
+    };
+    let dock = p.world.dock;
+    // Departure: undock and imprint (paired runs share it through `pair`).
+    let mut imprinted = None;
+    if sc.imprint.enabled && rig.lp.begin(&Mission::Departure).is_ok() {
+        let (dep_light, dep_sensor) = match &sc.imprint.lighting {
+            Some(name) => {
+                let l = sc.lighting_named(name);
+                (
+                    LightingRun::new(l.clone(), &mut Rng::new(spec.pair_seed ^ 0xD0), 120.0),
+                    sc.sensor_params(&l),
+                )
+            }
+            None => (run_light.clone(), sensor),
+        };
+        rig.sim.with(|s| {
+            s.set_lighting(dep_light, dep_sensor);
+            place_docked(s);
+        });
+        let end = rig.run("departure", 90.0, rec);
+        imprinted = Some(matches!(end, PhaseEnd::Finished(Outcome::Completed)));
+        let mut light = run_light;
+        light.advance_session(sc.imprint.sleep_s);
+        rig.sim.with(|s| s.set_lighting(light, sensor));
+    }
+    // Placement with the proctor's error.
+    let s = &spec.start;
+    let jx = pair.normal() * sc.starts.position_jitter_m;
+    let jy = pair.normal() * sc.starts.position_jitter_m;
+    let jt = pair.normal() * sc.starts.heading_jitter_deg.to_radians();
+    // `prepare` refused nominal starts inside the body; the jitter may still push one in.
+    let start = super::dock::slid_clear(
+        &dock,
+        Pose2::new(s.pose.x + jx, s.pose.y + jy, s.pose.theta + jt),
+        length,
+        width,
+    );
+    rig.sim.with(|sim| sim.place(start, false));
+    let dock_hint = sc.ballistic.enabled.then(|| {
+        // Odometry restarts at the placed pose: the dock's origin seen from there, with
+        // the a-priori error (its own stream, so the other draws stay as they were).
+        let mut r = Rng::new(spec.seed ^ 0xBA11_1571C);
+        let exact = start.relative(&Pose2::default());
+        let b = &sc.ballistic;
+        Pose2::new(
+            exact.x + r.normal() * b.error_m,
+            exact.y + r.normal() * b.error_m,
+            exact.theta + r.normal() * b.heading_error_deg.to_radians(),
+        )
+    });
+    rig.lp
+        .begin(&Mission::Docking { dock_hint })
+        .map_err(|e| SimError::Unsupported(e.to_string()))?;
+    let end = rig.run("docking", sc.timeout_s, rec);
+    let manoeuvres = rig.lp.root().stats().manoeuvres;
+    Ok(rig.sim.with(|sim| record(spec, sim, end, imprinted, manoeuvres)))
+}
+
+/// The run's `runs.jsonl` line, from the simulator's ground truth.
+fn record(spec: &RunSpec, sim: &Sim, end: PhaseEnd, imprinted: Option<bool>, manoeuvres: u32) -> RunRecord {
+    let s = &spec.start;
+    let success = sim.docked();
+    let outcome = match end {
+        PhaseEnd::Docked => "docked".to_string(),
+        PhaseEnd::Finished(Outcome::Docked) if success => "docked".to_string(),
+        PhaseEnd::Finished(Outcome::Docked | Outcome::Completed) => "false_dock".to_string(),
+        PhaseEnd::Finished(Outcome::Failed(r)) => r.as_str().to_string(),
+        PhaseEnd::Stuck { .. } => "stuck_contact".to_string(),
+        PhaseEnd::Timeout => "timeout".to_string(),
+    };
+    let time_s = sim.time();
+    let path_m = sim.path_m;
+    RunRecord {
+        index: spec.index,
+        start: s.label.clone(),
+        lighting: spec.lighting.clone(),
+        segmentation: spec.segmentation.as_str().into(),
+        terrain: spec.terrain.as_str().into(),
+        trial: spec.trial,
+        seed: spec.seed,
+        distance_m: s.distance,
+        angle_deg: s.angle_deg,
+        success,
+        outcome,
+        time_s,
+        path_m,
+        v_eff_cmps: if success && time_s > 0.0 {
+            s.distance / time_s * 100.0
+        } else {
+            0.0
+        },
+        commands_per_m: if path_m > 0.01 {
+            sim.drive_changes as f64 / path_m
+        } else {
+            0.0
+        },
+        entrance_lateral_m: sim.entrance.map(|e| e.0),
+        entrance_heading_deg: sim.entrance.map(|e| e.1.to_degrees()),
+        safe_stops: sim.safe_stops,
+        imprinted,
+        manoeuvres,
+        track: sim
+            .track
+            .iter()
+            .map(|t| [(t[1] * 1000.0).round() as i32, (t[2] * 1000.0).round() as i32])
+            .collect(),
+    }
+}
