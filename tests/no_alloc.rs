@@ -224,3 +224,110 @@ fn composed_bujold_ticks_do_not_allocate() {
     assert!(ran > 0);
     assert_eq!(allocs(), 0, "allocations in the composed behavior's ticks");
 }
+
+/// A synthetic back-camera view: the blue frame (`side` px, none when 0) centred
+/// `dx` px right of the image centre, the orange ball (radius `r` px) `ball_dx` px right
+/// of the frame's centre (off the axis: α ≠ 0).
+fn pyramid_view(side: usize, dx: f64, ball_dx: f64, r: f64) -> RgbImage {
+    let (w, h) = (160, 120);
+    let mut im = common::background(w, h);
+    let cx = w as f64 / 2.0 + dx;
+    if side > 0 {
+        let (x0, y0) = (cx as usize - side / 2, h / 2 - side / 2);
+        let bar = (side / 7).max(1);
+        for y in y0..y0 + side {
+            for x in x0..x0 + side {
+                if x < x0 + bar || x >= x0 + side - bar || y < y0 + bar || y >= y0 + side - bar {
+                    im.put(x, y, [20, 60, 220]);
+                }
+            }
+        }
+    }
+    let (bx, by) = (cx + ball_dx, h as f64 / 2.0);
+    for y in 0..h {
+        for x in 0..w {
+            if (x as f64 + 0.5 - bx).hypot(y as f64 + 0.5 - by) <= r {
+                im.put(x, y, [235, 120, 20]);
+            }
+        }
+    }
+    im
+}
+
+/// The composed RAPOSA behavior (pyramid perception, shared memory, the seven-state
+/// selector, the nested region-II sequence, the phase schemas) allocates nothing per tick
+/// once warmed up. The views cycle through nothing, a pair 18° off the axis (region II,
+/// its ellipse then swept toward either image edge), a near ball (state 6, then the
+/// retreat), a far pair, blue edges alone and a far ball alone, while odometry follows the
+/// commands; a first docking warms up, a second is counted.
+#[test]
+fn composed_raposa_ticks_do_not_allocate() {
+    use marsupial::behaviors::agent_for;
+    use marsupial::geometry::{Pose2, integrate_twist};
+    use marsupial::schemas::{Agent, Inputs, Mission, OdometryReading, Stamped};
+    let mut p = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml")).unwrap();
+    p.behavior.max_retries = 1000; // the final approach never meets a dock here
+    let mut agent = agent_for(&p).unwrap();
+    let frames = [
+        common::background(160, 120),
+        pyramid_view(30, 0.0, 14.0, 6.5),
+        pyramid_view(30, 45.0, 14.0, 6.5),
+        pyramid_view(30, -45.0, 14.0, 6.5),
+        pyramid_view(0, 0.0, 0.0, 44.0),
+        pyramid_view(24, 0.0, 0.0, 8.4),
+        pyramid_view(30, 0.0, 0.0, 0.0),
+        pyramid_view(0, 0.0, 0.0, 6.0),
+    ];
+    let run = |agent: &mut Box<dyn Agent>, phases: &mut Vec<&'static str>| {
+        let mut pose = Pose2::new(1.0, 0.0, 0.0);
+        let mut n = 0u64;
+        for k in 0..1500u64 {
+            let t = k as f64 * 0.1;
+            let f = &frames[(k / 37 % frames.len() as u64) as usize];
+            let cams: CameraInputs<'_> = smallvec::smallvec![Some(CameraInput {
+                stamp: t,
+                image: f.view()
+            })];
+            let mut inputs = Inputs::empty(t);
+            inputs.cameras = &cams;
+            inputs.odometry = Some(Stamped::new(
+                t,
+                OdometryReading {
+                    pose,
+                    ..Default::default()
+                },
+            ));
+            if let Some(s) = agent.tick(&inputs) {
+                n = n.wrapping_add(s.feedback.phase.len() as u64);
+                pose = integrate_twist(&pose, &s.output.drive.to_twist(), 0.1);
+                if phases.len() < phases.capacity() && !phases.contains(&s.feedback.phase) {
+                    phases.push(s.feedback.phase);
+                }
+            }
+        }
+        n
+    };
+    let mut phases: Vec<&'static str> = Vec::with_capacity(64);
+    agent.begin(&Mission::docking()).unwrap();
+    run(&mut agent, &mut phases); // warm-up: every phase's buffers sized once
+    phases.clear();
+    agent.begin(&Mission::docking()).unwrap();
+    reset();
+    COUNTING.with(|c| c.set(true));
+    let ran = run(&mut agent, &mut phases);
+    COUNTING.with(|c| c.set(false));
+    assert!(ran > 0);
+    assert_eq!(allocs(), 0, "allocations in the composed behavior's ticks");
+    for phase in [
+        "state_5",
+        "state_7",
+        "state_2_rotate",
+        "state_2_travel",
+        "state_2_rotate_phi",
+        "state_1",
+        "state_6",
+        "retreat",
+    ] {
+        assert!(phases.contains(&phase), "{phase} did not run: {phases:?}");
+    }
+}

@@ -142,3 +142,25 @@ fn an_unknown_selector_names_its_line() {
     assert_eq!(at, Some(line));
     assert!(msg.contains("unknown selector `bujold.nothing`"), "{msg}");
 }
+
+fn raposa_shipped() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml")).unwrap()
+}
+
+#[test]
+fn raposas_tree_builds_and_a_transition_out_of_its_sequence_is_refused() {
+    let p = Profile::parse(&raposa_shipped(), Path::new("raposa.toml")).unwrap();
+    assert!(agent_for(&p).is_ok());
+    // The region-II sequence hands `facing` up to the servo; `look` is the servo's state,
+    // not region_2's.
+    let src = raposa_shipped();
+    let from = "on = { facing = \"finish\" }";
+    assert_eq!(src.matches(from).count(), 1);
+    let line = src[..src.find(from).unwrap()].matches('\n').count() + 1;
+    let src = src.replacen(from, "on = { facing = \"look\" }", 1);
+    let e = Profile::parse(&src, Path::new("raposa-edited.toml")).expect_err("the profile must be refused");
+    let (path, at, msg) = only_problem(&e);
+    assert_eq!(path, "behavior.tree.nodes.rotate_phi.on.facing");
+    assert_eq!(at, Some(line));
+    assert!(msg.contains("`look` is not a state of `region_2`"), "{msg}");
+}

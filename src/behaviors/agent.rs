@@ -38,9 +38,7 @@ pub fn agent_for(profile: &Profile) -> Result<Box<dyn Agent>, BuildError> {
         ApproachKind::RatioSteering | ApproachKind::PotentialField if profile.fiducial.two_block.is_some() => {
             Ok(Box::new(super::bujold::agent(profile)?))
         }
-        ApproachKind::SevenState if profile.fiducial.pyramid.is_some() => {
-            Ok(Box::new(super::raposa::RaposaAgent::new(profile)?))
-        }
+        ApproachKind::SevenState if profile.fiducial.pyramid.is_some() => Ok(Box::new(super::raposa::agent(profile)?)),
         approach => Err(BuildError::NoBehavior {
             profile: profile.name.clone(),
             approach,

@@ -1,25 +1,33 @@
-//! RAPOSA's docking (seed 001): the seven-state vision servo onto the tether pyramid.
+//! RAPOSA's docking (seed 001) as a composition: the seven-state vision servo onto the
+//! tether pyramid, its phase schemas one file each in this folder, combined by the
+//! arbiters the way `profiles/raposa.toml` declares in `[behavior.tree]`.
 //!
 //! Every tick the [pyramid schema](crate::perception::PyramidSchema) reports the best
-//! (ellipse, blue region) pair, or an ellipse or blue region alone, with distance and α.
-//! The agent selects one of seven states ([`states`]) unless state 6 or 7 is latched:
+//! (ellipse, blue region) pair, or an ellipse or blue region alone, with distance and α,
+//! into the shared [`Memory`]. The `servo` sequencer's selector ([`selector`], the rules
+//! of [`states`]) picks one of seven states each tick unless the current one is latched:
 //!
 //! 1. **approach** (region I): the servo law of [`ServoLaw`](crate::schemas::ServoLaw)
 //!    (constant speed beyond 1 m, v = K_lin·√(A₁/A) closer, ω = −K_ang·x_dev);
 //! 2. **align** (region II, α > 15° beyond the dead zone): plan the manoeuvre of
-//!    [`region2`] (rotate −β, travel d, rotate φ, landing on the axis at δ);
+//!    [`region2`] (rotate −β, travel d, rotate φ, landing on the axis at δ) and run it as
+//!    the latched `region_2` sequence;
 //! 3. **far ellipse** alone: approach it at the far speed;
 //! 4. **blue only**: turn toward the blue region, creep once centred;
-//! 5. **nothing**: slow search, alternating sides and doubling the sweep (below 360°);
+//! 5. **search** (nothing): slow search, alternating sides and doubling the sweep (below
+//!    360°);
 //! 6. **final** (latched), from the 0.3 m area threshold: arm to −K_arm·y_dev, lights on,
-//!    slow constant speed for a set time, then stop and close the guides; without the dock
-//!    switch by then, back away and retry (up to `max_retries`);
-//! 7. **vision-tracked rotation** (latched): the part of −β that keeps the ellipse in view,
-//!    ended by a one-frame predictor before the ellipse leaves the image; the odometry
-//!    origin is then reset with the angle vision measured. The rest of −β, the travel (the
-//!    inverse (x_ref, y_ref) controller of [`PointController`](crate::schemas::PointController))
-//!    and φ run on odometry; then the robot looks, and searches slowly if the pyramid is
-//!    not in view.
+//!    slow constant speed for a set time, then stop; without the dock switch by then,
+//!    `retreat` and retry (up to `max_retries`);
+//! 7. **rotate_7** (the first state of `region_2`): the part of −β that keeps the ellipse
+//!    in view, ended by a one-frame predictor before the ellipse leaves the image; the
+//!    odometry origin is then reset with the angle vision measured. The rest of −β
+//!    (`rotate_odo`), the travel (`travel`, the inverse (x_ref, y_ref) controller of
+//!    [`PointController`](crate::schemas::PointController)) and φ (`rotate_phi`) run on
+//!    odometry; then the robot `look`s, and searches slowly if the pyramid is not in view.
+//!
+//! The `dock_switch` subsumes every docking phase. The departure (`depart`, `imprint`)
+//! drives out of the pyramid and imprints its colours (not in `fixed` segmentation).
 //!
 //! Beyond the paper (profile switch `leave_dead_zone`): a robot misaligned inside the dead
 //! zone backs away to `dead_zone_exit_m` first, so that region II can align it; the paper's
@@ -28,10 +36,147 @@
 //! Simplified relative to the paper: the simulator is planar, so the arm command and the
 //! lights are issued but do not change what the camera sees.
 
-pub mod agent;
+pub mod align;
+pub mod back_away;
+pub mod contact;
+pub mod departure;
+pub mod final_approach;
+pub mod manoeuvre;
+pub mod memory;
+pub mod params;
 pub mod region2;
+pub mod rotate7;
+pub mod search;
+pub mod selector;
+pub mod servo;
 pub mod states;
 
-pub use agent::RaposaAgent;
+pub use memory::Memory;
 pub use region2::Region2Plan;
 pub use states::{ServoState, select_state};
+
+use super::agent::BuildError;
+use super::composed::Composed;
+use super::registry::{LeafArgs, Registry};
+use crate::arbiter::Blackboard;
+use crate::profile::Profile;
+use back_away::{BackAway, Distance};
+use manoeuvre::{Manoeuvre, Part};
+
+/// Registers RAPOSA's phase schemas (`raposa.approach`, `raposa.rotate_7`, ...) and the
+/// `raposa.seven_state` selector in `registry`; each schema takes its tuning from its
+/// node's `params` (see [`params`]) and the robot-wide `[behavior.seven_state]`.
+pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
+    type Ctx = Blackboard<Memory>;
+    fn with<T: serde::de::DeserializeOwned>(args: &LeafArgs<'_>) -> Result<T, String> {
+        args.params()
+    }
+    fn none(args: &LeafArgs<'_>) -> Result<(), String> {
+        match args.params.keys().next() {
+            None => Ok(()),
+            Some(k) => Err(format!("params: unknown field `{k}`: this schema takes no params")),
+        }
+    }
+    let search_timeout = |a: &LeafArgs<'_>| a.profile.behavior.search_timeout_s;
+    registry
+        .register("raposa.depart", |m: &Ctx, a: &LeafArgs<'_>| {
+            none(a)?;
+            Ok(Box::new(departure::Depart::new(a.node, m.clone())))
+        })
+        .register("raposa.imprint", |m: &Ctx, a: &LeafArgs<'_>| {
+            none(a)?;
+            Ok(Box::new(departure::Imprint::new(a.node, m.clone())))
+        })
+        .register("raposa.dock_switch", |m: &Ctx, a: &LeafArgs<'_>| {
+            none(a)?;
+            Ok(Box::new(contact::DockSwitch::new(a.node, m.clone())))
+        })
+        .register("raposa.approach", |m: &Ctx, a: &LeafArgs<'_>| {
+            none(a)?;
+            Ok(Box::new(servo::Approach::new(a.node, m.clone())))
+        })
+        .register("raposa.align", |m: &Ctx, a: &LeafArgs<'_>| {
+            none(a)?;
+            Ok(Box::new(align::Align::new(a.node, m.clone())))
+        })
+        .register("raposa.far_ellipse", |m: &Ctx, a: &LeafArgs<'_>| {
+            none(a)?;
+            Ok(Box::new(servo::FarEllipse::new(a.node, m.clone())))
+        })
+        .register("raposa.blue_only", |m: &Ctx, a: &LeafArgs<'_>| {
+            Ok(Box::new(servo::BlueOnly::new(a.node, m.clone(), with(a)?)))
+        })
+        .register("raposa.search", move |m: &Ctx, a: &LeafArgs<'_>| {
+            Ok(Box::new(search::Search::new(
+                a.node,
+                m.clone(),
+                with(a)?,
+                search_timeout(a),
+            )))
+        })
+        .register("raposa.final", |m: &Ctx, a: &LeafArgs<'_>| {
+            none(a)?;
+            Ok(Box::new(final_approach::FinalApproach::new(
+                a.node,
+                m.clone(),
+                a.profile.behavior.max_retries,
+            )))
+        })
+        .register("raposa.leave_dead_zone", |m: &Ctx, a: &LeafArgs<'_>| {
+            Ok(Box::new(BackAway::new(a.node, m.clone(), Distance::DeadZone(with(a)?))))
+        })
+        .register("raposa.retreat", |m: &Ctx, a: &LeafArgs<'_>| {
+            Ok(Box::new(BackAway::new(a.node, m.clone(), Distance::Retreat(with(a)?))))
+        })
+        .register("raposa.rotate_7", |m: &Ctx, a: &LeafArgs<'_>| {
+            none(a)?;
+            Ok(Box::new(rotate7::Rotate7::new(a.node, m.clone())))
+        })
+        .register("raposa.rotate_odo", |m: &Ctx, a: &LeafArgs<'_>| {
+            none(a)?;
+            Ok(Box::new(Manoeuvre::new(a.node, m.clone(), Part::RotateOdo)))
+        })
+        .register("raposa.travel", |m: &Ctx, a: &LeafArgs<'_>| {
+            none(a)?;
+            Ok(Box::new(Manoeuvre::new(a.node, m.clone(), Part::Travel)))
+        })
+        .register("raposa.rotate_phi", |m: &Ctx, a: &LeafArgs<'_>| {
+            none(a)?;
+            Ok(Box::new(Manoeuvre::new(a.node, m.clone(), Part::RotatePhi)))
+        })
+        .register("raposa.look", move |m: &Ctx, a: &LeafArgs<'_>| {
+            Ok(Box::new(search::Look::new(
+                a.node,
+                m.clone(),
+                with(a)?,
+                search_timeout(a),
+            )))
+        })
+        .register_selector("raposa.seven_state", |m: &Ctx, a| {
+            Ok(Box::new(selector::SevenState::new(m.clone(), a)?))
+        });
+}
+
+/// RAPOSA's robot: the pyramid perceptual schema in the shared [`Memory`] and the tree of
+/// `[behavior.tree]`.
+pub type RaposaAgent = Composed<Memory>;
+
+/// Builds RAPOSA's robot from a profile with a `[fiducial.pyramid]`, a pin-hole back
+/// camera, `[behavior.seven_state]` and a `[behavior.tree]` of RAPOSA's schemas (or the
+/// user's, registered in `registry`).
+///
+/// # Errors
+/// [`BuildError`] when something it needs is missing or the tree does not build.
+pub fn agent_with(profile: &Profile, registry: &Registry<Blackboard<Memory>>) -> Result<RaposaAgent, BuildError> {
+    Composed::build(profile, registry, Memory::from_profile(profile)?)
+}
+
+/// Builds RAPOSA's robot with RAPOSA's own schemas (see [`agent_with`]).
+///
+/// # Errors
+/// As [`agent_with`].
+pub fn agent(profile: &Profile) -> Result<RaposaAgent, BuildError> {
+    let mut registry = Registry::new();
+    register(&mut registry);
+    agent_with(profile, &registry)
+}

@@ -1,0 +1,58 @@
+//! `raposa.align`, state 2 (region II, seed 001 §II.C.2): a pair seen more than
+//! `angle_threshold_deg` off the axis beyond the dead zone. Plans the alignment manoeuvre
+//! ([`super::region2`]: rotate −β, travel d, rotate φ) from this tick's pair, stores it in
+//! memory and ends with event `planned` (the `region_2` sequence runs it), already turning
+//! toward −β at the vision-tracked rate. Without a pair it stands still.
+
+use super::memory::Memory;
+use super::region2::{plan, robot_in_ball_frame};
+use crate::arbiter::Blackboard;
+use crate::schemas::{Behavior, Inputs, Status, Step};
+
+/// See the module docs.
+pub struct Align {
+    name: String,
+    mem: Blackboard<Memory>,
+}
+
+impl Align {
+    /// A leaf named `name`.
+    pub fn new(name: &str, mem: Blackboard<Memory>) -> Self {
+        Self { name: name.into(), mem }
+    }
+}
+
+impl Behavior for Align {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        let mut m = self.mem.lock();
+        let view = m.percept.view;
+        let (Some(view), Some(alpha)) = (view, view.and_then(|v| v.alpha)) else {
+            return Some(m.hold("state_2"));
+        };
+        let start = robot_in_ball_frame(&view, alpha, m.camera_x);
+        let pl = plan(start, m.gains.region2_distance_m, m.half_length);
+        tracing::debug!(
+            target: "marsupial::behavior",
+            now = m.now,
+            alpha_deg = alpha.to_degrees(),
+            beta_deg = -pl.rotation.to_degrees(),
+            d_m = pl.distance,
+            phi_deg = pl.final_rotation.to_degrees(),
+            reverse = pl.reverse,
+            "region II: rotate −β, travel d, rotate φ"
+        );
+        m.manoeuvres += 1;
+        m.settling = false;
+        m.plan = Some(pl);
+        let omega = m.vision_turn * pl.rotation.signum();
+        let mut step = m.turn(omega, "state_7");
+        step.status = Status::Event("planned");
+        Some(step)
+    }
+}

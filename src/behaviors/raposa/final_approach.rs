@@ -1,0 +1,72 @@
+//! `raposa.final`, state 6 (latched; seed 001 §II.E), selected once the ball is within
+//! `final_distance_m` (the area threshold). On entry the arm goes to −K_arm·y_dev and the
+//! lights turn on; the first tick still runs the state-1 law, then the robot drives at the
+//! slow constant `final_speed_mps`, steering on the ellipse when seen, for
+//! `final_time_s`. Without the dock switch by then (it subsumes this phase) the lights go
+//! off and the attempt counts as a retry: event `retry` (back away and try again), or the
+//! docking fails with retries exhausted after the profile's `behavior.max_retries`.
+
+use super::memory::Memory;
+use crate::arbiter::Blackboard;
+use crate::schemas::{Behavior, FailureReason, Inputs, MotorOutput, Outcome, Step};
+
+/// See the module docs.
+pub struct FinalApproach {
+    name: String,
+    mem: Blackboard<Memory>,
+    max_retries: u32,
+    start: f64,
+    first: bool,
+}
+
+impl FinalApproach {
+    /// A leaf named `name`, failing after `max_retries` retries.
+    pub fn new(name: &str, mem: Blackboard<Memory>, max_retries: u32) -> Self {
+        Self {
+            name: name.into(),
+            mem,
+            max_retries,
+            start: 0.0,
+            first: true,
+        }
+    }
+}
+
+impl Behavior for FinalApproach {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, _inputs: &Inputs<'_>) {
+        let mut m = self.mem.lock();
+        let dev = m.percept.view.map_or(0.0, |v| v.dev_px[1]);
+        m.aux.arm = Some(m.law.arm(dev));
+        m.aux.lights = Some(true);
+        self.start = m.now;
+        self.first = true;
+    }
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        let mut m = self.mem.lock();
+        if std::mem::take(&mut self.first) {
+            // The end of state 1: its law still runs on the tick state 6 is selected.
+            return Some(m.approach(false, "state_6"));
+        }
+        if m.now - self.start < m.gains.final_time_s {
+            let omega = m.percept.view.map_or(0.0, |v| m.law.turn(v.dev_px[0]));
+            return Some(m.drive(m.law.twist(m.gains.final_speed_mps, omega), "state_6"));
+        }
+        // Time is up without the dock switch: stop, and retry from further out.
+        m.aux.lights = Some(false);
+        m.retries += 1;
+        if m.retries > self.max_retries {
+            let out = MotorOutput::stop().with_aux(m.aux);
+            return Some(Step::done(
+                Outcome::Failed(FailureReason::RetriesExhausted),
+                out,
+                m.feedback("state_6"),
+            ));
+        }
+        Some(m.hold_event("retry", "state_6"))
+    }
+}

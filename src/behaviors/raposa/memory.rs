@@ -1,0 +1,270 @@
+//! What RAPOSA's phase schemas share: the pyramid perceptual schema and this tick's
+//! percept, the odometry pose, the auxiliary commands (arm, lights, guides) every output
+//! carries, the search and retry counters, and the region-II plan one phase hands the
+//! next.
+//!
+//! The perceptual schema runs once per tick for the whole tree ([`Memory::perceive`],
+//! called by the robot's [`Composed`](crate::behaviors::composed::Composed) root before the
+//! arbiters), in the order the seven-state robot needs: not at all during the departure
+//! (the robot drives out and imprints, [`Memory::perceiving`]), told that it is not
+//! looking during the blind part of the region-II manoeuvre ([`Memory::blind`], so the
+//! colour model's fallback clock pauses). The phases set both flags when they are entered;
+//! the next tick's perception reads them.
+
+use super::region2::Region2Plan;
+use crate::behaviors::BuildError;
+use crate::behaviors::composed::SharedMemory;
+use crate::geometry::{Pose2, Twist, wrap_angle};
+use crate::perception::{PyramidPercept, PyramidSchema};
+use crate::profile::{Profile, SegmentationMode, SevenStateGains};
+use crate::schemas::{
+    AgentStats, Auxiliary, DriveCommand, Feedback, Guides, Inputs, Mission, MissionError, MotorOutput,
+    PerceptualSchema, PointController, ServoLaw, Step,
+};
+
+/// RAPOSA's shared memory (see the module docs).
+pub struct Memory {
+    /// The pyramid perceptual schema (detector, colour model, imprint).
+    pub schema: PyramidSchema,
+    /// The seven states' gains and thresholds (`[behavior.seven_state]`).
+    pub gains: SevenStateGains,
+    /// The state-1 servo law.
+    pub law: ServoLaw,
+    /// The odometry point controller and rotations.
+    pub ctrl: PointController,
+    /// State 7's turn rate, rad/s.
+    pub vision_turn: f64,
+    /// Camera position along the body axis, m (negative: behind the centre).
+    pub camera_x: f64,
+    /// Centre-to-rear distance, m.
+    pub half_length: f64,
+    /// Camera distance in front of the socket (camera-to-ball minus socket-to-ball), m.
+    pub socket_inset: f64,
+    /// Half the image width, px.
+    pub half_width_px: f64,
+    /// Loop time of this tick, s.
+    pub now: f64,
+    /// Odometry pose of this tick.
+    pub odo: Pose2,
+    /// This tick's percept (the last one while perception is off).
+    pub percept: PyramidPercept,
+    /// When this mission began, s.
+    pub run_start: Option<f64>,
+    /// Arm, lights and guides: attached to every output.
+    pub aux: Auxiliary,
+    /// Final approaches retried this docking.
+    pub retries: u32,
+    /// Consecutive frames with neither the ellipse nor the blue edges.
+    pub unseen: u32,
+    /// When the current state-5 search began.
+    pub search_start: Option<f64>,
+    /// Sign of the last turn commanded (+1 CCW): searches start the other way.
+    pub last_turn: f64,
+    /// Right after a region-II manoeuvre: the angle threshold is widened until the next
+    /// plan.
+    pub settling: bool,
+    /// Region-II manoeuvres planned this docking.
+    pub manoeuvres: u32,
+    /// A departure imprinted successfully.
+    pub imprinted: bool,
+    /// The region-II plan being executed.
+    pub plan: Option<Region2Plan>,
+    /// The ball frame in the odometry frame, reset when state 7 ends with the angle vision
+    /// measured.
+    pub map: Pose2,
+    /// Perception runs this tick (off during the departure).
+    pub perceiving: bool,
+    /// The robot looks away from the pyramid on purpose (the blind part of region II).
+    pub blind: bool,
+}
+
+impl Memory {
+    /// The memory of a robot just switched on, built from a profile with a
+    /// `[fiducial.pyramid]`, a pin-hole back camera and `[behavior.seven_state]`.
+    ///
+    /// # Errors
+    /// [`BuildError::Profile`] naming what is missing.
+    pub fn from_profile(profile: &Profile) -> Result<Self, BuildError> {
+        let missing = |what: String| BuildError::Profile {
+            profile: profile.name.clone(),
+            what,
+        };
+        let gains = profile
+            .behavior
+            .seven_state
+            .ok_or_else(|| missing("needs [behavior.seven_state]".into()))?;
+        let schema = PyramidSchema::from_profile(profile, 0).map_err(|e| missing(e.to_string()))?;
+        let cam = &profile.cameras[0];
+        let camera_backward = wrap_angle(cam.mount.yaw_deg.to_radians()).abs() > std::f64::consts::FRAC_PI_2;
+        let half_length = profile.body.length_m / 2.0;
+        let camera_x = cam.mount.x_m;
+        let limits = profile.drive.limits();
+        let size = schema.detector().size();
+        Ok(Self {
+            schema,
+            gains,
+            law: ServoLaw {
+                k_lin: gains.k_lin,
+                k_ang: gains.k_ang,
+                k_arm: gains.k_arm,
+                far_speed: gains.far_speed_mps,
+                far_distance: gains.far_distance_m,
+                camera_backward,
+            },
+            ctrl: PointController {
+                k_rho: gains.k_rho,
+                k_heading: gains.k_heading,
+                max_speed: gains.travel_speed_mps.min(limits.max_speed),
+                max_turn: gains.turn_rate_dps.to_radians().min(limits.max_turn_rate),
+                position_tolerance: gains.position_tolerance_m,
+                rotation_tolerance: gains.rotation_tolerance_deg.to_radians(),
+            },
+            vision_turn: gains.vision_turn_rate_dps.to_radians(),
+            camera_x,
+            half_length,
+            socket_inset: (half_length + camera_x).max(0.0),
+            half_width_px: cam.width_px as f64 / 2.0,
+            now: 0.0,
+            odo: Pose2::default(),
+            percept: PyramidPercept::not_found(0.0, size),
+            run_start: None,
+            aux: Auxiliary::default(),
+            retries: 0,
+            unseen: 0,
+            search_start: None,
+            last_turn: 1.0,
+            settling: false,
+            manoeuvres: 0,
+            imprinted: false,
+            plan: None,
+            map: Pose2::default(),
+            perceiving: true,
+            blind: false,
+        })
+    }
+
+    /// Runs the perceptual schema on this tick's inputs (see the module docs).
+    pub fn perceive(&mut self, inputs: &Inputs<'_>) {
+        let now = inputs.now;
+        self.now = now;
+        self.run_start.get_or_insert(now);
+        self.odo = inputs.odometry.map(|o| o.value.pose).unwrap_or_default();
+        if !self.perceiving {
+            return;
+        }
+        self.schema.set_looking(!self.blind, now);
+        let p = self.schema.perceive(inputs);
+        if p.view.is_some() || p.detection.blue.is_some() {
+            self.unseen = 0;
+        }
+        self.percept = p;
+    }
+
+    /// Feedback for a phase.
+    pub fn feedback(&self, phase: &'static str) -> Feedback {
+        Feedback {
+            phase,
+            elapsed: self.now - self.run_start.unwrap_or(self.now),
+            retries: self.retries,
+        }
+    }
+
+    /// Drive with `twist`, carrying the auxiliary commands.
+    pub fn drive(&self, twist: Twist, phase: &'static str) -> Step {
+        self.command(DriveCommand::Twist(twist), phase)
+    }
+
+    /// Any drive command, carrying the auxiliary commands.
+    pub fn command(&self, drive: DriveCommand, phase: &'static str) -> Step {
+        Step::running(MotorOutput::drive(drive).with_aux(self.aux), self.feedback(phase))
+    }
+
+    /// Stand still, carrying the auxiliary commands.
+    pub fn hold(&self, phase: &'static str) -> Step {
+        Step::running(MotorOutput::stop().with_aux(self.aux), self.feedback(phase))
+    }
+
+    /// Stand still and end the state with `event`.
+    pub fn hold_event(&self, event: &'static str, phase: &'static str) -> Step {
+        Step::event(event, MotorOutput::stop().with_aux(self.aux), self.feedback(phase))
+    }
+
+    /// Turn in place at `omega`, remembering the side (searches start the other way).
+    pub fn turn(&mut self, omega: f64, phase: &'static str) -> Step {
+        if omega != 0.0 {
+            self.last_turn = omega.signum();
+        }
+        self.drive(Twist::new(0.0, omega), phase)
+    }
+
+    /// The state-1 approach law on this tick's ellipse (`far`: at the constant far speed,
+    /// state 3); stands still without one.
+    pub fn approach(&self, far: bool, phase: &'static str) -> Step {
+        let Some(v) = self.percept.view else {
+            return self.hold(phase);
+        };
+        // √(A₁/A) is the area's distance estimate.
+        let area_root = self.schema.geometry().distance_from_area(v.area_px as f64);
+        let speed = if far {
+            self.law.far_speed
+        } else {
+            self.law.speed(v.ball_distance_m, area_root)
+        };
+        let omega = self.law.turn(v.dev_px[0]);
+        self.drive(self.law.twist(speed, omega), phase)
+    }
+
+    /// Distance travelled from `mark` to this tick's odometry pose, m.
+    pub fn travelled(&self, mark: &Pose2) -> f64 {
+        (self.odo.x - mark.x).hypot(self.odo.y - mark.y)
+    }
+}
+
+impl SharedMemory for Memory {
+    fn perceive(&mut self, inputs: &Inputs<'_>) {
+        Memory::perceive(self, inputs);
+    }
+
+    /// Departure (seed 001's robot leaves the pyramid to explore): the perception is off
+    /// while it drives out and imprints; refused in `fixed` segmentation, which has
+    /// nothing to imprint. Docking: guides open, counters and tracking forgotten.
+    fn begin(&mut self, mission: &Mission) -> Result<(), MissionError> {
+        match mission {
+            Mission::Departure => {
+                if self.schema.mode() == SegmentationMode::Fixed {
+                    return Err(MissionError::Unavailable {
+                        robot: "raposa".into(),
+                        mission: "departure",
+                        why: "fixed segmentation has nothing to imprint".into(),
+                    });
+                }
+                self.imprinted = false;
+                self.run_start = None;
+                self.perceiving = false;
+            }
+            Mission::Docking { .. } => {
+                self.run_start = None;
+                self.retries = 0;
+                self.unseen = 0;
+                self.search_start = None;
+                self.settling = false;
+                self.aux = Auxiliary {
+                    guides: Some(Guides::Open),
+                    ..Auxiliary::default()
+                };
+                self.manoeuvres = 0;
+                self.plan = None;
+                self.perceiving = true;
+                self.blind = false;
+                self.schema.reset();
+            }
+        }
+        Ok(())
+    }
+
+    fn stats(&self) -> AgentStats {
+        AgentStats {
+            manoeuvres: self.manoeuvres,
+        }
+    }
+}

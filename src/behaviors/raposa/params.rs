@@ -1,0 +1,82 @@
+//! Tuning of RAPOSA's phase schemas, each read from its node's `params` table in
+//! `profiles/raposa.toml` (`[behavior.tree.nodes.<phase>.params]`). The robot-wide gains
+//! and thresholds of the seven states stay in `[behavior.seven_state]`
+//! ([`SevenStateGains`](crate::profile::SevenStateGains)); what is here is what one phase
+//! alone uses. Every field has the default the campaigns were tuned with, so a profile
+//! states only what it changes; the shipped profile states them all, with where each
+//! value comes from.
+
+use serde::{Deserialize, Serialize};
+
+/// `search` (state 5): the slow doubling search when nothing is seen.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SearchParams {
+    /// Frames without anything seen before the search starts turning (a single dropped
+    /// frame should not start a rotation).
+    pub grace_frames: u32,
+}
+
+impl Default for SearchParams {
+    fn default() -> Self {
+        Self { grace_frames: 3 }
+    }
+}
+
+/// `blue_only` (state 4): turn toward the blue edges, creep once centred.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BlueOnlyParams {
+    /// Creep at the final speed once the blue region's centre is within this many pixels
+    /// of the image centre, px.
+    pub centred_px: f64,
+}
+
+impl Default for BlueOnlyParams {
+    fn default() -> Self {
+        Self { centred_px: 10.0 }
+    }
+}
+
+/// `look`: after the region-II manoeuvre, stand still, then search slowly.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LookParams {
+    /// Stand still this long first, letting the image settle after stopping, s.
+    pub settle_s: f64,
+}
+
+impl Default for LookParams {
+    fn default() -> Self {
+        Self { settle_s: 0.5 }
+    }
+}
+
+/// `leave_dead_zone`: back away until the socket is `dead_zone_exit_m` from the ball
+/// (`[behavior.seven_state]`), at least `min_distance_m`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LeaveDeadZoneParams {
+    /// Shortest back-away, m.
+    pub min_distance_m: f64,
+}
+
+impl Default for LeaveDeadZoneParams {
+    fn default() -> Self {
+        Self { min_distance_m: 0.05 }
+    }
+}
+
+/// `retreat`: after a final approach without the dock switch, back away before retrying.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RetreatParams {
+    /// How far, m.
+    pub distance_m: f64,
+}
+
+impl Default for RetreatParams {
+    fn default() -> Self {
+        Self { distance_m: 0.4 }
+    }
+}

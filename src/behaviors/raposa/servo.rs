@@ -1,0 +1,104 @@
+//! The servo states that run while the selector keeps choosing them (seed 001 §II.E):
+//! `raposa.approach` (state 1), `raposa.far_ellipse` (state 3) and `raposa.blue_only`
+//! (state 4). They never end by themselves: the `servo` sequencer's selector
+//! ([`super::selector`]) leaves them when the percept calls for another state.
+
+use super::memory::Memory;
+use super::params::BlueOnlyParams;
+use crate::arbiter::Blackboard;
+use crate::schemas::{Behavior, Inputs, Step};
+
+/// `raposa.approach`, state 1 (region I): the servo law on the ellipse, constant speed
+/// beyond `far_distance_m`, v = K_lin·√(A₁/A) closer, ω = −K_ang·x_dev.
+pub struct Approach {
+    name: String,
+    mem: Blackboard<Memory>,
+}
+
+impl Approach {
+    /// A leaf named `name`.
+    pub fn new(name: &str, mem: Blackboard<Memory>) -> Self {
+        Self { name: name.into(), mem }
+    }
+}
+
+impl Behavior for Approach {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        Some(self.mem.lock().approach(false, "state_1"))
+    }
+}
+
+/// `raposa.far_ellipse`, state 3: a lone ellipse far away, approached at the constant far
+/// speed until the blue edges join it (the paper does not say how).
+pub struct FarEllipse {
+    name: String,
+    mem: Blackboard<Memory>,
+}
+
+impl FarEllipse {
+    /// A leaf named `name`.
+    pub fn new(name: &str, mem: Blackboard<Memory>) -> Self {
+        Self { name: name.into(), mem }
+    }
+}
+
+impl Behavior for FarEllipse {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        Some(self.mem.lock().approach(true, "state_3"))
+    }
+}
+
+/// `raposa.blue_only`, state 4: blue edges without the ellipse (hidden by glare or the
+/// pyramid's own body): turn toward them, and creep at the final speed once they are
+/// within `centred_px` of the image centre.
+pub struct BlueOnly {
+    name: String,
+    mem: Blackboard<Memory>,
+    params: BlueOnlyParams,
+}
+
+impl BlueOnly {
+    /// A leaf named `name`.
+    pub fn new(name: &str, mem: Blackboard<Memory>, params: BlueOnlyParams) -> Self {
+        Self {
+            name: name.into(),
+            mem,
+            params,
+        }
+    }
+}
+
+impl Behavior for BlueOnly {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        let m = self.mem.lock();
+        let Some(b) = m.percept.detection.blue else {
+            return Some(m.hold("state_4"));
+        };
+        let dev = b.centre()[0] + 0.5 - m.half_width_px;
+        let omega = m.law.turn(dev);
+        let creep = if dev.abs() < self.params.centred_px {
+            m.gains.final_speed_mps
+        } else {
+            0.0
+        };
+        Some(m.drive(m.law.twist(creep, omega), "state_4"))
+    }
+}

@@ -1,0 +1,582 @@
+//! RAPOSA's phase schemas driven one by one with scripted percepts in memory, without the
+//! renderer: each commands what its state's law says and ends with the event its profile
+//! transition expects, and only then; the seven-state selector maps percepts to the
+//! servo's states, with the look special case.
+
+mod common;
+
+use marsupial::arbiter::{Blackboard, Selector};
+use marsupial::behaviors::SharedMemory;
+use marsupial::behaviors::raposa::back_away::{BackAway, Distance};
+use marsupial::behaviors::raposa::manoeuvre::{Manoeuvre, Part};
+use marsupial::behaviors::raposa::memory::Memory;
+use marsupial::behaviors::raposa::params::*;
+use marsupial::behaviors::raposa::region2::{plan, robot_in_ball_frame};
+use marsupial::behaviors::raposa::selector::SevenState;
+use marsupial::behaviors::raposa::{ServoState, align, contact, departure, final_approach, rotate7, search, servo};
+use marsupial::behaviors::registry::SelectorArgs;
+use marsupial::geometry::{Pose2, Twist};
+use marsupial::perception::{BlueRegion, Ellipse, PyramidDetection, PyramidPercept, PyramidView};
+use marsupial::profile::tree::NodeSpec;
+use marsupial::profile::{Profile, SegmentationMode};
+use marsupial::schemas::{
+    Behavior, DriveCommand, FailureReason, Guides, Inputs, Mission, MissionError, OdometryReading, Outcome, Stamped,
+    Status, Step,
+};
+
+fn profile() -> Profile {
+    common::shipped_profile("raposa")
+}
+
+fn memory() -> Blackboard<Memory> {
+    Blackboard::new(Memory::from_profile(&profile()).unwrap())
+}
+
+/// What the pyramid schema would report: an ellipse `d` m away (with a pair when
+/// `alpha_deg` is given) `dev` px off the image centre, and/or the blue edges.
+fn seen(d: f64, alpha_deg: Option<f64>, dev: [f64; 2], blue: bool) -> PyramidPercept {
+    let mut p = nothing();
+    p.detection.ellipse = Some(Ellipse {
+        centre: [80.0 + dev[0], 60.0 + dev[1]],
+        semi_major: 5.0,
+        semi_minor: 5.0,
+        angle: 0.0,
+        count: 80,
+        bbox: [75, 55, 85, 65],
+    });
+    p.detection.blue = blue.then(|| blue_at(80));
+    p.view = Some(PyramidView {
+        blue_distance_m: alpha_deg.map(|_| d + 0.16),
+        ball_distance_m: d,
+        alpha: alpha_deg.map(f64::to_radians),
+        alpha_saturated: false,
+        bearing: 0.0,
+        dev_px: dev,
+        // The ball's area at `d` (7 cm at f ≈ 361 px).
+        area_px: (std::f64::consts::PI * (361.0 * 0.035 / d).powi(2)) as u64,
+    });
+    p
+}
+
+/// Blue edges alone, centred at column `x` (pixel centre `x + 0.5`).
+fn blue_at(x: u32) -> BlueRegion {
+    BlueRegion {
+        bbox: [x - 10, 50, x + 9, 70],
+        count: 100,
+    }
+}
+
+fn nothing() -> PyramidPercept {
+    let mut p = PyramidPercept::not_found(0.0, (160, 120));
+    p.detection = PyramidDetection {
+        pair: None,
+        ellipse: None,
+        blue: None,
+        candidates: 0,
+    };
+    p
+}
+
+fn inputs(now: f64, odo: Pose2) -> Inputs<'static> {
+    let mut i = Inputs::empty(now);
+    i.odometry = Some(Stamped::new(
+        now,
+        OdometryReading {
+            pose: odo,
+            ..Default::default()
+        },
+    ));
+    i
+}
+
+/// Sets this tick's time, pose and percept in memory (what the root's perception does),
+/// then ticks `leaf`.
+fn tick(leaf: &mut dyn Behavior, mem: &Blackboard<Memory>, now: f64, odo: Pose2, p: PyramidPercept) -> Step {
+    mem.with(|m| {
+        m.now = now;
+        m.odo = odo;
+        m.percept = p;
+    });
+    leaf.tick(&inputs(now, odo)).expect("a phase is always active")
+}
+
+/// Enters `leaf` at `now`, `odo`, with percept `p` in memory.
+fn enter(leaf: &mut dyn Behavior, mem: &Blackboard<Memory>, now: f64, odo: Pose2, p: PyramidPercept) {
+    mem.with(|m| {
+        m.now = now;
+        m.odo = odo;
+        m.percept = p;
+    });
+    leaf.enter(&inputs(now, odo));
+}
+
+fn twist(s: &Step) -> Twist {
+    match s.output.drive {
+        DriveCommand::Twist(t) => t,
+        DriveCommand::Stop => Twist::new(0.0, 0.0),
+        other => panic!("expected a twist, got {other:?}"),
+    }
+}
+
+fn turn_rate(s: &Step) -> f64 {
+    match s.output.drive {
+        DriveCommand::Turn { omega } => omega,
+        DriveCommand::Twist(t) if t.v == 0.0 => t.omega,
+        other => panic!("expected a turn, got {other:?}"),
+    }
+}
+
+fn at(x: f64) -> Pose2 {
+    Pose2::new(x, 0.0, 0.0)
+}
+
+#[test]
+fn servo_states_steer_on_what_they_see() {
+    let mem = memory();
+    let g = profile().behavior.seven_state.unwrap();
+    // State 1 near the pyramid: slower than the far speed, turning against x_dev; the
+    // camera looks back, so "toward the pyramid" is body-backward.
+    let mut s1 = servo::Approach::new("approach", mem.clone());
+    let step = tick(&mut s1, &mem, 0.1, at(1.0), seen(0.6, Some(5.0), [20.0, 0.0], true));
+    assert_eq!(step.status, Status::Running);
+    let t = twist(&step);
+    assert!(t.v < 0.0 && -t.v < g.far_speed_mps, "{t:?}");
+    assert!((t.omega - -g.k_ang * 20.0).abs() < 1e-12, "{t:?}");
+    // State 3: a lone ellipse far away, at the far speed.
+    let mut s3 = servo::FarEllipse::new("far_ellipse", mem.clone());
+    let t = twist(&tick(&mut s3, &mem, 0.2, at(1.0), seen(2.0, None, [0.0, 0.0], false)));
+    assert_eq!(t.v, -g.far_speed_mps);
+    // Without an ellipse both stand still.
+    assert_eq!(
+        tick(&mut s1, &mem, 0.3, at(1.0), nothing()).output.drive,
+        DriveCommand::Stop
+    );
+    // State 4: turn toward the blue edges; creep only within `centred_px` of the centre.
+    let mut s4 = servo::BlueOnly::new("blue_only", mem.clone(), BlueOnlyParams::default());
+    let mut blue = nothing();
+    blue.detection.blue = Some(blue_at(80));
+    let t = twist(&tick(&mut s4, &mem, 0.4, at(1.0), blue));
+    assert_eq!((t.v, t.omega), (-g.final_speed_mps, 0.0), "centred: creep straight");
+    blue.detection.blue = Some(blue_at(100));
+    let t = twist(&tick(&mut s4, &mem, 0.5, at(1.0), blue));
+    assert_eq!(t.v, 0.0, "20 px off: turn only");
+    assert!((t.omega - -g.k_ang * 20.0).abs() < 1e-12);
+    let wide = BlueOnlyParams { centred_px: 30.0 };
+    let mut s4 = servo::BlueOnly::new("blue_only", mem.clone(), wide);
+    assert_eq!(twist(&tick(&mut s4, &mem, 0.6, at(1.0), blue)).v, -g.final_speed_mps);
+}
+
+#[test]
+fn search_waits_its_grace_frames_turns_away_from_the_last_turn_and_times_out() {
+    let mem = memory();
+    let mut s = search::Search::new("search", mem.clone(), SearchParams::default(), 60.0);
+    mem.with(|m| m.last_turn = 1.0);
+    for k in 1..=3 {
+        let step = tick(&mut s, &mem, k as f64 * 0.1, at(1.0), nothing());
+        assert_eq!(step.output.drive, DriveCommand::Stop, "grace frame {k}");
+    }
+    let step = tick(&mut s, &mem, 0.4, at(1.0), nothing());
+    assert!(turn_rate(&step) < 0.0, "away from the last (left) turn: {step:?}");
+    assert_eq!(mem.lock().search_start, Some(0.4));
+    assert_eq!(tick(&mut s, &mem, 60.4, at(1.0), nothing()).status, Status::Running);
+    assert_eq!(
+        tick(&mut s, &mem, 60.5, at(1.0), nothing()).status,
+        Status::Done(Outcome::Failed(FailureReason::TargetLost))
+    );
+    // Five grace frames: still standing on the fourth.
+    let mem = memory();
+    let mut s = search::Search::new("search", mem.clone(), SearchParams { grace_frames: 5 }, 60.0);
+    for k in 1..=4 {
+        tick(&mut s, &mem, k as f64 * 0.1, at(1.0), nothing());
+    }
+    assert_eq!(mem.lock().unseen, 4);
+    assert_eq!(mem.lock().search_start, None);
+}
+
+#[test]
+fn align_plans_counts_and_hands_over_already_turning() {
+    let mem = memory();
+    mem.with(|m| m.settling = true);
+    let mut a = align::Align::new("align", mem.clone());
+    // No pair, no plan.
+    let step = tick(&mut a, &mem, 0.1, at(1.0), seen(1.5, None, [0.0, 0.0], false));
+    assert_eq!(step.status, Status::Running);
+    assert_eq!(mem.lock().manoeuvres, 0);
+    let p = seen(1.5, Some(40.0), [0.0, 0.0], true);
+    let step = tick(&mut a, &mem, 0.2, at(1.0), p);
+    assert_eq!(step.status, Status::Event("planned"));
+    let m = mem.lock();
+    let pl = m.plan.expect("the plan is in memory for region II");
+    let expected = plan(
+        robot_in_ball_frame(&p.view.unwrap(), 40f64.to_radians(), m.camera_x),
+        m.gains.region2_distance_m,
+        m.half_length,
+    );
+    assert_eq!(pl, expected);
+    assert_eq!((m.manoeuvres, m.settling), (1, false));
+    let omega = twist(&step).omega;
+    assert_eq!(omega, m.vision_turn * pl.rotation.signum());
+    assert_eq!(m.last_turn, pl.rotation.signum());
+}
+
+/// A memory holding a plan that turns `rotation_deg` first.
+fn planned(rotation_deg: f64) -> Blackboard<Memory> {
+    let mem = memory();
+    mem.with(|m| {
+        let mut pl = plan(Pose2::new(1.5, 0.5, 0.0), 0.9, 0.4);
+        pl.rotation = rotation_deg.to_radians();
+        m.plan = Some(pl);
+    });
+    mem
+}
+
+fn at_bearing(bearing: f64, dev_x: f64) -> PyramidPercept {
+    let mut p = seen(1.5, Some(30.0), [dev_x, 0.0], true);
+    p.view.as_mut().unwrap().bearing = bearing;
+    p
+}
+
+#[test]
+fn rotate_7_measures_the_rotation_by_vision_and_resets_the_odometry_frame() {
+    let mem = planned(17.0);
+    let mut r = rotate7::Rotate7::new("rotate_7", mem.clone());
+    enter(&mut r, &mem, 0.0, at(1.0), at_bearing(0.0, 0.0));
+    // 0.05 rad per frame toward a 17° (0.297 rad) goal, tolerance 2°: the predictor stops
+    // at 0.25 rad turned (next frame would reach 0.30).
+    let mut events = Vec::new();
+    for k in 1..=6 {
+        let step = tick(&mut r, &mem, k as f64 * 0.1, at(1.0), at_bearing(-0.05 * k as f64, 0.0));
+        events.push(step.status);
+        if step.status != Status::Running {
+            assert_eq!(step.output.drive, DriveCommand::Stop);
+            break;
+        }
+        assert!(turn_rate(&step) > 0.0);
+    }
+    assert_eq!(events.len(), 5, "{events:?}");
+    assert_eq!(*events.last().unwrap(), Status::Event("rotated"));
+    // The manoeuvre's frame: the robot's planned start, turned by what vision measured,
+    // sits at this tick's odometry pose.
+    let m = mem.lock();
+    let pl = m.plan.unwrap();
+    let start = Pose2::new(pl.start.x, pl.start.y, pl.start.theta + 0.25);
+    let here = m.map.compose(&start);
+    assert!(
+        (here.x - 1.0).abs() < 1e-9 && here.y.abs() < 1e-9 && here.theta.abs() < 1e-9,
+        "{here:?}"
+    );
+}
+
+#[test]
+fn rotate_7_stops_before_the_image_edge_and_gives_up_when_lost() {
+    let mem = planned(40.0);
+    let mut r = rotate7::Rotate7::new("rotate_7", mem.clone());
+    enter(&mut r, &mem, 0.0, at(1.0), at_bearing(0.0, 50.0));
+    // 0.05 rad is 18 px at f = 361 px: 50 + 18 passes 80 − 10 px.
+    assert_eq!(
+        tick(&mut r, &mem, 0.1, at(1.0), at_bearing(-0.05, 55.0)).status,
+        Status::Event("edge")
+    );
+    // Lost: stand still; the event comes on the `lost_frames`-th frame without it.
+    let lost_frames = mem.lock().gains.lost_frames;
+    enter(&mut r, &mem, 1.0, at(1.0), at_bearing(0.0, 0.0));
+    for k in 1..lost_frames {
+        let step = tick(&mut r, &mem, 1.0 + k as f64 * 0.1, at(1.0), nothing());
+        assert_eq!((step.status, step.output.drive), (Status::Running, DriveCommand::Stop));
+    }
+    assert_eq!(
+        tick(&mut r, &mem, 2.0, at(1.0), nothing()).status,
+        Status::Event("lost")
+    );
+}
+
+#[test]
+fn the_blind_manoeuvre_turns_travels_and_faces_the_ball_by_odometry() {
+    let mem = memory();
+    let pl = plan(Pose2::new(1.5, 0.8, 0.0), 0.9, 0.4);
+    mem.with(|m| {
+        m.plan = Some(pl);
+        m.map = Pose2::default();
+    });
+    let mut rot = Manoeuvre::new("rotate_odo", mem.clone(), Part::RotateOdo);
+    enter(&mut rot, &mem, 0.0, Pose2::new(1.5, 0.8, 0.0), nothing());
+    assert!(mem.lock().blind, "entering the blind part tells the perception");
+    let step = tick(&mut rot, &mem, 0.1, Pose2::new(1.5, 0.8, 0.0), nothing());
+    assert_eq!(step.status, Status::Running);
+    assert_eq!(turn_rate(&step).signum(), pl.rotation.signum());
+    let facing = Pose2::new(1.5, 0.8, pl.travel_heading);
+    assert_eq!(
+        tick(&mut rot, &mem, 0.2, facing, nothing()).status,
+        Status::Event("rotated")
+    );
+    let mut travel = Manoeuvre::new("travel", mem.clone(), Part::Travel);
+    enter(&mut travel, &mem, 0.2, facing, nothing());
+    let step = tick(&mut travel, &mem, 0.3, facing, nothing());
+    assert!(twist(&step).v != 0.0, "{step:?}");
+    let arrived = Pose2::new(pl.target.0, pl.target.1, pl.travel_heading);
+    assert_eq!(
+        tick(&mut travel, &mem, 0.4, arrived, nothing()).status,
+        Status::Event("arrived")
+    );
+    // φ: the ball is at the frame's origin; the camera looks back, so the body faces +x.
+    let mut phi = Manoeuvre::new("rotate_phi", mem.clone(), Part::RotatePhi);
+    enter(&mut phi, &mem, 0.4, arrived, nothing());
+    assert!(turn_rate(&tick(&mut phi, &mem, 0.5, arrived, nothing())) != 0.0);
+    let done = tick(&mut phi, &mem, 0.6, Pose2::new(pl.target.0, 0.0, 0.01), nothing());
+    assert_eq!(done.status, Status::Event("facing"));
+    assert_eq!(done.output.drive, DriveCommand::Stop);
+}
+
+#[test]
+fn look_clears_blind_settles_then_searches_away_from_the_last_turn() {
+    let mem = memory();
+    mem.with(|m| {
+        m.blind = true;
+        m.last_turn = 1.0;
+    });
+    let mut look = search::Look::new("look", mem.clone(), LookParams::default(), 60.0);
+    enter(&mut look, &mem, 10.0, at(1.0), nothing());
+    assert!(!mem.lock().blind);
+    mem.with(|m| m.last_turn = -1.0); // later turns do not change the first direction
+    assert_eq!(
+        tick(&mut look, &mem, 10.4, at(1.0), nothing()).output.drive,
+        DriveCommand::Stop
+    );
+    assert!(turn_rate(&tick(&mut look, &mem, 10.6, at(1.0), nothing())) < 0.0);
+    assert_eq!(
+        tick(&mut look, &mem, 70.1, at(1.0), nothing()).status,
+        Status::Done(Outcome::Failed(FailureReason::TargetLost))
+    );
+    let mut slow = search::Look::new("look", mem.clone(), LookParams { settle_s: 2.0 }, 60.0);
+    enter(&mut slow, &mem, 0.0, at(1.0), nothing());
+    assert_eq!(
+        tick(&mut slow, &mem, 1.9, at(1.0), nothing()).output.drive,
+        DriveCommand::Stop
+    );
+}
+
+#[test]
+fn final_runs_the_state_1_law_once_then_creeps_and_retries() {
+    let mem = memory();
+    let g = profile().behavior.seven_state.unwrap();
+    let mut f = final_approach::FinalApproach::new("final", mem.clone(), 3);
+    let near = seen(0.28, Some(3.0), [4.0, 10.0], true);
+    enter(&mut f, &mem, 5.0, at(0.5), near);
+    let aux = mem.lock().aux;
+    assert_eq!(aux.arm, Some(-g.k_arm * 10.0));
+    assert_eq!(aux.lights, Some(true));
+    let first = tick(&mut f, &mem, 5.0, at(0.5), near);
+    let mut approach = servo::Approach::new("approach", mem.clone());
+    assert_eq!(first.output, tick(&mut approach, &mem, 5.0, at(0.5), near).output);
+    assert_eq!(first.output.aux.lights, Some(true));
+    let t = twist(&tick(&mut f, &mem, 5.1, at(0.5), near));
+    assert_eq!(t.v, -g.final_speed_mps);
+    assert_eq!(tick(&mut f, &mem, 14.9, at(0.5), near).status, Status::Running);
+    let end = tick(&mut f, &mem, 15.1, at(0.5), near);
+    assert_eq!(end.status, Status::Event("retry"));
+    assert_eq!(end.output.drive, DriveCommand::Stop);
+    assert_eq!(end.output.aux.lights, Some(false));
+    assert_eq!(mem.lock().retries, 1);
+    // The last retry used: retries exhausted.
+    mem.with(|m| m.retries = 3);
+    enter(&mut f, &mem, 20.0, at(0.5), near);
+    tick(&mut f, &mem, 20.0, at(0.5), near);
+    assert_eq!(
+        tick(&mut f, &mem, 30.1, at(0.5), near).status,
+        Status::Done(Outcome::Failed(FailureReason::RetriesExhausted))
+    );
+}
+
+#[test]
+fn back_aways_leave_by_their_distance_then_clear() {
+    let mem = memory();
+    let g = profile().behavior.seven_state.unwrap();
+    let mut retreat = BackAway::new("retreat", mem.clone(), Distance::Retreat(RetreatParams::default()));
+    enter(&mut retreat, &mem, 0.0, at(0.5), nothing());
+    let step = tick(&mut retreat, &mem, 0.1, at(0.6), nothing());
+    assert_eq!(twist(&step).v, g.far_speed_mps, "body forward, away from the pyramid");
+    assert_eq!(
+        tick(&mut retreat, &mem, 0.2, at(0.89), nothing()).status,
+        Status::Running
+    );
+    assert_eq!(
+        tick(&mut retreat, &mem, 0.3, at(0.91), nothing()).status,
+        Status::Event("cleared")
+    );
+    // The dead zone: the socket is 0.43 − 0.1 = 0.33 m from the ball; out to 0.6 m.
+    let mut dz = BackAway::new(
+        "leave_dead_zone",
+        mem.clone(),
+        Distance::DeadZone(LeaveDeadZoneParams::default()),
+    );
+    let close = seen(0.43, Some(60.0), [0.0, 0.0], true);
+    enter(&mut dz, &mem, 0.0, at(0.5), close);
+    assert_eq!(tick(&mut dz, &mem, 0.1, at(0.76), close).status, Status::Running);
+    assert_eq!(
+        tick(&mut dz, &mem, 0.2, at(0.78), close).status,
+        Status::Event("cleared")
+    );
+    // Already past the exit distance: the shortest back-away still runs.
+    let out = seen(1.0, Some(60.0), [0.0, 0.0], true);
+    let p = LeaveDeadZoneParams { min_distance_m: 0.2 };
+    let mut dz = BackAway::new("leave_dead_zone", mem.clone(), Distance::DeadZone(p));
+    enter(&mut dz, &mem, 0.0, at(0.5), out);
+    assert_eq!(tick(&mut dz, &mem, 0.1, at(0.69), out).status, Status::Running);
+    assert_eq!(tick(&mut dz, &mem, 0.2, at(0.71), out).status, Status::Event("cleared"));
+}
+
+#[test]
+fn departure_drives_out_to_the_imprint_distance_then_imprints() {
+    let mem = memory();
+    let mut d = departure::Depart::new("depart", mem.clone());
+    // Docked, the camera is 0.1 m from the ball; it imprints from 0.6 m.
+    let step = tick(&mut d, &mem, 0.1, at(0.0), nothing());
+    assert!(twist(&step).v > 0.0, "body forward: {step:?}");
+    assert_eq!(tick(&mut d, &mem, 0.2, at(0.45), nothing()).status, Status::Running);
+    assert_eq!(
+        tick(&mut d, &mem, 0.3, at(0.5), nothing()).status,
+        Status::Event("stopped")
+    );
+    // Imprint: the first frame skipped, then `imprint_frames` (5); nothing sampled here
+    // (no camera), so the departure fails.
+    let mut im = departure::Imprint::new("imprint", mem.clone());
+    enter(&mut im, &mem, 0.3, at(0.5), nothing());
+    for k in 1..=5 {
+        assert_eq!(
+            tick(&mut im, &mem, 0.3 + k as f64 * 0.1, at(0.5), nothing()).status,
+            Status::Running
+        );
+    }
+    assert_eq!(
+        tick(&mut im, &mem, 0.9, at(0.5), nothing()).status,
+        Status::Done(Outcome::Failed(FailureReason::TargetNeverDetected))
+    );
+    assert!(!mem.lock().imprinted);
+}
+
+#[test]
+fn the_dock_switch_closes_the_guides_and_docks() {
+    let mem = memory();
+    let mut s = contact::DockSwitch::new("dock_switch", mem.clone());
+    assert!(s.tick(&Inputs::empty(0.0)).is_none());
+    let mut i = Inputs::empty(0.1);
+    i.dock_contact = Some(Stamped::new(0.1, true));
+    let step = s.tick(&i).unwrap();
+    assert_eq!(step.status, Status::Done(Outcome::Docked));
+    assert_eq!(step.output.drive, DriveCommand::Stop);
+    assert_eq!(step.output.aux.guides, Some(Guides::Closed));
+}
+
+#[test]
+fn the_memory_perceives_only_outside_the_departure() {
+    let mut m = Memory::from_profile(&profile()).unwrap();
+    // Fixed bands: nothing to imprint, no departure.
+    assert!(matches!(
+        m.begin(&Mission::Departure),
+        Err(MissionError::Unavailable { .. })
+    ));
+    let mut p = profile();
+    p.perception.mode = SegmentationMode::Static;
+    let mut m = Memory::from_profile(&p).unwrap();
+    m.begin(&Mission::Departure).unwrap();
+    m.percept = seen(1.0, None, [0.0, 0.0], false);
+    SharedMemory::perceive(&mut m, &inputs(0.5, at(0.2)));
+    assert_eq!((m.now, m.odo), (0.5, at(0.2)), "time and odometry still follow");
+    assert!(m.percept.view.is_some(), "the perception did not run");
+    m.begin(&Mission::docking()).unwrap();
+    assert_eq!(m.aux.guides, Some(Guides::Open));
+    m.unseen = 2;
+    SharedMemory::perceive(&mut m, &inputs(0.6, at(0.2)));
+    assert!(m.percept.view.is_none(), "no camera: nothing seen");
+    assert_eq!(m.unseen, 2, "only a sighting resets the unseen count");
+}
+
+/// The servo's states as the shipped profile lists them.
+fn servo_states(p: &Profile) -> Vec<String> {
+    match &p.behavior.tree.as_ref().unwrap().nodes["servo"] {
+        NodeSpec::Sequencer { states, .. } => states.clone(),
+        other => panic!("servo is a sequencer, got {other:?}"),
+    }
+}
+
+#[test]
+fn the_selector_maps_percepts_to_states_and_looks_until_the_ellipse_is_seen() {
+    let p = profile();
+    let states = servo_states(&p);
+    let mem = memory();
+    let args = SelectorArgs {
+        node: "servo",
+        states: &states,
+        profile: &p,
+    };
+    let mut sel = SevenState::new(mem.clone(), &args).unwrap();
+    let idx = |name: &str| states.iter().position(|s| s == name).unwrap();
+    let mut select = |current: &str, percept: PyramidPercept| {
+        mem.with(|m| m.percept = percept);
+        sel.select(&Inputs::empty(0.0), idx(current))
+            .map(|i| states[i].as_str())
+    };
+    let from = "search";
+    assert_eq!(select(from, seen(1.5, Some(5.0), [0.0, 0.0], true)), Some("approach"));
+    assert_eq!(select(from, seen(1.5, Some(40.0), [0.0, 0.0], true)), Some("align"));
+    assert_eq!(select(from, seen(2.0, None, [0.0, 0.0], false)), Some("far_ellipse"));
+    let mut blue = nothing();
+    blue.detection.blue = Some(blue_at(80));
+    assert_eq!(select(from, blue), Some("blue_only"));
+    assert_eq!(select("approach", nothing()), Some("search"));
+    assert_eq!(select(from, seen(0.28, Some(40.0), [0.0, 0.0], true)), Some("final"));
+    assert_eq!(
+        select(from, seen(0.43, Some(60.0), [0.0, 0.0], true)),
+        Some("leave_dead_zone")
+    );
+    // A sighting restarts the search clock.
+    mem.with(|m| m.search_start = Some(3.0));
+    select(from, seen(1.5, Some(5.0), [0.0, 0.0], true));
+    assert_eq!(mem.lock().search_start, None);
+    // After region II: keep looking without the ellipse (blue alone does not count)...
+    assert_eq!(select("look", nothing()), None);
+    assert_eq!(select("look", blue), None);
+    assert!(!mem.lock().settling);
+    // ...and select with the threshold widened once it is seen: 18° is not region II.
+    assert_eq!(
+        select("look", seen(1.0, Some(18.0), [0.0, 0.0], true)),
+        Some("approach")
+    );
+    assert!(mem.lock().settling);
+    assert_eq!(
+        select("approach", seen(1.0, Some(18.0), [0.0, 0.0], true)),
+        Some("approach")
+    );
+    mem.with(|m| m.settling = false);
+    assert_eq!(
+        select("approach", seen(1.0, Some(18.0), [0.0, 0.0], true)),
+        Some("align")
+    );
+    // Every servo state of `select_state` but state 7 (align hands over to it) has one.
+    for s in [
+        ServoState::S1Approach,
+        ServoState::S2Align,
+        ServoState::S3FarEllipse,
+        ServoState::S4BlueOnly,
+        ServoState::S5Nothing,
+        ServoState::S6Final,
+        ServoState::LeaveDeadZone,
+    ] {
+        assert!(sel.index(s).is_some(), "{s:?}");
+    }
+    assert_eq!(sel.index(ServoState::S7Rotate), None);
+}
+
+#[test]
+fn the_selector_names_a_missing_state() {
+    let p = profile();
+    let mut states = servo_states(&p);
+    states.retain(|s| s != "look");
+    let args = SelectorArgs {
+        node: "servo",
+        states: &states,
+        profile: &p,
+    };
+    let e = SevenState::new(memory(), &args).err().unwrap();
+    assert!(e.contains("`look`"), "{e}");
+}
