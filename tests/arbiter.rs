@@ -282,3 +282,68 @@ fn an_event_a_nested_sequence_finishes_on_is_routed_by_its_parent() {
     assert_eq!(s.status, Status::Done(Outcome::Failed(FailureReason::FailedToControl)));
     assert!(lone.is_finished());
 }
+
+#[test]
+fn a_sum_ends_with_its_first_childs_event_so_it_can_be_a_sequencer_state() {
+    let near = Emits {
+        name: "field",
+        event: "near",
+        after: 3,
+        ticks: 0,
+    };
+    let push = Scripted::new("avoid", 0.0, 100.0, MotorOutput::twist(0.0, 0.1));
+    let mut s = VectorSum::new("sum", vec![(1.0, Box::new(near)), (1.0, Box::new(push))], 1.0, 1.0);
+    for now in [0.0, 0.1] {
+        assert_eq!(s.tick(&Inputs::empty(now)).unwrap().status, Status::Running);
+    }
+    let step = s.tick(&Inputs::empty(0.2)).unwrap();
+    assert_eq!(step.status, Status::Event("near"));
+    // The sum's command that tick still adds both children's turns.
+    let DriveCommand::Twist(t) = step.output.drive else {
+        panic!()
+    };
+    assert!((t.omega - 0.4).abs() < 1e-12, "{t:?}");
+}
+
+#[test]
+fn a_rear_first_sum_backs_along_the_vector() {
+    let vector = |x, y| MotorOutput::drive(DriveCommand::Vector(MotionVector::new(x, y)));
+    let twist = |s: &mut VectorSum| match s.tick(&Inputs::empty(0.0)).unwrap().output.drive {
+        DriveCommand::Twist(t) => t,
+        other => panic!("{other:?}"),
+    };
+    // Straight behind: back straight at full speed, no turn.
+    let mut s = VectorSum::new(
+        "sum",
+        vec![(1.0, Box::new(Scripted::new("a", 0.0, 1.0, vector(-0.2, 0.0))))],
+        1.0,
+        1.0,
+    )
+    .rear_first();
+    let t = twist(&mut s);
+    assert!((t.v + 0.2).abs() < 1e-12 && t.omega.abs() < 1e-12, "{t:?}");
+    // The same vector leading with the front turns the robot round instead.
+    let mut s = VectorSum::new(
+        "sum",
+        vec![(1.0, Box::new(Scripted::new("a", 0.0, 1.0, vector(-0.2, 0.0))))],
+        1.0,
+        1.0,
+    );
+    let t = twist(&mut s);
+    assert!(
+        t.v.abs() < 1e-12 && (t.omega.abs() - std::f64::consts::PI).abs() < 1e-12,
+        "{t:?}"
+    );
+    // Behind and to the left: backing, the rear swings left, so the body turns right
+    // (clockwise, ω < 0), by the vector's 45° off the rear axis.
+    let mut s = VectorSum::new(
+        "sum",
+        vec![(1.0, Box::new(Scripted::new("a", 0.0, 1.0, vector(-0.1, 0.1))))],
+        1.0,
+        1.0,
+    )
+    .rear_first();
+    let t = twist(&mut s);
+    assert!(t.v < 0.0, "{t:?}");
+    assert!((t.omega + std::f64::consts::FRAC_PI_4).abs() < 1e-12, "{t:?}");
+}

@@ -164,3 +164,67 @@ fn raposas_tree_builds_and_a_transition_out_of_its_sequence_is_refused() {
     assert_eq!(at, Some(line));
     assert!(msg.contains("`look` is not a state of `region_2`"), "{msg}");
 }
+
+/// The problem reported at `path` (others may follow from it).
+fn problem_at<'e>(e: &'e ConfigError, path: &str) -> (&'e str, Option<usize>, &'e str) {
+    let p = e
+        .problems()
+        .iter()
+        .find(|p| p.path == path)
+        .unwrap_or_else(|| panic!("no problem at {path}: {e}"));
+    (p.path.as_str(), p.line, p.message.as_str())
+}
+
+fn avoid_shipped() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/bujold-avoid.toml")).unwrap()
+}
+
+/// `profiles/bujold-avoid.toml` with `from` replaced by `to` (which must occur once), and
+/// the line `from` starts on.
+fn avoid_edited(from: &str, to: &str) -> (String, usize) {
+    let src = avoid_shipped();
+    assert_eq!(src.matches(from).count(), 1, "`{from}` must occur once");
+    let line = src[..src.find(from).unwrap()].matches('\n').count() + 1;
+    (src.replacen(from, to, 1), line)
+}
+
+#[test]
+fn an_unknown_sensor_kind_names_its_line_and_the_registered_kinds() {
+    let (src, line) = avoid_edited("kind = \"range\"", "kind = \"lidar\"");
+    let e = build_error(&src);
+    // The avoid leaf, which needs a range finder, is refused too (at its own line).
+    let (_, at, msg) = problem_at(&e, "sensors[0].kind");
+    assert_eq!(at, Some(line));
+    assert!(msg.contains("`lidar`") && msg.contains("range"), "{msg}");
+}
+
+#[test]
+fn a_sensors_bad_params_are_refused_by_its_kind() {
+    let (src, _) = avoid_edited("beams = 19,", "beams = 0,");
+    let e = build_error(&src);
+    let (_, _, msg) = problem_at(&e, "sensors[0].params");
+    assert!(msg.contains("beams"), "{msg}");
+}
+
+#[test]
+fn a_leaf_needing_a_sensor_the_profile_lacks_names_the_leaf() {
+    let src = avoid_shipped();
+    let cut = src.find("\n[[sensors]]\n").unwrap() + 1;
+    let end = cut + src[cut..].find("\n\n").unwrap();
+    let src = format!("{}{}", &src[..cut], &src[end + 2..]);
+    let line = src[..src.find("schema = \"avoid_obstacles\"").unwrap()]
+        .matches('\n')
+        .count()
+        + 1;
+    let e = build_error(&src);
+    let (path, at, msg) = only_problem(&e);
+    assert_eq!(path, "behavior.tree.nodes.avoid.schema");
+    assert_eq!(at, Some(line));
+    assert!(msg.contains("[[sensors]]") && msg.contains("range"), "{msg}");
+}
+
+#[test]
+fn the_avoid_profile_builds() {
+    let p = Profile::parse(&avoid_shipped(), Path::new("bujold-avoid.toml")).unwrap();
+    assert!(agent_for(&p).is_ok());
+}

@@ -6,16 +6,21 @@ use crate::schemas::{Behavior, DriveCommand, Feedback, Inputs, MotionVector, Mot
 
 /// Sums the active children's drive outputs, each scaled by its gain.
 ///
-/// `Vector` outputs are summed as vectors (then clipped to `max_speed` and turned into a
-/// twist by the heading controller with gain `k_theta`); every other drive command is
-/// summed as a twist. Auxiliary commands merge in list order (earlier children win).
-/// The first child to report `Done` ends the sum with that outcome. With no active child
-/// the arbiter is inactive.
+/// `Vector` outputs (body-frame velocities, Arkin's motion vectors) are summed as vectors,
+/// clipped to `max_speed` and turned into a twist by the heading controller with gain
+/// `k_theta`, for a robot that leads with its front or, with [`VectorSum::rear_first`],
+/// its rear (a robot backing into its dock follows the vector rear first instead of
+/// turning round). Every other drive command is summed as a twist. Auxiliary commands
+/// merge in list order (earlier children win). The first child (in list order) to end
+/// with an outcome or an event ends the sum with it, so a sum can be a sequencer's state
+/// whose leaf decides when it is over. With no active child the arbiter is inactive.
 pub struct VectorSum {
     name: String,
     children: Vec<(f64, Box<dyn Behavior>)>,
     max_speed: f64,
     k_theta: f64,
+    /// −1 when the robot follows the summed vector rear first, +1 front first.
+    lead: f64,
     decision: Decision,
 }
 
@@ -28,7 +33,14 @@ impl VectorSum {
             children,
             max_speed,
             k_theta,
+            lead: 1.0,
         }
+    }
+
+    /// Follows the summed vector rear first (the robot drives backwards along it).
+    pub fn rear_first(mut self) -> Self {
+        self.lead = -1.0;
+        self
     }
 
     /// The last tick's decision.
@@ -70,7 +82,7 @@ impl Behavior for VectorSum {
             }
             aux = aux.or(step.output.aux);
             feedback.get_or_insert(step.feedback);
-            if status == Status::Running && matches!(step.status, Status::Done(_)) {
+            if status == Status::Running {
                 status = step.status;
             }
         }
@@ -80,8 +92,10 @@ impl Behavior for VectorSum {
             return None;
         }
         if any_vec {
-            let t = vec_sum.clip(self.max_speed).to_twist(self.k_theta);
-            tw.v += t.v;
+            // In the lead's frame (rotated half a turn when leading with the rear), the
+            // heading controller steers the leading end along the vector.
+            let t = vec_sum.clip(self.max_speed).scale(self.lead).to_twist(self.k_theta);
+            tw.v += self.lead * t.v;
             tw.omega += t.omega;
         }
         let output = MotorOutput {

@@ -7,6 +7,7 @@
 
 pub mod agent;
 pub mod bujold;
+pub mod common;
 pub mod composed;
 pub mod raposa;
 pub mod registry;

@@ -32,8 +32,8 @@
 
 use crate::arbiter::{Next, Priority, Selector, Sequencer, VectorSum};
 use crate::config::ConfigError;
-use crate::profile::Profile;
-use crate::profile::tree::{FINISH, NodeSpec, TreeSpec};
+use crate::profile::tree::{FINISH, Lead, NodeSpec, TreeSpec};
+use crate::profile::{Profile, RANGE_KIND, RangeParams};
 use crate::schemas::Behavior;
 use serde::de::DeserializeOwned;
 use std::collections::BTreeMap;
@@ -50,6 +50,32 @@ pub struct LeafArgs<'a> {
 }
 
 impl LeafArgs<'_> {
+    /// Index of the profile's first `[[sensors]]` entry of kind `kind` (the leaf reads it
+    /// as [`Inputs::sensor`](crate::schemas::Inputs::sensor)).
+    ///
+    /// # Errors
+    /// A message saying the leaf needs such a sensor and the profile declares none.
+    pub fn sensor(&self, kind: &str) -> Result<usize, String> {
+        self.profile
+            .sensors
+            .iter()
+            .position(|s| s.kind == kind)
+            .ok_or_else(|| format!("needs a [[sensors]] entry of kind `{kind}`, and the profile declares none"))
+    }
+
+    /// Index of the profile's first `[[actuators]]` entry of kind `kind` (the leaf
+    /// commands it through [`Auxiliary::actuators`](crate::schemas::Auxiliary::actuators)).
+    ///
+    /// # Errors
+    /// A message saying the leaf needs such an actuator and the profile declares none.
+    pub fn actuator(&self, kind: &str) -> Result<usize, String> {
+        self.profile
+            .actuators
+            .iter()
+            .position(|a| a.kind == kind)
+            .ok_or_else(|| format!("needs an [[actuators]] entry of kind `{kind}`, and the profile declares none"))
+    }
+
     /// Deserializes the node's params into the schema's own tuning struct (use
     /// `#[serde(deny_unknown_fields, default)]` so a misspelt field is refused and an
     /// absent one keeps its default).
@@ -92,10 +118,15 @@ impl SelectorArgs<'_> {
 /// Builds one selector; the error says what the sequencer lacks.
 pub type SelectorFactory<C> = dyn Fn(&C, &SelectorArgs<'_>) -> Result<Box<dyn Selector>, String> + Send + Sync;
 
-/// Schemas and selectors by name (see the module docs).
+/// Checks a device kind's `params` table; the error names the field.
+pub type KindCheck = dyn Fn(&toml::Table) -> Result<(), String> + Send + Sync;
+
+/// Schemas, selectors and device kinds by name (see the module docs).
 pub struct Registry<C> {
     leaves: BTreeMap<String, Box<LeafFactory<C>>>,
     selectors: BTreeMap<String, Box<SelectorFactory<C>>>,
+    sensor_kinds: BTreeMap<String, Box<KindCheck>>,
+    actuator_kinds: BTreeMap<String, Box<KindCheck>>,
 }
 
 impl<C> Default for Registry<C> {
@@ -105,12 +136,39 @@ impl<C> Default for Registry<C> {
 }
 
 impl<C> Registry<C> {
-    /// An empty registry.
+    /// A registry with no schemas, knowing the device kinds the crate ships (the
+    /// [`RANGE_KIND`] range finder).
     pub fn new() -> Self {
-        Self {
+        let mut r = Self {
             leaves: BTreeMap::new(),
             selectors: BTreeMap::new(),
-        }
+            sensor_kinds: BTreeMap::new(),
+            actuator_kinds: BTreeMap::new(),
+        };
+        r.register_sensor_kind(RANGE_KIND, |p| RangeParams::from_table(p).map(|_| ()));
+        r
+    }
+
+    /// Registers (or replaces) a sensor kind a profile's `[[sensors]]` may declare, with
+    /// the check of its `params`.
+    pub fn register_sensor_kind(
+        &mut self,
+        kind: impl Into<String>,
+        check: impl Fn(&toml::Table) -> Result<(), String> + Send + Sync + 'static,
+    ) -> &mut Self {
+        self.sensor_kinds.insert(kind.into(), Box::new(check));
+        self
+    }
+
+    /// Registers (or replaces) an actuator kind a profile's `[[actuators]]` may declare,
+    /// with the check of its `params`.
+    pub fn register_actuator_kind(
+        &mut self,
+        kind: impl Into<String>,
+        check: impl Fn(&toml::Table) -> Result<(), String> + Send + Sync + 'static,
+    ) -> &mut Self {
+        self.actuator_kinds.insert(kind.into(), Box::new(check));
+        self
     }
 
     /// Registers (or replaces) the schema `name`.
@@ -153,6 +211,40 @@ impl<C> Registry<C> {
             )]));
         };
         let mut problems = Vec::new();
+        let devices = profile
+            .sensors
+            .iter()
+            .map(|s| ("sensors", "sensor", &s.kind, &s.params, &self.sensor_kinds))
+            .chain(
+                profile
+                    .actuators
+                    .iter()
+                    .map(|a| ("actuators", "actuator", &a.kind, &a.params, &self.actuator_kinds)),
+            );
+        let (mut n_sensor, mut n_actuator) = (0, 0);
+        for (table, what, kind, params, kinds) in devices {
+            let n = if table == "sensors" {
+                &mut n_sensor
+            } else {
+                &mut n_actuator
+            };
+            let at = format!("{table}[{}]", *n);
+            *n += 1;
+            match kinds.get(kind.as_str()) {
+                None => {
+                    let known: Vec<&str> = kinds.keys().map(String::as_str).collect();
+                    problems.push((
+                        format!("{at}.kind"),
+                        format!("unknown {what} kind `{kind}` (registered: {})", known.join(", ")),
+                    ));
+                }
+                Some(check) => {
+                    if let Err(e) = check(params) {
+                        problems.push((format!("{at}.params"), e));
+                    }
+                }
+            }
+        }
         let root = self.node(tree, &tree.root, profile, ctx, &mut problems, 0);
         match root {
             Some(r) if problems.is_empty() => Ok(r),
@@ -209,7 +301,7 @@ impl<C> Registry<C> {
                         None
                     }
                     Err(e) => {
-                        let at = if e.starts_with("params") {
+                        let at = if e.starts_with("params") && !params.is_empty() {
                             format!("{path}.params")
                         } else {
                             format!("{path}.schema")
@@ -227,11 +319,16 @@ impl<C> Registry<C> {
                 gains,
                 max_speed_mps,
                 k_theta,
+                lead,
                 ..
             } => {
                 let built: Option<Vec<_>> = children(problems).into_iter().collect();
                 let pairs = gains.iter().copied().zip(built?).collect();
-                Some(Box::new(VectorSum::new(name, pairs, *max_speed_mps, *k_theta)))
+                let sum = VectorSum::new(name, pairs, *max_speed_mps, *k_theta);
+                Some(Box::new(match lead {
+                    Lead::Front => sum,
+                    Lead::Rear => sum.rear_first(),
+                }))
             }
             NodeSpec::Sequencer {
                 states,

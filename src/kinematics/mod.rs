@@ -59,7 +59,8 @@ impl DriveModel {
     /// * Speeds are clamped to the limits; non-finite commands become `Stop`.
     /// * `Vector` commands go through the heading controller first.
     /// * On [`DriveModel::TurnOrDrive`], a twist with both parts non-zero becomes the part
-    ///   with the larger wheel-speed demand (|v| against |ω|·d/2).
+    ///   with the larger wheel-speed demand (|v| against |ω|·d/2, as asked, before
+    ///   saturation), then saturated.
     /// * On [`DriveModel::DoubleAckermann`], the yaw rate is limited by the steering
     ///   range at the commanded speed, and turning in place becomes `Stop`.
     pub fn realise(&self, cmd: &DriveCommand, limits: &DriveLimits) -> DriveCommand {
@@ -71,14 +72,17 @@ impl DriveModel {
         match (self, *cmd) {
             (_, DriveCommand::Stop) => DriveCommand::Stop,
             (DriveModel::TurnOrDrive(s), c) => {
+                // The demands as asked, not as saturated: a large heading error asks for
+                // more turning than the base can give, and must still win over driving.
                 let t = c.to_twist();
-                let (v, w) = (clamp_v(t.v), clamp_w(t.omega));
-                if v == 0.0 && w == 0.0 {
+                if t.v == 0.0 && t.omega == 0.0 {
                     DriveCommand::Stop
-                } else if w.abs() * s.effective() / 2.0 > v.abs() {
-                    DriveCommand::Turn { omega: w }
+                } else if t.omega.abs() * s.effective() / 2.0 > t.v.abs() {
+                    DriveCommand::Turn {
+                        omega: clamp_w(t.omega),
+                    }
                 } else {
-                    DriveCommand::Straight { v }
+                    DriveCommand::Straight { v: clamp_v(t.v) }
                 }
             }
             (DriveModel::DoubleAckermann(a), c) => {

@@ -80,6 +80,8 @@ pub struct RangeParams {
     /// Mount: direction of the fan's centre beam, degrees CCW from the body's forward axis
     /// (180: looks backwards).
     pub yaw_deg: f64,
+    /// 1-σ range noise, m (the simulator adds it; for a real device it documents it).
+    pub noise_m: f64,
 }
 
 impl Default for RangeParams {
@@ -91,6 +93,7 @@ impl Default for RangeParams {
             x_m: 0.0,
             y_m: 0.0,
             yaw_deg: 0.0,
+            noise_m: 0.01,
         }
     }
 }
@@ -109,6 +112,12 @@ impl RangeParams {
         }
         if !(p.fov_deg > 0.0 && p.fov_deg <= 360.0) {
             return Err(format!("params.fov_deg: expected (0, 360], got {}", p.fov_deg));
+        }
+        if !(p.noise_m >= 0.0 && p.noise_m.is_finite()) {
+            return Err(format!(
+                "params.noise_m: expected a non-negative distance, got {}",
+                p.noise_m
+            ));
         }
         if !(p.max_range_m > 0.0 && p.max_range_m.is_finite()) {
             return Err(format!(

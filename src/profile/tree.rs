@@ -51,6 +51,17 @@ pub struct TreeSpec {
     pub nodes: BTreeMap<String, NodeSpec>,
 }
 
+/// Which end of the robot leads along a summed motion vector.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Lead {
+    /// Drive forward along it.
+    #[default]
+    Front,
+    /// Back along it.
+    Rear,
+}
+
 /// Where a state's events lead: event name → state name (or [`FINISH`]).
 pub type Transitions = BTreeMap<String, String>;
 
@@ -121,6 +132,10 @@ pub enum NodeSpec {
         max_speed_mps: f64,
         /// Heading gain turning the summed vector into a twist, 1/s.
         k_theta: f64,
+        /// Which end follows the summed vector: `front`, or `rear` for a robot that
+        /// backs along it (Bujold backs into her mother).
+        #[serde(default)]
+        lead: Lead,
         /// As a sequencer state: where its events lead.
         #[serde(default)]
         on: Transitions,

@@ -5,6 +5,7 @@
 //! condition and reports [`Feedback`] and a typed [`Outcome`]. Motion vectors compose by
 //! Arkin's gain-weighted sum ([`MotionVector::weighted_sum`]).
 
+pub mod avoid;
 pub mod behavior;
 pub mod goto_point;
 pub mod inputs;
@@ -18,6 +19,7 @@ pub mod traits;
 pub mod vector;
 pub mod visual_servo;
 
+pub use avoid::AvoidObstacles;
 pub use behavior::{Behavior, FailureReason, Feedback, Outcome, Presence, SchemaBehavior, Status, Step};
 pub use goto_point::PointController;
 pub use inputs::{CameraInput, CameraInputs, Inputs, OdometryReading, SensorInput, SensorInputs, TetherReading};

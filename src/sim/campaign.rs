@@ -8,6 +8,7 @@
 //! instant, same placement error and the same imprint, as in the paper's paired protocol.
 
 use super::SimError;
+use super::robot::SimDevices;
 pub use super::run::{Recording, run_one};
 use super::scenario::{Loaded, RunSpec};
 use super::world::{self, World};
@@ -96,6 +97,9 @@ pub struct Prepared {
     pub world: Arc<World>,
     /// Every run.
     pub runs: Vec<RunSpec>,
+    /// How the simulator simulates the profile's `[[sensors]]` by kind (the built-in
+    /// `range`, plus any kind a caller registers for its own schemas).
+    pub devices: Arc<SimDevices>,
 }
 
 /// Loads backdrops, builds the world and lists the runs of a loaded scenario.
@@ -131,6 +135,7 @@ pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
         loaded,
         world: Arc::new(world),
         runs,
+        devices: Arc::new(SimDevices::default()),
     })
 }
 

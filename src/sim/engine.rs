@@ -37,6 +37,11 @@ pub enum PhaseEnd {
         /// Heading error, rad.
         heading: f64,
     },
+    /// The robot drove into an obstacle (a scenario box).
+    Collision {
+        /// Index of the obstacle's footprint in the world.
+        obstacle: usize,
+    },
     /// Time ran out.
     Timeout,
 }
@@ -61,6 +66,8 @@ pub struct Sim {
     inside: bool,
     docked: bool,
     rng: Rng,
+    /// The run's seed (devices derive their own streams from it).
+    seed: u64,
     t: f64,
     dt: f64,
     frame_count: u64,
@@ -131,6 +138,7 @@ impl Sim {
             inside: false,
             docked: false,
             rng: Rng::new(seed),
+            seed,
             t: 0.0,
             dt,
             frame_count: 0,
@@ -227,6 +235,11 @@ impl Sim {
         });
     }
 
+    /// The run's seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
     /// The profile simulated.
     pub fn profile(&self) -> &Profile {
         &self.profile
@@ -297,7 +310,7 @@ impl Sim {
     }
 
     /// Advances the physics by one loop tick (in substeps of the scenario's `dt`); `Some`
-    /// when the robot docked or caught the entrance edge.
+    /// when the robot docked, caught the entrance edge or drove into an obstacle.
     pub fn advance(&mut self) -> Option<PhaseEnd> {
         let tick_dt = 1.0 / self.profile.loop_.rate_hz;
         let substeps = ((tick_dt / self.dt).round() as usize).max(1);
@@ -308,6 +321,10 @@ impl Sim {
             let mut to = self.motion.step(self.t, dt, &from, &mut self.rng);
             if let Some(t) = &mut self.tether {
                 to = t.step(dt, &to, self.reel);
+            }
+            if let Some(obstacle) = self.world.obstacles.entered(&from, &to, length, width) {
+                self.motion.halt();
+                return Some(PhaseEnd::Collision { obstacle });
             }
             let lowered = self.posture == Posture::Lowered;
             match judge(&self.world.dock, self.inside, &from, &to, length, width, lowered) {

@@ -9,11 +9,13 @@
 //! on the wall clock (`examples/bujold_on_threads.rs`).
 //!
 //! Devices the profile declares in `[[sensors]]` are built by kind from a
-//! [`SimDevices`] table; a user's crate adds simulated devices for its own kinds.
+//! [`SimDevices`] table: the built-in `range` kind casts its beams against the world's
+//! obstacles and the dock ([`super::range`]); a user's crate adds simulated devices for
+//! its own kinds.
 
 use super::engine::{PhaseEnd, Sim};
 use crate::perception::RgbImage;
-use crate::profile::SensorSpec;
+use crate::profile::{RANGE_KIND, RangeParams, SensorSpec};
 use crate::robot::{
     BodyPosture, Camera, DockGuides, DockSensor, Drive, HardwareError, Lights, Odometer, Robot, Sensor, TetherReel,
 };
@@ -30,9 +32,27 @@ pub struct SimRobot(Arc<Mutex<Sim>>);
 pub type SensorFactory = dyn Fn(&SimRobot, &SensorSpec) -> Result<Box<dyn Sensor>, String> + Send + Sync;
 
 /// Simulated devices by kind (see the module docs).
-#[derive(Default)]
 pub struct SimDevices {
     sensors: BTreeMap<String, Box<SensorFactory>>,
+}
+
+impl Default for SimDevices {
+    /// The kinds the simulator ships: the `range` finder.
+    fn default() -> Self {
+        let mut d = Self {
+            sensors: BTreeMap::new(),
+        };
+        d.register_sensor(RANGE_KIND, |sim, spec| {
+            let params = RangeParams::from_table(&spec.params)?;
+            // Each range finder draws its noise from its own stream, named by the sensor.
+            let name = spec.name.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+                (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+            });
+            let seed = sim.with(|s| s.seed()) ^ name;
+            Ok(Box::new(super::range::SimRange::new(sim.clone(), params, seed)))
+        });
+        d
+    }
 }
 
 impl SimDevices {

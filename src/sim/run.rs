@@ -15,7 +15,7 @@ use super::lighting::LightingRun;
 use super::motion::Motion;
 use super::render::SensorParams;
 use super::rng::Rng;
-use super::robot::{SimDevices, SimRobot};
+use super::robot::SimRobot;
 use super::scenario::{RunSpec, Scenario};
 use crate::arbiter::{Lockstep, LoopStatus, NodeTrace, ReactiveLoop, TickOutput};
 use crate::geometry::Pose2;
@@ -55,12 +55,13 @@ pub struct TraceLine<'a> {
 impl Recording<'_> {
     /// A last trace line when the simulator, not the behavior, ended the mission: the
     /// plates closed (`docked`), the robot caught the entrance (`stuck_contact`), or time
-    /// ran out (`timeout`).
+    /// ran out (`timeout`), or it drove into an obstacle (`collision`).
     fn end(&mut self, mission: &'static str, t: f64, end: &PhaseEnd) {
         let Some(w) = self.trace.as_mut() else { return };
         let what = match end {
             PhaseEnd::Docked => "docked",
             PhaseEnd::Stuck { .. } => "stuck_contact",
+            PhaseEnd::Collision { .. } => "collision",
             PhaseEnd::Timeout => "timeout",
             PhaseEnd::Finished(_) => return,
         };
@@ -211,7 +212,7 @@ pub fn run_one(
     let (length, width) = (profile.body.length_m, profile.body.width_m);
     let config = profile.loop_config();
     let sim = SimRobot::new(sim);
-    let robot = sim.robot(&SimDevices::default()).map_err(SimError::Unsupported)?;
+    let robot = sim.robot(&p.devices).map_err(SimError::Unsupported)?;
     let mut rig = Rig {
         step: Lockstep::new(&robot, &config),
         lp: ReactiveLoop::new(agent, config),
@@ -285,6 +286,7 @@ fn record(spec: &RunSpec, sim: &Sim, end: PhaseEnd, imprinted: Option<bool>, man
         PhaseEnd::Finished(Outcome::Docked | Outcome::Completed) => "false_dock".to_string(),
         PhaseEnd::Finished(Outcome::Failed(r)) => r.as_str().to_string(),
         PhaseEnd::Stuck { .. } => "stuck_contact".to_string(),
+        PhaseEnd::Collision { .. } => "collision".to_string(),
         PhaseEnd::Timeout => "timeout".to_string(),
     };
     let time_s = sim.time();

@@ -4,6 +4,7 @@
 //! the dock along its axis, +z up. The mother's (or station's) body lies at x < 0.
 
 use super::SimError;
+use super::obstacles::{Footprint, Obstacles};
 use super::scene::{CircleMark, Material, Prim, Scene, Shape, Tag, albedo, boxed};
 use crate::perception::RgbImage;
 use crate::profile::{CirclesSpec, NamedColor, Profile};
@@ -40,7 +41,8 @@ pub struct ClutterSpec {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ClutterKind {
-    /// A coloured box standing on the ground.
+    /// A coloured box. Standing lower than the robot's body (`z_m` under `body.height_m`)
+    /// it is an obstacle: the robot cannot drive through it, and range finders see it.
     Box,
     /// A flat coloured panel.
     Panel,
@@ -96,6 +98,8 @@ pub struct World {
     pub dock: DockGeometry,
     /// Index of the primitives that form the target (for shadows and tests).
     pub target_prims: Vec<usize>,
+    /// What the robot can bump into and range finders see.
+    pub obstacles: Obstacles,
 }
 
 fn y_axis() -> Vector3<f64> {
@@ -325,8 +329,26 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
             Tag::Backdrop,
         ));
     }
+    // Boxes standing lower than the robot's body are in its way.
+    let solid = clutter
+        .iter()
+        .filter(|c| c.kind == ClutterKind::Box && c.z_m < profile.body.height_m)
+        .map(|c| {
+            let (sx, sy) = (
+                c.size_m.first().copied().unwrap_or(0.1),
+                c.size_m.get(1).copied().unwrap_or(0.1),
+            );
+            Footprint {
+                x0: c.x_m - sx / 2.0,
+                y0: c.y_m - sy / 2.0,
+                x1: c.x_m + sx / 2.0,
+                y1: c.y_m + sy / 2.0,
+            }
+        })
+        .collect();
     Ok(World {
         scene: Scene::on_floor(prims),
+        obstacles: Obstacles::new(solid, &dock),
         dock,
         target_prims,
     })

@@ -6,13 +6,21 @@
 //! Events: `at_dock` when the summed pixel count reaches `dock_total_px`; `off_axis` when
 //! the median viewing angle of the last reliable frames puts the robot more than
 //! `reposition_lateral_m` off the axis (retries left: creeping in would only arrive
-//! misaligned); `lost` when the fiducial has been out of sight for `lost_after_s`.
+//! misaligned); `lost` when the fiducial has been out of sight for `lost_after_s`; with
+//! `near_m`, `near` once the fiducial is that close.
+//!
+//! With `output = "vector"` the leaf proposes the potential field's motion vector instead
+//! of a steering command, so a vector-sum node can add other motor schemas to it (an
+//! avoid-obstacle schema in `profiles/bujold-avoid.toml`); while the fiducial is out of
+//! sight (for up to `lost_after_s`) it follows the field toward the dock pose remembered
+//! from the last sighting and carried on by odometry.
 
 use super::memory::Memory;
-use super::params::ApproachParams;
+use super::memory::raised;
+use super::params::{ApproachOutput, ApproachParams};
 use crate::arbiter::Blackboard;
 use crate::perception::two_block_pose::FiducialView;
-use crate::schemas::{Behavior, Inputs, Step};
+use crate::schemas::{Behavior, DriveCommand, Inputs, MotorOutput, Step};
 
 /// See the module docs.
 pub struct Approach {
@@ -26,19 +34,37 @@ pub struct Approach {
 impl Approach {
     /// A leaf named `name`; at the dock at `dock_total_px`, repositioning at most
     /// `max_retries` times per docking.
+    ///
+    /// # Errors
+    /// A message when `output = "vector"` but the memory's approach has no potential
+    /// field.
     pub fn new(
         name: &str,
         mem: Blackboard<Memory>,
         params: ApproachParams,
         dock_total_px: f64,
         max_retries: u32,
-    ) -> Self {
-        Self {
+    ) -> Result<Self, String> {
+        if params.output == ApproachOutput::Vector && mem.lock().approach.field.is_none() {
+            return Err(
+                "params.output: `vector` needs behavior.approach = \"potential_field\" (ratio steering has no vector)"
+                    .into(),
+            );
+        }
+        Ok(Self {
             name: name.into(),
             mem,
             params,
             dock_total_px,
             max_retries,
+        })
+    }
+
+    /// This tick's proposal for a view.
+    fn propose(&self, m: &Memory, v: &FiducialView) -> MotorOutput {
+        match (self.params.output, m.approach.vector(v)) {
+            (ApproachOutput::Vector, Some(vec)) => MotorOutput::drive(DriveCommand::Vector(vec)).with_aux(raised()),
+            _ => m.approach.act(v),
         }
     }
 
@@ -79,10 +105,26 @@ impl Behavior for Approach {
                 m.plan = Some(m.plan_reposition(&off));
                 Step::event("off_axis", m.hold("approach").output, m.feedback("approach"))
             }
-            (Some(v), _) => Step::running(m.approach.act(&v), m.feedback("approach")),
+            (Some(v), _) if self.params.near_m.is_some_and(|near| v.distance < near) => {
+                Step::event("near", self.propose(&m, &v), m.feedback("approach"))
+            }
+            (Some(v), _) => Step::running(self.propose(&m, &v), m.feedback("approach")),
             (None, _) => {
                 let lost = m.last_seen.is_none_or(|t| m.now - t > self.params.lost_after_s);
-                let hold = m.hold("approach");
+                // Out of sight for a moment: a vector approach follows the field toward
+                // where odometry says the dock is (Murphy: the remembered dock
+                // direction); a steering approach stands still and waits.
+                let remembered = match self.params.output {
+                    ApproachOutput::Vector => m.remembered_pose().and_then(|p| m.approach.vector_at(&p)),
+                    ApproachOutput::Steer => None,
+                };
+                let hold = match remembered {
+                    Some(vec) => Step::running(
+                        MotorOutput::drive(DriveCommand::Vector(vec)).with_aux(raised()),
+                        m.feedback("approach"),
+                    ),
+                    None => m.hold("approach"),
+                };
                 if lost {
                     Step::event("lost", hold.output, hold.feedback)
                 } else {

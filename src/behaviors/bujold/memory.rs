@@ -7,6 +7,7 @@
 //! arbiters), so colour adaptation
 //! follows the light whichever phase runs; the phase schemas then read the views.
 
+use super::median::MedianWindow;
 use super::params::BujoldTuning;
 use crate::behaviors::BuildError;
 use crate::behaviors::composed::SharedMemory;
@@ -16,69 +17,9 @@ use crate::perception::frame_change::FrameChange;
 use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
 use crate::profile::{ApproachKind, Profile};
 use crate::schemas::{
-    Auxiliary, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Percept, PerceptualSchema, Posture,
-    PotentialField, RatioSteering, Step,
+    Auxiliary, DriveCommand, Feedback, Inputs, Mission, MissionError, MotionVector, MotorOutput, Percept,
+    PerceptualSchema, Posture, PotentialField, RatioSteering, Step,
 };
-
-/// Largest median window the repositioning decision may look back over, frames.
-pub const MAX_ALPHA_WINDOW: usize = 64;
-
-/// The last `capacity` samples in a fixed ring, with their median: a robust summary that
-/// ignores the minority of frames a flash, a shadow edge or a glare notch biases, where a
-/// low-pass filter would follow them part of the way.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MedianWindow {
-    values: [f64; MAX_ALPHA_WINDOW],
-    capacity: usize,
-    len: usize,
-    next: usize,
-}
-
-impl MedianWindow {
-    /// An empty window of `capacity` samples (clamped to 1..=[`MAX_ALPHA_WINDOW`]).
-    pub fn new(capacity: usize) -> Self {
-        Self {
-            values: [0.0; MAX_ALPHA_WINDOW],
-            capacity: capacity.clamp(1, MAX_ALPHA_WINDOW),
-            len: 0,
-            next: 0,
-        }
-    }
-
-    /// Forgets every sample.
-    pub fn clear(&mut self) {
-        self.len = 0;
-        self.next = 0;
-    }
-
-    /// Adds a sample, dropping the oldest when full.
-    pub fn push(&mut self, v: f64) {
-        self.values[self.next] = v;
-        self.next = (self.next + 1) % self.capacity;
-        self.len = (self.len + 1).min(self.capacity);
-    }
-
-    /// True when the window holds `capacity` samples.
-    pub fn is_full(&self) -> bool {
-        self.len == self.capacity
-    }
-
-    /// Median of the samples held (`None` when empty); an even count averages the middle two.
-    pub fn median(&self) -> Option<f64> {
-        if self.len == 0 {
-            return None;
-        }
-        let mut v = self.values;
-        let v = &mut v[..self.len];
-        v.sort_by(f64::total_cmp);
-        let m = self.len / 2;
-        Some(if self.len % 2 == 1 {
-            v[m]
-        } else {
-            0.5 * (v[m - 1] + v[m])
-        })
-    }
-}
 
 /// The approach motor schema the profile selects (`behavior.approach`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -90,6 +31,19 @@ pub struct ApproachMotor {
 }
 
 impl ApproachMotor {
+    /// The field's desired velocity for a view, body frame (`None` without a field):
+    /// Arkin's motion vector, for a vector-sum arbiter to combine with others.
+    pub fn vector(&self, view: &FiducialView) -> Option<MotionVector> {
+        self.vector_at(&view.dock_pose())
+    }
+
+    /// The field's desired velocity for a robot at `pose` in the dock frame, body frame.
+    pub fn vector_at(&self, pose: &Pose2) -> Option<MotionVector> {
+        let dd = self.steering.geometry.drive_dir;
+        // `body_vector` is in the frame of the leading end; back to the body frame.
+        self.field.as_ref().map(|pf| pf.body_vector(pose, dd).scale(dd))
+    }
+
     /// The approach command for a view (raised).
     pub fn act(&self, view: &FiducialView) -> MotorOutput {
         let out = match &self.field {
@@ -152,6 +106,9 @@ pub struct Memory {
     pub ever_seen: bool,
     /// When last seen, s.
     pub last_seen: Option<f64>,
+    /// Where the dock was at the last sighting, in the odometry frame (from the planning
+    /// view): the remembered dock direction while the fiducial is out of sight.
+    pub dock_in_odometry: Option<Pose2>,
     /// Side it was last seen on (+1 left of the image centre line, −1 right): the search
     /// turns that way.
     pub last_side: f64,
@@ -250,6 +207,7 @@ impl Memory {
             frame_change: FrameChange::new(),
             ever_seen: false,
             last_seen: None,
+            dock_in_odometry: None,
             last_side: 1.0,
             run_start: None,
             retries: 0,
@@ -295,6 +253,9 @@ impl Memory {
             // The final decision uses the filtered estimate (repositioning the median of
             // `alpha_window`); steering uses it scaled by its trust.
             self.planning = Some(v.with_alpha(a));
+            // dock → odometry: odo = T ⊕ here, so T = odo ⊕ here⁻¹.
+            let here = v.with_alpha(a).dock_pose();
+            self.dock_in_odometry = Some(self.odo.compose(&here.relative(&Pose2::default())));
             *v = v.with_alpha(a * trust);
         }
         self.view = view;
@@ -315,6 +276,12 @@ impl Memory {
         } else {
             tracing::trace!(target: "marsupial::behavior", now, mode = %percept.mode, "no fiducial");
         }
+    }
+
+    /// The robot's pose in the dock frame as odometry carries it on from the last
+    /// sighting (`None` before any).
+    pub fn remembered_pose(&self) -> Option<Pose2> {
+        self.dock_in_odometry.map(|dock| dock.relative(&self.odo))
     }
 
     /// A repositioning plan from an estimated pose in the dock frame (`view`) and this
@@ -397,6 +364,7 @@ impl SharedMemory for Memory {
                 self.unjams = 0;
                 self.ever_seen = false;
                 self.last_seen = None;
+                self.dock_in_odometry = None;
                 self.failing = None;
                 self.plan = None;
                 self.dock_hint = *dock_hint;
@@ -426,32 +394,5 @@ pub fn raised() -> Auxiliary {
     Auxiliary {
         posture: Some(Posture::Raised),
         ..Auxiliary::default()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn median_window_ignores_a_minority_of_outliers_and_forgets_the_oldest() {
-        let mut w = MedianWindow::new(16);
-        assert_eq!(w.median(), None);
-        w.push(3.0);
-        w.push(1.0);
-        assert_eq!(w.median(), Some(2.0));
-        // A steady 0.1 rad with a third of the frames pushed to 0.5 by a flash.
-        w.clear();
-        for k in 0..16 {
-            w.push(if k % 3 == 0 { 0.5 } else { 0.1 });
-        }
-        assert!(w.is_full());
-        assert_eq!(w.median(), Some(0.1));
-        // A full window of new values replaces the old ones entirely.
-        for _ in 0..16 {
-            w.push(-0.2);
-        }
-        assert_eq!(w.median(), Some(-0.2));
-        assert_eq!(w.len, 16);
     }
 }

@@ -20,6 +20,7 @@ pub mod back_in;
 pub mod contact;
 pub mod decide;
 pub mod departure;
+pub mod median;
 pub mod memory;
 pub mod move_away;
 pub mod params;
@@ -95,7 +96,7 @@ pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
                 with(a)?,
                 dock_total,
                 retries,
-            )))
+            )?))
         })
         .register("bujold.decide", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
             let s = &a.profile.success;
@@ -183,6 +184,7 @@ pub fn agent_with(profile: &Profile, registry: &Registry<Blackboard<Memory>>) ->
 /// As [`agent_with`].
 pub fn agent(profile: &Profile) -> Result<BujoldAgent, BuildError> {
     let mut registry = Registry::new();
+    super::common::register(&mut registry);
     register(&mut registry);
     agent_with(profile, &registry)
 }

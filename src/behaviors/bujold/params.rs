@@ -103,6 +103,15 @@ pub struct ApproachParams {
     pub lost_after_s: f64,
     /// A reliable view more than this far off the axis triggers repositioning, m.
     pub reposition_lateral_m: f64,
+    /// What the leaf proposes: a steering command, or the field's motion vector for a
+    /// vector-sum arbiter to combine with other schemas (needs
+    /// `behavior.approach = "potential_field"`).
+    pub output: ApproachOutput,
+    /// When set, the event `near` fires once the fiducial is closer than this to the
+    /// camera, m: the dock area, where a composition may hand over to a state without
+    /// obstacle avoidance (Murphy: the docking behavior lowers avoid's gain near the dock,
+    /// whose own body would repel the robot).
+    pub near_m: Option<f64>,
 }
 
 impl Default for ApproachParams {
@@ -110,8 +119,20 @@ impl Default for ApproachParams {
         Self {
             lost_after_s: 1.5,
             reposition_lateral_m: 0.08,
+            output: ApproachOutput::Steer,
+            near_m: None,
         }
     }
+}
+
+/// What `bujold.approach` proposes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ApproachOutput {
+    /// A turn-or-drive command from the approach motor schema (seed 004 §V).
+    Steer,
+    /// The potential field's body-frame motion vector.
+    Vector,
 }
 
 /// `decide`: average views at the dock and decide to back in or retry.

@@ -177,6 +177,7 @@ pub fn agent_with(profile: &Profile, registry: &Registry<Blackboard<Memory>>) ->
 /// As [`agent_with`].
 pub fn agent(profile: &Profile) -> Result<RaposaAgent, BuildError> {
     let mut registry = Registry::new();
+    super::common::register(&mut registry);
     register(&mut registry);
     agent_with(profile, &registry)
 }
