@@ -6,7 +6,8 @@ mod common;
 use marsupial::arbiter::Blackboard;
 use marsupial::behaviors::bujold::memory::{Memory, RepositionPlan};
 use marsupial::behaviors::bujold::params::*;
-use marsupial::behaviors::bujold::{approach, back_in, contact, decide, departure, move_away, reposition, search};
+use marsupial::behaviors::bujold::{approach, back_in, decide, departure, move_away, reposition, search};
+use marsupial::behaviors::common::docking::{DockSwitch, Imprint, ImprintEnd};
 use marsupial::geometry::Pose2;
 use marsupial::perception::RgbImage;
 use marsupial::perception::two_block_pose::FiducialView;
@@ -312,7 +313,7 @@ fn departure_undocks_imprints_once_and_fails_without_an_imprint() {
     assert_eq!(tick(&mut d, &mem, 6.0, at(0.3), None).status, Status::Running);
     assert_eq!(tick(&mut d, &mem, 9.0, at(0.41), None).status, Status::Event("imprint"));
     // The imprint (here on no frames) failed: imprinting is tried again.
-    let mut i = departure::Imprint::new("imprint", mem.clone(), 2);
+    let mut i = Imprint::new("imprint", mem.clone(), 0, 2, ImprintEnd::Event("imprinted"));
     enter(&mut i, &mem, 9.0, at(0.41));
     assert_eq!(tick(&mut i, &mem, 9.1, at(0.41), None).status, Status::Running);
     assert_eq!(
@@ -338,7 +339,7 @@ fn departure_undocks_imprints_once_and_fails_without_an_imprint() {
 #[test]
 fn the_dock_switch_is_released_only_by_contact() {
     let mem = memory();
-    let mut c = contact::DockSwitch::new("dock_switch", mem.clone());
+    let mut c = DockSwitch::new("dock_switch", mem.clone());
     assert!(c.tick(&Inputs::empty(0.0)).is_none());
     let mut inputs = Inputs::empty(0.1);
     inputs.dock_contact = Some(Stamped::new(0.1, true));

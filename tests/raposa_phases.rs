@@ -7,13 +7,14 @@ mod common;
 
 use marsupial::arbiter::{Blackboard, Selector};
 use marsupial::behaviors::SharedMemory;
+use marsupial::behaviors::common::docking::{DockSwitch, Imprint, ImprintEnd};
 use marsupial::behaviors::raposa::back_away::{BackAway, Distance};
 use marsupial::behaviors::raposa::manoeuvre::{Manoeuvre, Part};
 use marsupial::behaviors::raposa::memory::Memory;
 use marsupial::behaviors::raposa::params::*;
 use marsupial::behaviors::raposa::region2::{plan, robot_in_ball_frame};
 use marsupial::behaviors::raposa::selector::SevenState;
-use marsupial::behaviors::raposa::{ServoState, align, contact, departure, final_approach, rotate7, search, servo};
+use marsupial::behaviors::raposa::{ServoState, align, departure, final_approach, rotate7, search, servo};
 use marsupial::behaviors::registry::SelectorArgs;
 use marsupial::geometry::{Pose2, Twist};
 use marsupial::perception::{BlueRegion, Ellipse, PyramidDetection, PyramidPercept, PyramidView};
@@ -439,7 +440,9 @@ fn departure_drives_out_to_the_imprint_distance_then_imprints() {
     );
     // Imprint: the first frame skipped, then `imprint_frames` (5); nothing sampled here
     // (no camera), so the departure fails.
-    let mut im = departure::Imprint::new("imprint", mem.clone());
+    // As `raposa.imprint` is registered.
+    let frames = mem.lock().schema.imprint_frames_wanted();
+    let mut im = Imprint::new("imprint", mem.clone(), 1, frames, ImprintEnd::Outcome);
     enter(&mut im, &mem, 0.3, at(0.5), nothing());
     for k in 1..=5 {
         assert_eq!(
@@ -457,7 +460,7 @@ fn departure_drives_out_to_the_imprint_distance_then_imprints() {
 #[test]
 fn the_dock_switch_closes_the_guides_and_docks() {
     let mem = memory();
-    let mut s = contact::DockSwitch::new("dock_switch", mem.clone());
+    let mut s = DockSwitch::new("dock_switch", mem.clone());
     assert!(s.tick(&Inputs::empty(0.0)).is_none());
     let mut i = Inputs::empty(0.1);
     i.dock_contact = Some(Stamped::new(0.1, true));

@@ -87,6 +87,17 @@ impl LeafArgs<'_> {
             .try_into()
             .map_err(|e: toml::de::Error| format!("params: {}", e.message().trim()))
     }
+
+    /// Refuses params for a schema that takes none.
+    ///
+    /// # Errors
+    /// A message naming the first param given.
+    pub fn no_params(&self) -> Result<(), String> {
+        match self.params.keys().next() {
+            None => Ok(()),
+            Some(k) => Err(format!("params: unknown field `{k}`: this schema takes no params")),
+        }
+    }
 }
 
 /// Builds one leaf; the error says what is wrong with its params or the profile.

@@ -1,6 +1,7 @@
 //! The departure phases (seed 004 §IV.C): `undock` out of the pouch lowered, `drive_out`
 //! raised with the camera on the flap, stopping at the imprint distance to `imprint` the
-//! blocks' colours, then on out.
+//! blocks' colours, then on out. `imprint` is the common leaf
+//! ([`crate::behaviors::common::docking::Imprint`]), registered as `bujold.imprint`.
 
 use super::memory::{Memory, lowered};
 use super::params::{DriveOutParams, UndockParams};
@@ -102,55 +103,5 @@ impl Behavior for DriveOut {
         } else {
             m.drive_away(self.params.speed_mps, "drive_out")
         })
-    }
-}
-
-/// `bujold.imprint`: stand still for the profile's `perception.imprint.frames` frames,
-/// sampling the middle of each block, then learn the colours; event `imprinted` either
-/// way (the departure's outcome says whether it worked).
-pub struct Imprint {
-    name: String,
-    mem: Blackboard<Memory>,
-    frames_wanted: u32,
-    frames: u32,
-}
-
-impl Imprint {
-    /// A leaf named `name` imprinting over `frames` frames.
-    pub fn new(name: &str, mem: Blackboard<Memory>, frames: u32) -> Self {
-        Self {
-            name: name.into(),
-            mem,
-            frames_wanted: frames,
-            frames: 0,
-        }
-    }
-}
-
-impl Behavior for Imprint {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn enter(&mut self, _inputs: &Inputs<'_>) {
-        self.frames = 0;
-    }
-
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
-        let mut m = self.mem.lock();
-        if let Some(cam) = inputs.camera(0) {
-            m.schema.imprint_frame(&cam.image);
-        }
-        self.frames += 1;
-        if self.frames >= self.frames_wanted {
-            let now = m.now;
-            m.imprinted = m.schema.finish_imprint(now);
-            return Some(Step::event(
-                "imprinted",
-                m.hold("imprint").output,
-                m.feedback("imprint"),
-            ));
-        }
-        Some(m.hold("imprint"))
     }
 }

@@ -17,9 +17,9 @@
 
 pub mod approach;
 pub mod back_in;
-pub mod contact;
 pub mod decide;
 pub mod departure;
+pub mod docking;
 pub mod median;
 pub mod memory;
 pub mod move_away;
@@ -31,6 +31,7 @@ pub mod unjam;
 pub use decide::{Decision, at_dock_decision};
 
 use super::agent::BuildError;
+use super::common::docking::{DockSwitch, Imprint, ImprintEnd};
 use super::composed::Composed;
 use super::registry::{LeafArgs, Registry};
 use crate::arbiter::Blackboard;
@@ -43,29 +44,34 @@ use reposition::PlanFrom;
 /// Registers Bujold's phase schemas (`bujold.undock`, `bujold.search`, ...) in `registry`;
 /// each takes its tuning from its node's `params` (see [`params`]).
 pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
-    fn with<T: serde::de::DeserializeOwned>(args: &LeafArgs<'_>) -> Result<T, String> {
-        args.params()
-    }
     let depth = |a: &LeafArgs<'_>| a.profile.dock.map(|d| d.depth_m).ok_or("needs [dock]");
     registry
         .register("bujold.undock", move |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(departure::Undock::new(a.node, m.clone(), with(a)?, depth(a)?)))
+            Ok(Box::new(departure::Undock::new(
+                a.node,
+                m.clone(),
+                a.params()?,
+                depth(a)?,
+            )))
         })
         .register("bujold.drive_out", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
             let imprint_at = imprint_distance(a.profile).ok_or("needs [dock] and a camera")?;
             Ok(Box::new(departure::DriveOut::new(
                 a.node,
                 m.clone(),
-                with(a)?,
+                a.params()?,
                 imprint_at,
             )))
         })
         .register("bujold.imprint", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            with::<toml::Table>(a).and_then(|t| no_params(&t))?;
-            Ok(Box::new(departure::Imprint::new(
+            a.no_params()?;
+            // Samples from its first tick; the departure goes on whether it worked.
+            Ok(Box::new(Imprint::new(
                 a.node,
                 m.clone(),
+                0,
                 a.profile.perception.imprint.frames,
+                ImprintEnd::Event("imprinted"),
             )))
         })
         .register("bujold.search", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
@@ -79,13 +85,13 @@ pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
             Ok(Box::new(search::Search::new(
                 a.node,
                 m.clone(),
-                with(a)?,
+                a.params()?,
                 rotation,
                 timeout,
             )))
         })
         .register("bujold.unjam", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(unjam::Unjam::new(a.node, m.clone(), with(a)?)))
+            Ok(Box::new(unjam::Unjam::new(a.node, m.clone(), a.params()?)))
         })
         .register("bujold.approach", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
             let dock_total = m.lock().approach.steering.dock_total_px;
@@ -93,7 +99,7 @@ pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
             Ok(Box::new(approach::Approach::new(
                 a.node,
                 m.clone(),
-                with(a)?,
+                a.params()?,
                 dock_total,
                 retries,
             )?))
@@ -103,20 +109,25 @@ pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
             Ok(Box::new(decide::Decide::new(
                 a.node,
                 m.clone(),
-                with(a)?,
+                a.params()?,
                 s.lateral_tolerance_m,
                 s.heading_tolerance_deg.to_radians(),
                 a.profile.behavior.max_retries,
             )))
         })
         .register("bujold.back_in", move |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(back_in::BackIn::new(a.node, m.clone(), with(a)?, depth(a)?)))
+            Ok(Box::new(back_in::BackIn::new(
+                a.node,
+                m.clone(),
+                a.params()?,
+                depth(a)?,
+            )))
         })
         .register("bujold.reposition", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
             Ok(Box::new(reposition::Reposition::new(
                 a.node,
                 m.clone(),
-                with(a)?,
+                a.params()?,
                 PlanFrom::Memory,
             )))
         })
@@ -124,28 +135,25 @@ pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
             Ok(Box::new(reposition::Reposition::new(
                 a.node,
                 m.clone(),
-                with(a)?,
+                a.params()?,
                 PlanFrom::DockHint,
             )))
         })
         .register("bujold.move_away", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(move_away::MoveAway::new(a.node, m.clone(), with(a)?, false)))
+            Ok(Box::new(move_away::MoveAway::new(
+                a.node,
+                m.clone(),
+                a.params()?,
+                false,
+            )))
         })
         .register("bujold.give_up", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(move_away::MoveAway::new(a.node, m.clone(), with(a)?, true)))
+            Ok(Box::new(move_away::MoveAway::new(a.node, m.clone(), a.params()?, true)))
         })
         .register("bujold.dock_switch", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            with::<toml::Table>(a).and_then(|t| no_params(&t))?;
-            Ok(Box::new(contact::DockSwitch::new(a.node, m.clone())))
+            a.no_params()?;
+            Ok(Box::new(DockSwitch::new(a.node, m.clone())))
         });
-}
-
-/// Refuses params for a schema that takes none.
-fn no_params(t: &toml::Table) -> Result<(), String> {
-    match t.keys().next() {
-        None => Ok(()),
-        Some(k) => Err(format!("params: unknown field `{k}`: this schema takes no params")),
-    }
 }
 
 /// Distance from the camera back to the robot's rear, m.

@@ -1,8 +1,11 @@
-//! Schemas any robot's tree can use, whatever its shared memory: they read only the
-//! tick's inputs and their own params. [`register`] adds them to a robot's registry under
-//! their plain names (no robot prefix).
+//! Schemas any robot's tree can use. [`register`] adds those that read only the tick's
+//! inputs and their own params (`avoid_obstacles`) to a robot's registry under their plain
+//! names; the docking leaves every robot has (`imprint`, `dock_switch`, in [`docking`])
+//! reach the robot's perception through its memory's [`docking::DockingMemory`], and each
+//! robot registers them under its own names with its own settings.
 
 pub mod avoid;
+pub mod docking;
 
 use super::registry::{LeafArgs, Registry};
 

@@ -38,8 +38,8 @@
 
 pub mod align;
 pub mod back_away;
-pub mod contact;
 pub mod departure;
+pub mod docking;
 pub mod final_approach;
 pub mod manoeuvre;
 pub mod memory;
@@ -56,6 +56,7 @@ pub use region2::Region2Plan;
 pub use states::{ServoState, select_state};
 
 use super::agent::BuildError;
+use super::common::docking::{DockSwitch, Imprint, ImprintEnd};
 use super::composed::Composed;
 use super::registry::{LeafArgs, Registry};
 use crate::arbiter::Blackboard;
@@ -68,54 +69,54 @@ use manoeuvre::{Manoeuvre, Part};
 /// node's `params` (see [`params`]) and the robot-wide `[behavior.seven_state]`.
 pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
     type Ctx = Blackboard<Memory>;
-    fn with<T: serde::de::DeserializeOwned>(args: &LeafArgs<'_>) -> Result<T, String> {
-        args.params()
-    }
-    fn none(args: &LeafArgs<'_>) -> Result<(), String> {
-        match args.params.keys().next() {
-            None => Ok(()),
-            Some(k) => Err(format!("params: unknown field `{k}`: this schema takes no params")),
-        }
-    }
     let search_timeout = |a: &LeafArgs<'_>| a.profile.behavior.search_timeout_s;
     registry
         .register("raposa.depart", |m: &Ctx, a: &LeafArgs<'_>| {
-            none(a)?;
+            a.no_params()?;
             Ok(Box::new(departure::Depart::new(a.node, m.clone())))
         })
         .register("raposa.imprint", |m: &Ctx, a: &LeafArgs<'_>| {
-            none(a)?;
-            Ok(Box::new(departure::Imprint::new(a.node, m.clone())))
+            a.no_params()?;
+            // The first frame after stopping is skipped (motion blur); the imprint's
+            // result is the departure's.
+            let frames = m.lock().schema.imprint_frames_wanted();
+            Ok(Box::new(Imprint::new(
+                a.node,
+                m.clone(),
+                1,
+                frames,
+                ImprintEnd::Outcome,
+            )))
         })
         .register("raposa.dock_switch", |m: &Ctx, a: &LeafArgs<'_>| {
-            none(a)?;
-            Ok(Box::new(contact::DockSwitch::new(a.node, m.clone())))
+            a.no_params()?;
+            Ok(Box::new(DockSwitch::new(a.node, m.clone())))
         })
         .register("raposa.approach", |m: &Ctx, a: &LeafArgs<'_>| {
-            none(a)?;
+            a.no_params()?;
             Ok(Box::new(servo::Approach::new(a.node, m.clone())))
         })
         .register("raposa.align", |m: &Ctx, a: &LeafArgs<'_>| {
-            none(a)?;
+            a.no_params()?;
             Ok(Box::new(align::Align::new(a.node, m.clone())))
         })
         .register("raposa.far_ellipse", |m: &Ctx, a: &LeafArgs<'_>| {
-            none(a)?;
+            a.no_params()?;
             Ok(Box::new(servo::FarEllipse::new(a.node, m.clone())))
         })
         .register("raposa.blue_only", |m: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(servo::BlueOnly::new(a.node, m.clone(), with(a)?)))
+            Ok(Box::new(servo::BlueOnly::new(a.node, m.clone(), a.params()?)))
         })
         .register("raposa.search", move |m: &Ctx, a: &LeafArgs<'_>| {
             Ok(Box::new(search::Search::new(
                 a.node,
                 m.clone(),
-                with(a)?,
+                a.params()?,
                 search_timeout(a),
             )))
         })
         .register("raposa.final", |m: &Ctx, a: &LeafArgs<'_>| {
-            none(a)?;
+            a.no_params()?;
             Ok(Box::new(final_approach::FinalApproach::new(
                 a.node,
                 m.clone(),
@@ -123,32 +124,40 @@ pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
             )))
         })
         .register("raposa.leave_dead_zone", |m: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(BackAway::new(a.node, m.clone(), Distance::DeadZone(with(a)?))))
+            Ok(Box::new(BackAway::new(
+                a.node,
+                m.clone(),
+                Distance::DeadZone(a.params()?),
+            )))
         })
         .register("raposa.retreat", |m: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(BackAway::new(a.node, m.clone(), Distance::Retreat(with(a)?))))
+            Ok(Box::new(BackAway::new(
+                a.node,
+                m.clone(),
+                Distance::Retreat(a.params()?),
+            )))
         })
         .register("raposa.rotate_7", |m: &Ctx, a: &LeafArgs<'_>| {
-            none(a)?;
+            a.no_params()?;
             Ok(Box::new(rotate7::Rotate7::new(a.node, m.clone())))
         })
         .register("raposa.rotate_odo", |m: &Ctx, a: &LeafArgs<'_>| {
-            none(a)?;
+            a.no_params()?;
             Ok(Box::new(Manoeuvre::new(a.node, m.clone(), Part::RotateOdo)))
         })
         .register("raposa.travel", |m: &Ctx, a: &LeafArgs<'_>| {
-            none(a)?;
+            a.no_params()?;
             Ok(Box::new(Manoeuvre::new(a.node, m.clone(), Part::Travel)))
         })
         .register("raposa.rotate_phi", |m: &Ctx, a: &LeafArgs<'_>| {
-            none(a)?;
+            a.no_params()?;
             Ok(Box::new(Manoeuvre::new(a.node, m.clone(), Part::RotatePhi)))
         })
         .register("raposa.look", move |m: &Ctx, a: &LeafArgs<'_>| {
             Ok(Box::new(search::Look::new(
                 a.node,
                 m.clone(),
-                with(a)?,
+                a.params()?,
                 search_timeout(a),
             )))
         })
