@@ -121,17 +121,6 @@ impl Lockstep {
         }
     }
 
-    /// Restarts odometry integration and forgets every reading (the robot was moved by
-    /// hand, or a new outing begins).
-    pub fn forget(&mut self, model: DriveModel) {
-        self.odometry_source = OdometrySource::new(model);
-        self.frame_stamps.iter_mut().for_each(|s| *s = None);
-        self.sensor_stamps.iter_mut().for_each(|s| *s = None);
-        self.odometry = None;
-        self.tether = None;
-        self.dock_contact = None;
-    }
-
     /// The last frame of each camera (what the loop saw this tick).
     pub fn frames(&self) -> &[RgbImage] {
         &self.frames

@@ -222,40 +222,10 @@ impl<C> Registry<C> {
             )]));
         };
         let mut problems = Vec::new();
-        let devices = profile
-            .sensors
-            .iter()
-            .map(|s| ("sensors", "sensor", &s.kind, &s.params, &self.sensor_kinds))
-            .chain(
-                profile
-                    .actuators
-                    .iter()
-                    .map(|a| ("actuators", "actuator", &a.kind, &a.params, &self.actuator_kinds)),
-            );
-        let (mut n_sensor, mut n_actuator) = (0, 0);
-        for (table, what, kind, params, kinds) in devices {
-            let n = if table == "sensors" {
-                &mut n_sensor
-            } else {
-                &mut n_actuator
-            };
-            let at = format!("{table}[{}]", *n);
-            *n += 1;
-            match kinds.get(kind.as_str()) {
-                None => {
-                    let known: Vec<&str> = kinds.keys().map(String::as_str).collect();
-                    problems.push((
-                        format!("{at}.kind"),
-                        format!("unknown {what} kind `{kind}` (registered: {})", known.join(", ")),
-                    ));
-                }
-                Some(check) => {
-                    if let Err(e) = check(params) {
-                        problems.push((format!("{at}.params"), e));
-                    }
-                }
-            }
-        }
+        let sensors = profile.sensors.iter().map(|d| (&d.kind, &d.params));
+        check_devices("sensors", "sensor", sensors, &self.sensor_kinds, &mut problems);
+        let actuators = profile.actuators.iter().map(|d| (&d.kind, &d.params));
+        check_devices("actuators", "actuator", actuators, &self.actuator_kinds, &mut problems);
         let root = self.node(tree, &tree.root, profile, ctx, &mut problems, 0);
         match root {
             Some(r) if problems.is_empty() => Ok(r),
@@ -393,6 +363,33 @@ impl<C> Registry<C> {
                     }
                 }
                 Some(Box::new(seq))
+            }
+        }
+    }
+}
+
+/// Checks a profile's `[[sensors]]` or `[[actuators]]` (`table`) against the registered
+/// kinds: an unknown kind at `table[i].kind`, params the kind refuses at `table[i].params`.
+fn check_devices<'p>(
+    table: &str,
+    what: &str,
+    devices: impl Iterator<Item = (&'p String, &'p toml::Table)>,
+    kinds: &BTreeMap<String, Box<KindCheck>>,
+    problems: &mut Vec<(String, String)>,
+) {
+    for (i, (kind, params)) in devices.enumerate() {
+        match kinds.get(kind.as_str()) {
+            None => {
+                let known: Vec<&str> = kinds.keys().map(String::as_str).collect();
+                problems.push((
+                    format!("{table}[{i}].kind"),
+                    format!("unknown {what} kind `{kind}` (registered: {})", known.join(", ")),
+                ));
+            }
+            Some(check) => {
+                if let Err(e) = check(params) {
+                    problems.push((format!("{table}[{i}].params"), e));
+                }
             }
         }
     }

@@ -62,6 +62,17 @@ pub enum Lead {
     Rear,
 }
 
+impl Lead {
+    /// +1 for the front, −1 for the rear: the sign of the body-frame x of the lead's
+    /// direction of travel.
+    pub fn sign(self) -> f64 {
+        match self {
+            Lead::Front => 1.0,
+            Lead::Rear => -1.0,
+        }
+    }
+}
+
 /// Where a state's events lead: event name → state name (or [`FINISH`]).
 pub type Transitions = BTreeMap<String, String>;
 

@@ -103,11 +103,6 @@ impl Obstacles {
         Self { solid, walls }
     }
 
-    /// The first solid footprint a robot of `length × width` at `pose` overlaps.
-    pub fn hit(&self, pose: &Pose2, length: f64, width: f64) -> Option<usize> {
-        self.solid.iter().position(|f| f.hits(pose, length, width))
-    }
-
     /// The first solid footprint the move `from` → `to` drives into: the robot overlaps it
     /// at `to`, and either did not at `from` or moved toward its centre. A robot the
     /// proctor placed against a box (overlapping it by a placement error) may drive out
@@ -195,7 +190,10 @@ mod tests {
         assert!(!f.hits(&Pose2::new(1.45, 0.25, q), 0.4, 0.1));
         assert!(f.hits(&Pose2::new(1.25, 0.0, q), 0.4, 0.1));
         let o = Obstacles::new(vec![f], &dock());
-        assert_eq!(o.hit(&Pose2::new(1.1, 0.0, 1.0), 0.2, 0.2), Some(0));
+        assert_eq!(
+            o.entered(&Pose2::new(3.0, 0.0, 1.0), &Pose2::new(1.1, 0.0, 1.0), 0.2, 0.2),
+            Some(0)
+        );
     }
 
     #[test]

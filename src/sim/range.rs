@@ -17,13 +17,9 @@ pub struct SimRange {
 }
 
 impl SimRange {
-    /// A range finder with `params` on the robot of `sim`, its noise drawn from `seed`.
-    pub fn new(sim: SimRobot, params: RangeParams, seed: u64) -> Self {
-        Self {
-            sim,
-            params,
-            rng: Rng::new(seed),
-        }
+    /// A range finder with `params` on the robot of `sim`, its noise drawn from `rng`.
+    pub fn new(sim: SimRobot, params: RangeParams, rng: Rng) -> Self {
+        Self { sim, params, rng }
     }
 }
 

@@ -14,6 +14,7 @@
 //! its own kinds.
 
 use super::engine::{PhaseEnd, Sim};
+use super::rng::Rng;
 use crate::perception::RgbImage;
 use crate::profile::{RANGE_KIND, RangeParams, SensorSpec};
 use crate::robot::{
@@ -45,11 +46,8 @@ impl Default for SimDevices {
         d.register_sensor(RANGE_KIND, |sim, spec| {
             let params = RangeParams::from_table(&spec.params)?;
             // Each range finder draws its noise from its own stream, named by the sensor.
-            let name = spec.name.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-                (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-            });
-            let seed = sim.with(|s| s.seed()) ^ name;
-            Ok(Box::new(super::range::SimRange::new(sim.clone(), params, seed)))
+            let rng = Rng::named(sim.with(|s| s.seed()), &spec.name);
+            Ok(Box::new(super::range::SimRange::new(sim.clone(), params, rng)))
         });
         d
     }

@@ -70,10 +70,7 @@ impl AvoidLeaf {
                 gain: params.gain_mps,
                 cap: params.cap,
                 swirl: params.swirl,
-                lead: match params.lead {
-                    Lead::Front => 1.0,
-                    Lead::Rear => -1.0,
-                },
+                lead: params.lead.sign(),
             },
             side: None,
         }
