@@ -7,9 +7,12 @@
 //!   drives into, from the same starts and seeds.
 
 use marsupial::behaviors::agent_for;
+use marsupial::robot::{HardwareError, Sensor};
 use marsupial::sim::campaign;
+use marsupial::sim::robot::SimDevices;
 use marsupial::sim::scenario::Scenario;
 use std::path::Path;
+use std::sync::Arc;
 use toml::Table;
 
 fn read_table(file: &str) -> Table {
@@ -78,6 +81,11 @@ fn bujold_avoid_is_bujold_but_for_the_listed_keys() {
 /// Runs two of `scenarios/bujold-avoid.toml`'s starts, one trial each; `avoid_off` sets
 /// the avoid schema's gain to 0 as `scenarios/bujold-avoid-off.toml` does.
 fn run(avoid_off: bool) -> Vec<campaign::RunRecord> {
+    run_with(avoid_off, |_| {})
+}
+
+/// As [`run`], letting `devices` change how the simulator simulates sensor kinds.
+fn run_with(avoid_off: bool, devices: impl FnOnce(&mut SimDevices)) -> Vec<campaign::RunRecord> {
     let file = if avoid_off {
         "scenarios/bujold-avoid-off.toml"
     } else {
@@ -92,7 +100,10 @@ fn run(avoid_off: bool) -> Vec<campaign::RunRecord> {
         .points
         .retain(|p| keep.contains(&p.label.as_deref().unwrap_or("")));
     assert_eq!(loaded.scenario.starts.points.len(), keep.len());
-    let p = campaign::prepare(loaded).unwrap();
+    let mut p = campaign::prepare(loaded).unwrap();
+    let mut sim_devices = SimDevices::default();
+    devices(&mut sim_devices);
+    p.devices = Arc::new(sim_devices);
     campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap().0
 }
 
@@ -109,6 +120,41 @@ fn the_summed_approach_goes_round_the_box_that_stops_the_plain_one() {
         assert_eq!(
             r.outcome, "collision",
             "without avoid, start {} should hit the box: {} after {:.1} s",
+            r.start, r.outcome, r.time_s
+        );
+    }
+}
+
+/// A range finder that never sees anything: every beam reads its maximum range.
+struct Blind {
+    beams: usize,
+    max: f64,
+}
+
+impl Sensor for Blind {
+    fn read(&mut self, values: &mut Vec<f64>) -> Result<(), HardwareError> {
+        values.extend(std::iter::repeat_n(self.max, self.beams));
+        Ok(())
+    }
+}
+
+#[test]
+fn a_campaign_simulates_the_sensor_kinds_its_caller_registers() {
+    // The caller's `range` replaces the built-in one: blind, so avoid never acts, and the
+    // starts that go round the box with the built-in range finder hit it.
+    let records = run_with(false, |d| {
+        d.register_sensor("range", |_, spec| {
+            let p = marsupial::profile::RangeParams::from_table(&spec.params)?;
+            Ok(Box::new(Blind {
+                beams: p.beams,
+                max: p.max_range_m,
+            }))
+        });
+    });
+    for r in records {
+        assert_eq!(
+            r.outcome, "collision",
+            "with a blind range finder, start {} should hit the box: {} after {:.1} s",
             r.start, r.outcome, r.time_s
         );
     }
