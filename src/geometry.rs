@@ -76,6 +76,16 @@ impl Pose2 {
     pub fn is_finite(&self) -> bool {
         self.x.is_finite() && self.y.is_finite() && self.theta.is_finite()
     }
+
+    /// Distance between the two poses' positions, m (headings ignored).
+    ///
+    /// ```
+    /// use marsupial::geometry::Pose2;
+    /// assert_eq!(Pose2::new(1.0, 1.0, 0.3).distance(&Pose2::new(4.0, 5.0, -1.0)), 5.0);
+    /// ```
+    pub fn distance(&self, other: &Pose2) -> f64 {
+        (self.x - other.x).hypot(self.y - other.y)
+    }
 }
 
 /// A body-frame velocity: forward speed `v` (m/s) and yaw rate `omega` (rad/s, CCW positive).

@@ -151,6 +151,20 @@ impl Step {
             status: Status::Done(outcome),
         }
     }
+
+    /// This step, ending the current sequencer state with `event` (see [`Step::event`]).
+    pub fn with_event(self, event: &'static str) -> Self {
+        Self {
+            status: Status::Event(event),
+            ..self
+        }
+    }
+
+    /// This step as a final one with `outcome` (see [`Step::done`]: the base stops, the
+    /// auxiliary commands and feedback are kept).
+    pub fn finishing(self, outcome: Outcome) -> Self {
+        Self::done(outcome, self.output, self.feedback)
+    }
 }
 
 /// A behavior: ticked by the arbiter; returns `None` when its activation condition does

@@ -364,7 +364,7 @@ impl Sim {
             let (dl, dr) = (enc.left - self.encoder_ref.0, enc.right - self.encoder_ref.1);
             self.encoder_ref = (enc.left, enc.right);
             self.odometry.update_wheels(dl, dr, dt);
-            self.path_m += (self.pose.x - from.x).hypot(self.pose.y - from.y);
+            self.path_m += self.pose.distance(&from);
             self.t += dt;
             if self.t >= self.next_track {
                 self.track.push([self.t, self.pose.x, self.pose.y, self.pose.theta]);

@@ -97,13 +97,11 @@ impl Behavior for Approach {
             _ => None,
         };
         let step = match (m.view, off_axis) {
-            (Some(v), _) if v.total_px as f64 >= self.dock_total_px => {
-                Step::event("at_dock", m.hold("approach").output, m.feedback("approach"))
-            }
+            (Some(v), _) if v.total_px as f64 >= self.dock_total_px => m.hold("approach").with_event("at_dock"),
             (Some(_), Some(off)) => {
                 m.retries += 1;
                 m.plan = Some(m.plan_reposition(&off));
-                Step::event("off_axis", m.hold("approach").output, m.feedback("approach"))
+                m.hold("approach").with_event("off_axis")
             }
             (Some(v), _) if self.params.near_m.is_some_and(|near| v.distance < near) => {
                 Step::event("near", self.propose(&m, &v), m.feedback("approach"))
@@ -125,11 +123,7 @@ impl Behavior for Approach {
                     ),
                     None => m.hold("approach"),
                 };
-                if lost {
-                    Step::event("lost", hold.output, hold.feedback)
-                } else {
-                    hold
-                }
+                if lost { hold.with_event("lost") } else { hold }
             }
         };
         Some(step)

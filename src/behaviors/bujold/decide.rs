@@ -111,7 +111,7 @@ impl Behavior for Decide {
             if m.now - self.started > self.params.lost_after_s {
                 // Lost at the gate: back off and look again.
                 m.retries += 1;
-                return Some(Step::event("lost", m.hold("decide").output, m.feedback("decide")));
+                return Some(m.hold("decide").with_event("lost"));
             }
             return Some(m.hold("decide"));
         }
@@ -146,7 +146,7 @@ impl Behavior for Decide {
             ..self.samples[0]
         };
         m.plan = Some(m.plan_reposition(&mean));
-        Some(Step::event("misaligned", m.hold("decide").output, m.feedback("decide")))
+        Some(m.hold("decide").with_event("misaligned"))
     }
 }
 

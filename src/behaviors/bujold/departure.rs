@@ -92,14 +92,14 @@ impl Behavior for DriveOut {
         let m = self.mem.lock();
         let out = m.travelled(&m.departure_mark);
         Some(if !m.imprinted && out >= self.imprint_at {
-            Step::event("imprint", m.hold("drive_out").output, m.feedback("drive_out"))
+            m.hold("drive_out").with_event("imprint")
         } else if out >= self.params.distance_m {
             let outcome = if m.imprinted {
                 Outcome::Completed
             } else {
                 Outcome::Failed(FailureReason::TargetNeverDetected)
             };
-            Step::done(outcome, m.hold("drive_out").output, m.feedback("drive_out"))
+            m.hold("drive_out").finishing(outcome)
         } else {
             m.drive_away(self.params.speed_mps, "drive_out")
         })

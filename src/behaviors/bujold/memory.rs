@@ -344,7 +344,7 @@ impl Memory {
 
     /// Distance travelled from `mark` to this tick's odometry pose, m.
     pub fn travelled(&self, mark: &Pose2) -> f64 {
-        (self.odo.x - mark.x).hypot(self.odo.y - mark.y)
+        self.odo.distance(mark)
     }
 }
 

@@ -4,11 +4,11 @@
 //! left in memory (a timeout when none did): every failure close to the dock first
 //! moves away from the entrance, then stops.
 
-use super::memory::{Memory, raised};
+use super::memory::Memory;
 use super::params::MoveAwayParams;
 use crate::arbiter::Blackboard;
 use crate::geometry::Pose2;
-use crate::schemas::{Behavior, FailureReason, Inputs, MotorOutput, Outcome, Step};
+use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, Step};
 
 /// See the module docs.
 pub struct MoveAway {
@@ -53,13 +53,9 @@ impl Behavior for MoveAway {
         }
         Some(if self.give_up {
             let reason = m.failing.unwrap_or(FailureReason::Timeout);
-            Step::done(
-                Outcome::Failed(reason),
-                MotorOutput::stop().with_aux(raised()),
-                m.feedback(phase),
-            )
+            m.hold(phase).finishing(Outcome::Failed(reason))
         } else {
-            Step::event("done", m.hold(phase).output, m.feedback(phase))
+            m.hold(phase).with_event("done")
         })
     }
 }

@@ -159,7 +159,7 @@ impl Behavior for Reposition {
                 if err.abs() < tol {
                     m.alpha_filtered = None;
                     m.alpha_window.clear();
-                    Step::event("aligned", m.hold(phase).output, m.feedback(phase))
+                    m.hold(phase).with_event("aligned")
                 } else {
                     m.turn_by(err, phase)
                 }

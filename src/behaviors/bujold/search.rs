@@ -85,17 +85,13 @@ impl Behavior for Search {
             } else {
                 FailureReason::TargetNeverDetected
             };
-            return Some(Step::done(
-                Outcome::Failed(reason),
-                m.hold("search").output,
-                m.feedback("search"),
-            ));
+            return Some(m.hold("search").finishing(Outcome::Failed(reason)));
         }
         if self.jammed(change, now, m.unjams) {
             m.unjams += 1;
             m.last_side = -m.last_side;
             tracing::debug!(target: "marsupial::behavior", now, unjams = m.unjams, "search turn jammed");
-            return Some(Step::event("jammed", m.hold("search").output, m.feedback("search")));
+            return Some(m.hold("search").with_event("jammed"));
         }
         let mut s = self.rotation;
         s.rate *= m.last_side;

@@ -64,7 +64,7 @@ impl Behavior for Unjam {
             return Some(m.turn_by(err, "unjam"));
         }
         if m.travelled(&self.mark) >= p.distance_m || in_stage > 2.0 * p.distance_m / p.speed_mps {
-            return Some(Step::event("cleared", m.hold("unjam").output, m.feedback("unjam")));
+            return Some(m.hold("unjam").with_event("cleared"));
         }
         Some(m.drive_away(p.speed_mps, "unjam"))
     }

@@ -74,7 +74,7 @@ impl Behavior for BackAway {
         let phase = self.phase();
         if m.travelled(&self.mark) >= self.distance {
             m.schema.reset();
-            return Some(m.hold_event("cleared", phase));
+            return Some(m.hold(phase).with_event("cleared"));
         }
         let omega = m.percept.view.map_or(0.0, |v| m.law.turn(v.dev_px[0]));
         let speed = m.gains.far_speed_mps;

@@ -48,7 +48,7 @@ impl Behavior for Depart {
         let m = self.mem.lock();
         Some(match m.ctrl.travel(&m.odo, self.target, false) {
             Some(t) => m.drive(t, "depart"),
-            None => m.hold_event("stopped", "depart"),
+            None => m.hold("depart").with_event("stopped"),
         })
     }
 }

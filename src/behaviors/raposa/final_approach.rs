@@ -8,7 +8,7 @@
 
 use super::memory::Memory;
 use crate::arbiter::Blackboard;
-use crate::schemas::{Behavior, FailureReason, Inputs, MotorOutput, Outcome, Step};
+use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, Step};
 
 /// See the module docs.
 pub struct FinalApproach {
@@ -60,13 +60,11 @@ impl Behavior for FinalApproach {
         m.aux.lights = Some(false);
         m.retries += 1;
         if m.retries > self.max_retries {
-            let out = MotorOutput::stop().with_aux(m.aux);
-            return Some(Step::done(
-                Outcome::Failed(FailureReason::RetriesExhausted),
-                out,
-                m.feedback("state_6"),
-            ));
+            return Some(
+                m.hold("state_6")
+                    .finishing(Outcome::Failed(FailureReason::RetriesExhausted)),
+            );
         }
-        Some(m.hold_event("retry", "state_6"))
+        Some(m.hold("state_6").with_event("retry"))
     }
 }

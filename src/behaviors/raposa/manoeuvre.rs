@@ -62,11 +62,11 @@ impl Behavior for Manoeuvre {
         Some(match self.part {
             Part::RotateOdo => match m.ctrl.rotate(&odo, map.theta + pl.travel_heading) {
                 Some(t) => m.turn(t.omega, "state_2_rotate"),
-                None => m.hold_event("rotated", "state_2_rotate"),
+                None => m.hold("state_2_rotate").with_event("rotated"),
             },
             Part::Travel => match m.ctrl.travel(&odo, map.to_world(pl.target.0, pl.target.1), pl.reverse) {
                 Some(t) => m.drive(t, "state_2_travel"),
-                None => m.hold_event("arrived", "state_2_travel"),
+                None => m.hold("state_2_travel").with_event("arrived"),
             },
             Part::RotatePhi => {
                 // Face the ball from where the robot actually is: the camera looks back.
@@ -76,7 +76,7 @@ impl Behavior for Manoeuvre {
                     Some(t) => m.turn(t.omega, "state_2_rotate_phi"),
                     None => {
                         m.schema.reset();
-                        m.hold_event("facing", "state_2_rotate_phi")
+                        m.hold("state_2_rotate_phi").with_event("facing")
                     }
                 }
             }

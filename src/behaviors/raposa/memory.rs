@@ -184,11 +184,6 @@ impl Memory {
         Step::running(MotorOutput::stop().with_aux(self.aux), self.feedback(phase))
     }
 
-    /// Stand still and end the state with `event`.
-    pub fn hold_event(&self, event: &'static str, phase: &'static str) -> Step {
-        Step::event(event, MotorOutput::stop().with_aux(self.aux), self.feedback(phase))
-    }
-
     /// Turn in place at `omega`, remembering the side (searches start the other way).
     pub fn turn(&mut self, omega: f64, phase: &'static str) -> Step {
         if omega != 0.0 {
@@ -216,7 +211,7 @@ impl Memory {
 
     /// Distance travelled from `mark` to this tick's odometry pose, m.
     pub fn travelled(&self, mark: &Pose2) -> f64 {
-        (self.odo.x - mark.x).hypot(self.odo.y - mark.y)
+        self.odo.distance(mark)
     }
 }
 

@@ -57,14 +57,14 @@ impl Behavior for Rotate7 {
     fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
         let mut m = self.mem.lock();
         let Some(pl) = m.plan else {
-            return Some(m.hold_event("lost", "state_7"));
+            return Some(m.hold("state_7").with_event("lost"));
         };
         let dir = pl.rotation.signum();
         let want = pl.rotation.abs();
         let Some(v) = m.percept.view else {
             // Lost: stop; give up on the vision part after too many frames.
             if self.lost + 1 >= m.gains.lost_frames {
-                return Some(m.hold_event("lost", "state_7"));
+                return Some(m.hold("state_7").with_event("lost"));
             }
             self.last_step = 0.0;
             self.lost += 1;
@@ -85,7 +85,7 @@ impl Behavior for Rotate7 {
             // Reset the odometry origin with the angle rotated by vision.
             let start = Pose2::new(pl.start.x, pl.start.y, pl.start.theta + rotated * dir);
             m.map = m.odo.compose(&start.relative(&Pose2::default()));
-            return Some(m.hold_event(if done { "rotated" } else { "edge" }, "state_7"));
+            return Some(m.hold("state_7").with_event(if done { "rotated" } else { "edge" }));
         }
         self.rotated = rotated;
         self.last_bearing = v.bearing;

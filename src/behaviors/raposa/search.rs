@@ -6,7 +6,7 @@
 use super::memory::Memory;
 use super::params::{LookParams, SearchParams};
 use crate::arbiter::Blackboard;
-use crate::schemas::{Behavior, FailureReason, Inputs, MotorOutput, Outcome, SearchRotation, Step};
+use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, SearchRotation, Step};
 
 /// `raposa.search`, state 5: after `grace_frames` frames with nothing seen, the doubling
 /// search, first away from the side of the last turn; the docking fails (target lost)
@@ -47,12 +47,7 @@ impl Behavior for Search {
         let now = m.now;
         let start = *m.search_start.get_or_insert(now);
         if now - start > self.timeout {
-            let out = MotorOutput::stop().with_aux(m.aux);
-            return Some(Step::done(
-                Outcome::Failed(FailureReason::TargetLost),
-                out,
-                m.feedback("state_5"),
-            ));
+            return Some(m.hold("state_5").finishing(Outcome::Failed(FailureReason::TargetLost)));
         }
         let search = SearchRotation {
             rate: m.gains.search_rate_dps.to_radians() * -m.last_turn,
@@ -109,12 +104,10 @@ impl Behavior for Look {
             return Some(m.hold("state_2_look")); // let the image settle after stopping
         }
         if t > self.timeout {
-            let out = MotorOutput::stop().with_aux(m.aux);
-            return Some(Step::done(
-                Outcome::Failed(FailureReason::TargetLost),
-                out,
-                m.feedback("state_2_look"),
-            ));
+            return Some(
+                m.hold("state_2_look")
+                    .finishing(Outcome::Failed(FailureReason::TargetLost)),
+            );
         }
         let search = SearchRotation {
             rate: m.gains.search_rate_dps.to_radians() * self.first_dir,
