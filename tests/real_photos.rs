@@ -2,7 +2,7 @@
 //! imprint → detect loop on real sensor colour (a ColorChecker's adjacent magenta and cyan
 //! patches). Skips with a message when the photo folder is absent.
 
-use marsupial::cli::image_io::load_rgb;
+use marsupial::image_io::load_rgb;
 use marsupial::perception::{ColorMode, TwoBlockSchema};
 use marsupial::profile::Profile;
 use std::path::{Path, PathBuf};

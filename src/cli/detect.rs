@@ -1,6 +1,6 @@
 //! `marsupial detect`: run the two-block perceptual schema over image files, as a stream.
 
-use super::image_io::{ImageFileError, load_rgb, save_png};
+use crate::image_io::{ImageFileError, load_rgb, save_png};
 use crate::config::ConfigError;
 use crate::perception::overlay::paint_overlay;
 use crate::perception::{RgbImage, TwoBlockPercept, TwoBlockSchema, VisionError};
