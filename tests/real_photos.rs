@@ -3,8 +3,9 @@
 //! patches). Skips with a message when the photo folder is absent.
 
 use marsupial::image_io::load_rgb;
-use marsupial::perception::{ColorMode, TwoBlockSchema};
+use marsupial::perception::ColorMode;
 use marsupial::profile::Profile;
+use marsupial::schemas::TwoBlockSchema;
 use std::path::{Path, PathBuf};
 
 fn photos() -> Option<PathBuf> {

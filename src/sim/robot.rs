@@ -35,7 +35,6 @@ pub struct SimDevices {
     sensors: BTreeMap<String, Box<SensorFactory>>,
 }
 
-
 impl SimDevices {
     /// Registers (or replaces) how the simulator simulates sensor kind `kind`.
     pub fn register_sensor(
