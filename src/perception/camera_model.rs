@@ -10,7 +10,6 @@
 //!   [[c, d], [e, 1]] about the distortion centre. Projection inverts f numerically via a
 //!   monotonic table of the ray's off-axis angle.
 
-use crate::profile::{CameraModelKind, CameraSpec, Mount};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
 /// Pin-hole model with radial distortion.
@@ -134,7 +133,8 @@ impl Fisheye {
     }
 }
 
-/// A camera model.
+/// A camera model. A profile's `[[cameras]]` entry gives one through
+/// `CameraModel::from_spec` (in `profile`).
 #[derive(Debug, Clone, PartialEq)]
 pub enum CameraModel {
     /// Pin-hole.
@@ -144,39 +144,6 @@ pub enum CameraModel {
 }
 
 impl CameraModel {
-    /// The model a profile's camera describes.
-    pub fn from_spec(spec: &CameraSpec) -> Self {
-        match spec.model {
-            CameraModelKind::Pinhole => {
-                let k = spec.pinhole_intrinsics().unwrap_or(crate::profile::Intrinsics {
-                    fx: spec.width_px as f64,
-                    fy: spec.width_px as f64,
-                    cx: spec.width_px as f64 / 2.0,
-                    cy: spec.height_px as f64 / 2.0,
-                    k1: 0.0,
-                    k2: 0.0,
-                });
-                CameraModel::Pinhole(Pinhole {
-                    fx: k.fx,
-                    fy: k.fy,
-                    cx: k.cx,
-                    cy: k.cy,
-                    k1: k.k1,
-                    k2: k.k2,
-                })
-            }
-            CameraModelKind::Fisheye => {
-                let fe = spec.fisheye.clone().unwrap_or(crate::profile::FisheyeSpec {
-                    poly: vec![-(spec.width_px as f64) / 2.0],
-                    center_px: [spec.width_px as f64 / 2.0, spec.height_px as f64 / 2.0],
-                    affine: [1.0, 0.0, 0.0],
-                });
-                let max_rho = (spec.width_px as f64).hypot(spec.height_px as f64);
-                CameraModel::Fisheye(Fisheye::new(fe.poly, fe.center_px, fe.affine, max_rho))
-            }
-        }
-    }
-
     /// Pixel of a camera-frame point.
     pub fn project(&self, p: &Vector3<f64>) -> Option<[f64; 2]> {
         match self {
@@ -194,12 +161,33 @@ impl CameraModel {
     }
 }
 
+/// Where a camera looks on its body: the orientation part of a mounting, in degrees as a
+/// profile's `[cameras.mount]` gives it (a `&profile::Mount` converts into it).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MountAngles {
+    /// Yaw about body +z, degrees (0 looks forward, 180 backward).
+    pub yaw_deg: f64,
+    /// Pitch, degrees (positive looks down).
+    pub pitch_deg: f64,
+    /// Roll about the optical axis, degrees (180 turns the image upside down).
+    pub roll_deg: f64,
+}
+
+impl MountAngles {
+    /// True when the image is upside down (roll near ±180°).
+    pub fn is_flipped(&self) -> bool {
+        let r = self.roll_deg.rem_euclid(360.0);
+        (r - 180.0).abs() < 90.0
+    }
+}
+
 /// Rotation taking camera-frame vectors to the body frame, for a mount.
 ///
 /// With yaw = pitch = roll = 0 the camera looks along body +x with image right = body −y
 /// and image down = body −z. Then: yaw about body +z, pitch about the body's (yawed) +y
 /// (positive looks down), roll about the optical axis (180° turns the image upside down).
-pub fn body_from_camera(mount: &Mount) -> Matrix3<f64> {
+pub fn body_from_camera(mount: impl Into<MountAngles>) -> Matrix3<f64> {
+    let mount = mount.into();
     let r0 = Matrix3::new(0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, -1.0, 0.0);
     let yaw = Rotation3::from_axis_angle(&Vector3::z_axis(), mount.yaw_deg.to_radians());
     let pitch = Rotation3::from_axis_angle(&Vector3::y_axis(), mount.pitch_deg.to_radians());
@@ -249,13 +237,13 @@ mod tests {
 
     #[test]
     fn mounts() {
-        let fwd = body_from_camera(&Mount::default());
+        let fwd = body_from_camera(MountAngles::default());
         assert!((fwd * Vector3::z() - Vector3::x()).norm() < 1e-12);
         assert!(
             (fwd * Vector3::x() + Vector3::y()).norm() < 1e-12,
             "image right is body −y"
         );
-        let back = body_from_camera(&Mount {
+        let back = body_from_camera(MountAngles {
             yaw_deg: 180.0,
             roll_deg: 180.0,
             ..Default::default()
@@ -264,7 +252,7 @@ mod tests {
         // Rolled 180°: image right is body −y again when looking backwards, image down is up.
         assert!((back * Vector3::x() + Vector3::y()).norm() < 1e-12);
         assert!((back * Vector3::y() - Vector3::z()).norm() < 1e-12);
-        let down = body_from_camera(&Mount {
+        let down = body_from_camera(MountAngles {
             pitch_deg: 30.0,
             ..Default::default()
         });

@@ -23,9 +23,34 @@
 use super::image::RgbView;
 use super::sct::Sct;
 use super::segment::{ChromaGate, SctRange};
-use crate::profile::{PerceptionSpec, SegmentationMode};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
+
+/// Adaptive (imprint + adapt + fallback), static (imprint only) or fixed (table values
+/// only) segmentation. A profile's `perception.mode` (re-exported as
+/// `profile::SegmentationMode`); it lives here because the trackers act on it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SegmentationMode {
+    /// Imprint, then adapt every frame; fall back on timeouts (seed 004 Fig. 5).
+    Adaptive,
+    /// Imprint, never adapt (the paper's comparison, Table II).
+    Static,
+    /// The table values alone: no imprint, no adaptation (RAPOSA's operator-tuned HSV
+    /// bands, seed 001 §II.D).
+    Fixed,
+}
+
+impl SegmentationMode {
+    /// The name used in TOML and output.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            SegmentationMode::Adaptive => "adaptive",
+            SegmentationMode::Static => "static",
+            SegmentationMode::Fixed => "fixed",
+        }
+    }
+}
 
 /// Mean and standard deviation of the SCT angles of one colour, radians.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -171,7 +196,8 @@ impl fmt::Display for ColorMode {
     }
 }
 
-/// Tuning of a [`ColorModel`]. `sd_floor`, `sd_ceiling`, `min_l` and `min_chroma` shape the SCT ranges
+/// Tuning of a [`ColorModel`] (a profile's `[perception]` gives them through
+/// `ColorModelParams::from_spec` in `profile`). `sd_floor`, `sd_ceiling`, `min_l` and `min_chroma` shape the SCT ranges
 /// of [`ColorModel::ranges`]; HSV models carry their own limits
 /// ([`HsvLimits`](super::HsvLimits)).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -195,24 +221,6 @@ pub struct ColorModelParams {
     pub adaptive: bool,
     /// Blend rate of adaptation in (0, 1]; 1 is the paper's (replace each frame).
     pub adapt_rate: f64,
-}
-
-impl ColorModelParams {
-    /// The parameters a profile's `[perception]` table sets (adaptive only in
-    /// `adaptive` mode).
-    pub fn from_spec(p: &PerceptionSpec) -> Self {
-        Self {
-            n_sd: p.n_sd,
-            sd_floor: p.sd_floor_deg.to_radians(),
-            sd_ceiling: p.sd_ceiling_deg.to_radians(),
-            min_l: p.min_brightness,
-            min_chroma: p.min_chroma_deg.to_radians(),
-            timeout1: p.timeout1_s,
-            timeout2: p.timeout2_s,
-            adaptive: p.mode == SegmentationMode::Adaptive,
-            adapt_rate: p.adapt_rate,
-        }
-    }
 }
 
 /// The per-colour statistics with the fallback chain. `S` holds every colour's

@@ -18,10 +18,7 @@
 //! +y. Seen from +y the blue edges (behind the ball) appear to the right of the ball, so a
 //! ball left of the blue centre means α > 0.
 
-use super::VisionError;
 use super::pyramid::{PyramidDetection, PyramidPair, PyramidShape};
-use crate::profile::Profile;
-use crate::schemas::Percept;
 use serde::Serialize;
 
 /// The largest angle the quadratic can return, atan(2m/h), rad.
@@ -49,7 +46,8 @@ pub fn alpha_from_k(k: f64, h: f64, m: f64) -> f64 {
     s.clamp(0.0, 1.0).asin()
 }
 
-/// Camera and target constants of the pyramid geometry.
+/// Camera and target constants of the pyramid geometry. A profile gives them through
+/// `PyramidGeometry::from_profile` (in `profile`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PyramidGeometry {
     /// Focal length, px.
@@ -85,32 +83,6 @@ pub struct PyramidView {
 }
 
 impl PyramidGeometry {
-    /// From a profile's first camera and `[fiducial.pyramid]`.
-    ///
-    /// # Errors
-    /// [`VisionError::Profile`] without a pin-hole camera or a pyramid fiducial.
-    pub fn from_profile(profile: &Profile, camera: usize) -> Result<Self, VisionError> {
-        let err = |what: String| VisionError::Profile { what };
-        let pyr = profile
-            .fiducial
-            .pyramid
-            .ok_or_else(|| err(format!("profile `{}` has no [fiducial.pyramid]", profile.name)))?;
-        let cam = profile
-            .cameras
-            .get(camera)
-            .ok_or_else(|| err(format!("profile `{}` has no camera {camera}", profile.name)))?;
-        let k = cam
-            .pinhole_intrinsics()
-            .ok_or_else(|| err(format!("camera `{}` is not a pin-hole camera", cam.name)))?;
-        Ok(Self {
-            f_px: k.fx,
-            principal: [k.cx, k.cy],
-            h: pyr.blue_edge_length_m,
-            m: pyr.edge_to_ball_m,
-            ball_diameter: pyr.ball_diameter_m,
-        })
-    }
-
     /// The proportions the detector's pair filters use.
     pub fn shape(&self) -> PyramidShape {
         PyramidShape {
@@ -202,16 +174,6 @@ impl PyramidPercept {
             view: None,
             image_size,
         }
-    }
-}
-
-impl Percept for PyramidPercept {
-    fn stamp(&self) -> f64 {
-        self.stamp
-    }
-    /// Found when the orange guide is seen (blue alone is not the target).
-    fn found(&self) -> bool {
-        self.view.is_some()
     }
 }
 

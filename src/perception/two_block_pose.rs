@@ -15,12 +15,12 @@
 //! Sign conventions come from the camera mount, so the same code serves a rear camera
 //! rolled 180° (Bujold) and a forward camera.
 
-use super::camera_model::{CameraModel, body_from_camera};
+use super::camera_model::{CameraModel, MountAngles, body_from_camera};
 use super::two_block::TwoBlockPercept;
-use crate::profile::{CameraSpec, TwoBlockSpec};
 use nalgebra::Vector3;
 
-/// What a motor schema needs to know about the camera and the fiducial.
+/// What a motor schema needs to know about the camera and the fiducial. A profile gives
+/// one through `TwoBlockGeometry::new(camera, fiducial)` (in `profile`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TwoBlockGeometry {
     /// Horizontal focal length, px.
@@ -34,18 +34,19 @@ pub struct TwoBlockGeometry {
 }
 
 impl TwoBlockGeometry {
-    /// From the profile's camera and fiducial.
-    pub fn new(camera: &CameraSpec, fiducial: &TwoBlockSpec) -> Self {
-        let fx = match CameraModel::from_spec(camera) {
+    /// From a camera's model, image width (px) and mounting, and the fiducial's (width,
+    /// height) in metres. A fisheye camera's focal length is taken as half the width.
+    pub fn from_camera(model: &CameraModel, width_px: usize, mount: MountAngles, size_m: (f64, f64)) -> Self {
+        let fx = match model {
             CameraModel::Pinhole(p) => p.fx,
-            CameraModel::Fisheye(_) => camera.width_px as f64 / 2.0,
+            CameraModel::Fisheye(_) => width_px as f64 / 2.0,
         };
-        let r = body_from_camera(&camera.mount);
+        let r = body_from_camera(mount);
         let right = r * Vector3::x();
         let axis = r * Vector3::z();
         Self {
             fx,
-            size: (fiducial.width_m, fiducial.height_m),
+            size: size_m,
             image_right_sign: if right.y < 0.0 { 1.0 } else { -1.0 },
             drive_dir: if axis.x < 0.0 { -1.0 } else { 1.0 },
         }

@@ -15,7 +15,7 @@
 
 use super::motor_output::{DriveCommand, MotorOutput};
 use crate::geometry::Twist;
-use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
+use crate::perception::{FiducialView, TwoBlockGeometry};
 
 /// Largest aim angle, rad (25°).
 pub const MAX_AIM_RAD: f64 = 25.0 * std::f64::consts::PI / 180.0;

@@ -11,10 +11,10 @@ use super::params::BujoldTuning;
 use crate::behaviors::BuildError;
 use crate::behaviors::composed::SharedMemory;
 use crate::geometry::Pose2;
-use crate::perception::TwoBlockSchema;
 use crate::perception::frame_change::FrameChange;
 use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
 use crate::profile::{ApproachKind, Profile};
+use crate::schemas::TwoBlockSchema;
 use crate::schemas::{
     Auxiliary, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Percept, PerceptualSchema, Posture,
     PotentialField, RatioSteering, Step,

@@ -1,11 +1,11 @@
-//! The pyramid perceptual schema: detector, geometry and the HSV colour model for one
-//! camera.
+//! The pyramid tracker: detector, geometry and the HSV colour model for one camera's
+//! frames (`schemas::PyramidSchema` runs it on a tick's inputs).
 //!
 //! The paper segments with HSV bands an operator tunes, and retunes live when the light
 //! changes (seed 001 §II.D); its future work is to replace that operator with the
 //! imprint/adapt method of seed 004. Both are here, chosen by `perception.mode`:
 //!
-//! * **fixed**: the profile's bands, changed only through [`PyramidSchema::set_bands`]
+//! * **fixed**: the table bands, changed only through [`PyramidTracker::set_bands`]
 //!   (the paper's method);
 //! * **static**: on departure the robot imprints the bands from the pyramid it is
 //!   leaving, and keeps them;
@@ -22,16 +22,14 @@
 //! 004 samples "the middle of each block"), and for the blue edges the segmented pixels
 //! of the region's box outside the ellipse. HSV statistics and bands are in [`HsvStats`].
 
-use super::colour_model::{ColorMode, ColorModel, ColorModelParams};
+use super::colour_model::{ColorMode, ColorModel, ColorModelParams, SegmentationMode};
 use super::hsv::Hsv;
 use super::hsv_stats::{HsvAccumulator, HsvLimits, HsvStats, hue_band};
 use super::image::RgbView;
-use super::pyramid::{PyramidDetector, PyramidPair};
+use super::pyramid::{PyramidDetector, PyramidPair, PyramidParams};
 use super::pyramid_pose::{PyramidGeometry, PyramidPercept};
 use super::segment::{HsvRange, Mask};
 use super::{VisionError, check_same_size};
-use crate::profile::{Profile, SegmentationMode};
-use crate::schemas::{Inputs, PerceptualSchema};
 
 /// Largest |α| and |bearing| of a pair accepted for imprinting, rad (12°).
 const IMPRINT_ANGLE: f64 = 0.21;
@@ -40,10 +38,36 @@ const IMPRINT_DISTANCE_ERROR: f64 = 0.35;
 /// Fewest pixels per colour for statistics.
 const MIN_SAMPLES: u64 = 10;
 
-/// The pyramid perceptual schema. Allocates only in [`PyramidSchema::from_profile`].
+/// Everything a [`PyramidTracker`] needs, in plain numbers. A profile gives them through
+/// `PyramidTrackerParams::from_profile` (in `profile`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PyramidTrackerParams {
+    /// Frame width, px.
+    pub width: usize,
+    /// Frame height, px.
+    pub height: usize,
+    /// The detector's table bands and filters.
+    pub detector: PyramidParams,
+    /// Camera and pyramid constants.
+    pub geometry: PyramidGeometry,
+    /// Fixed (table bands only), static (imprint) or adaptive (imprint and adapt).
+    pub mode: SegmentationMode,
+    /// Fallback-chain timing and blend rate (its `adaptive` flag is replaced by
+    /// `mode == Adaptive`; the SCT fields are unused here).
+    pub colour: ColorModelParams,
+    /// How learned statistics become bands.
+    pub limits: HsvLimits,
+    /// Camera-to-ball distance at which the departing robot imprints, m.
+    pub imprint_distance_m: f64,
+    /// The imprint finds the pyramid with the table bands widened by this factor (≥ 1).
+    pub imprint_widen: f64,
+    /// Frames to imprint on.
+    pub imprint_frames: u32,
+}
+
+/// RAPOSA's pyramid perception for one camera. Allocates only in [`PyramidTracker::new`].
 #[derive(Debug, Clone)]
-pub struct PyramidSchema {
-    camera: usize,
+pub struct PyramidTracker {
     detector: PyramidDetector,
     geometry: PyramidGeometry,
     mode: SegmentationMode,
@@ -57,40 +81,27 @@ pub struct PyramidSchema {
     imprinted_frames: u32,
 }
 
-impl PyramidSchema {
-    /// Builds the schema for camera `camera` of a profile with a `[fiducial.pyramid]`;
-    /// bands, filters and imprint/adapt settings come from `[perception]` and
-    /// `[perception.pyramid]`.
-    ///
-    /// # Errors
-    /// [`VisionError::Profile`] when the profile lacks the fiducial or the camera.
-    pub fn from_profile(profile: &Profile, camera: usize) -> Result<Self, VisionError> {
-        let geometry = PyramidGeometry::from_profile(profile, camera)?;
-        let cam = &profile.cameras[camera];
-        let p = &profile.perception;
-        let spec = &p.pyramid;
-        let table = [spec.orange.range(), spec.blue.range()];
-        let params = ColorModelParams::from_spec(p);
-        Ok(Self {
-            camera,
-            detector: PyramidDetector::new(cam.width_px, cam.height_px, spec, geometry.shape()),
-            geometry,
+impl PyramidTracker {
+    /// Builds the tracker; the colour model starts on the detector's table bands.
+    pub fn new(p: &PyramidTrackerParams) -> Self {
+        let table = [p.detector.orange, p.detector.blue];
+        let params = ColorModelParams {
+            adaptive: p.mode == SegmentationMode::Adaptive,
+            ..p.colour
+        };
+        Self {
+            detector: PyramidDetector::new(p.width, p.height, &p.detector, p.geometry.shape()),
+            geometry: p.geometry,
             mode: p.mode,
             table,
-            model: ColorModel::new(table.map(|b| HsvStats::from_band(&b, p.n_sd)), params),
-            limits: HsvLimits {
-                n_sd: p.n_sd,
-                hue_sd_deg: spec.hue_sd_deg,
-                sv_sd: spec.sv_sd,
-                min_s: spec.min_s,
-                min_v: spec.min_v,
-            },
-            imprint_distance: spec.imprint_distance_m,
-            imprint_widen: spec.imprint_widen,
-            imprint_frames: spec.imprint_frames,
+            model: ColorModel::new(table.map(|b| HsvStats::from_band(&b, p.limits.n_sd)), params),
+            limits: p.limits,
+            imprint_distance: p.imprint_distance_m,
+            imprint_widen: p.imprint_widen,
+            imprint_frames: p.imprint_frames,
             imprint_acc: [HsvAccumulator::default(); 2],
             imprinted_frames: 0,
-        })
+        }
     }
 
     /// The geometry constants.
@@ -129,6 +140,18 @@ impl PyramidSchema {
         self.model = ColorModel::new(self.table.map(|b| HsvStats::from_band(&b, n)), *self.model.params());
     }
 
+    /// Forgets the tracked ellipse (after the robot moved blind).
+    pub fn reset_tracking(&mut self) {
+        self.detector.reset_tracking();
+    }
+
+    /// No frame arrived by `now` (the camera is silent): the colour model counts it
+    /// toward its timeouts, and the percept is "nothing seen" at the detector's size.
+    pub fn no_frame(&mut self, now: f64) -> PyramidPercept {
+        self.model.update(now, None);
+        PyramidPercept::not_found(now, self.detector.size())
+    }
+
     /// Tells the colour model whether the robot expects the pyramid in view
     /// ([`ColorModel::set_looking`]): turning away must not discard a good imprint.
     pub fn set_looking(&mut self, looking: bool, now: f64) {
@@ -140,7 +163,7 @@ impl PyramidSchema {
         self.imprint_distance
     }
 
-    /// Frames the profile asks to imprint on.
+    /// Frames to imprint on (`imprint_frames` of the params).
     pub fn imprint_frames_wanted(&self) -> u32 {
         self.imprint_frames
     }
@@ -269,27 +292,6 @@ fn sample_pair(view: &RgbView<'_>, pair: &PyramidPair, masks: &[Mask; 2], acc: &
     };
     add(0, e.bbox, &|x, y| inside(x, y, 0.8));
     add(1, pair.blue.bbox, &|x, y| !inside(x, y, 1.0));
-}
-
-impl PerceptualSchema for PyramidSchema {
-    type Percept = PyramidPercept;
-
-    fn perceive(&mut self, inputs: &Inputs<'_>) -> PyramidPercept {
-        let size = self.detector.size();
-        match inputs.camera(self.camera) {
-            Some(cam) => self
-                .process(&cam.image, cam.stamp)
-                .unwrap_or_else(|_| PyramidPercept::not_found(cam.stamp, size)),
-            None => {
-                self.model.update(inputs.now, None);
-                PyramidPercept::not_found(inputs.now, size)
-            }
-        }
-    }
-
-    fn reset(&mut self) {
-        self.detector.reset_tracking();
-    }
 }
 
 #[cfg(test)]
