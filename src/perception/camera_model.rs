@@ -13,6 +13,31 @@
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
 /// Pin-hole model with radial distortion.
+///
+/// # Example
+///
+/// Without distortion, the point (0.5, −0.2, 2) m projects to
+/// (100·0.5/2 + 80, 100·(−0.2)/2 + 60) = (105, 50), and the ray through that pixel points
+/// back at it.
+///
+/// ```
+/// use marsupial::perception::Pinhole;
+/// use nalgebra::Vector3;
+///
+/// let cam = Pinhole { fx: 100.0, fy: 100.0, cx: 80.0, cy: 60.0, k1: 0.0, k2: 0.0 };
+/// let p = Vector3::new(0.5, -0.2, 2.0);
+/// let [u, v] = cam.project(&p).unwrap();
+/// assert!((u - 105.0).abs() < 1e-12 && (v - 50.0).abs() < 1e-12);
+/// assert!((cam.ray(u, v) - p.normalize()).norm() < 1e-12);
+/// assert_eq!(cam.project(&Vector3::new(0.0, 0.0, -1.0)), None, "behind the camera");
+///
+/// // Barrel distortion (k1 < 0) pulls off-axis points toward the centre, and `ray`
+/// // undoes it.
+/// let barrel = Pinhole { k1: -0.2, ..cam };
+/// let [ud, vd] = barrel.project(&p).unwrap();
+/// assert!(ud < u && vd > v);
+/// assert!((barrel.ray(ud, vd) - p.normalize()).norm() < 1e-9);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pinhole {
     /// Focal length x, px.
@@ -58,6 +83,25 @@ impl Pinhole {
 }
 
 /// Scaramuzza omnidirectional model (see the module docs).
+///
+/// # Example
+///
+/// With the constant polynomial f(ρ) = −100 a pixel ρ px off centre maps to the ray
+/// (x, y, 100): the model reduces to a pin-hole of focal length 100 px, so the point that
+/// [`Pinhole`]'s example projects to (105, 50) lands there too (within the inverse table's
+/// interpolation).
+///
+/// ```
+/// use marsupial::perception::Fisheye;
+/// use nalgebra::Vector3;
+///
+/// let cam = Fisheye::new(vec![-100.0], [80.0, 60.0], [1.0, 0.0, 0.0], 400.0);
+/// assert!((cam.max_angle() - 4f64.atan()).abs() < 1e-9); // ρ up to 400 px
+/// assert!((cam.ray(80.0, 60.0) - Vector3::z()).norm() < 1e-12);
+/// let [u, v] = cam.project(&Vector3::new(0.5, -0.2, 2.0)).unwrap();
+/// assert!((u - 105.0).abs() < 0.01 && (v - 50.0).abs() < 0.01, "({u}, {v})");
+/// assert_eq!(cam.project(&Vector3::new(1.0, 0.0, 0.0)), None, "90° off axis: outside");
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Fisheye {
     /// f(ρ) coefficients a0, a1, a2 …
@@ -135,6 +179,19 @@ impl Fisheye {
 
 /// A camera model. A profile's `[[cameras]]` entry gives one through
 /// `CameraModel::from_spec` (in `profile`).
+///
+/// # Example
+///
+/// ```
+/// use marsupial::perception::{CameraModel, Pinhole};
+/// use nalgebra::Vector3;
+///
+/// let cam = CameraModel::Pinhole(Pinhole { fx: 100.0, fy: 100.0, cx: 80.0, cy: 60.0, k1: 0.0, k2: 0.0 });
+/// // A point one metre ahead, 0.1 m right: 10 px right of the principal point.
+/// let [u, v] = cam.project(&Vector3::new(0.1, 0.0, 1.0)).unwrap();
+/// assert!((u - 90.0).abs() < 1e-12 && (v - 60.0).abs() < 1e-12);
+/// assert!((cam.ray(90.0, 60.0) - Vector3::new(0.1, 0.0, 1.0).normalize()).norm() < 1e-12);
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub enum CameraModel {
     /// Pin-hole.
@@ -186,6 +243,26 @@ impl MountAngles {
 /// With yaw = pitch = roll = 0 the camera looks along body +x with image right = body −y
 /// and image down = body −z. Then: yaw about body +z, pitch about the body's (yawed) +y
 /// (positive looks down), roll about the optical axis (180° turns the image upside down).
+///
+/// # Example
+///
+/// A forward camera, and a rear camera rolled upside down (Bujold's): the rear camera
+/// looks along body −x, and its image right is body −y again.
+///
+/// ```
+/// use marsupial::perception::{MountAngles, body_from_camera};
+/// use nalgebra::Vector3;
+///
+/// let fwd = body_from_camera(MountAngles::default());
+/// assert!((fwd * Vector3::z() - Vector3::x()).norm() < 1e-12, "optical axis: body +x");
+/// assert!((fwd * Vector3::x() + Vector3::y()).norm() < 1e-12, "image right: body −y");
+///
+/// let rear = MountAngles { yaw_deg: 180.0, pitch_deg: 0.0, roll_deg: 180.0 };
+/// assert!(rear.is_flipped() && !MountAngles::default().is_flipped());
+/// let r = body_from_camera(rear);
+/// assert!((r * Vector3::z() + Vector3::x()).norm() < 1e-12, "optical axis: body −x");
+/// assert!((r * Vector3::x() + Vector3::y()).norm() < 1e-12, "image right: body −y");
+/// ```
 pub fn body_from_camera(mount: impl Into<MountAngles>) -> Matrix3<f64> {
     let mount = mount.into();
     let r0 = Matrix3::new(0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, -1.0, 0.0);

@@ -69,6 +69,54 @@ pub struct Pair {
 }
 
 /// Segments, labels and pairs; owns all scratch buffers.
+///
+/// # Example
+///
+/// A 16×8 grey frame with a 4×4 cyan block at x = 4…7 and a 4×4 magenta block right of
+/// it at x = 8…11 (rows 2…5): the pair is found with both blocks' counts, centroids and
+/// boxes; the same blocks in the other order (the fiducial upside down) are rejected.
+///
+/// ```
+/// use marsupial::perception::{PairLimits, RgbImage, Sct, SctRange, TwoBlockDetector};
+///
+/// let (cyan, magenta) = ([20, 190, 210], [200, 30, 190]);
+/// let frame = |left: [u8; 3], right: [u8; 3]| {
+///     let mut im = RgbImage::new(16, 8);
+///     im.fill([110, 105, 100]);
+///     for y in 2..6 {
+///         (4..8).for_each(|x| im.put(x, y, left));
+///         (8..12).for_each(|x| im.put(x, y, right));
+///     }
+///     im
+/// };
+/// let d = |deg: f64| deg.to_radians();
+/// let ranges = [
+///     SctRange { a: [d(30.0), d(60.0)], b: [d(70.0), d(90.0)], min_l: 30.0, min_chroma: 0.0 },
+///     SctRange { a: [d(30.0), d(60.0)], b: [d(0.0), d(20.0)], min_l: 30.0, min_chroma: 0.0 },
+/// ];
+/// let limits = PairLimits {
+///     min_component_px: 8,
+///     max_gap_frac: 0.5,
+///     gap_slack_px: 3.0,
+///     max_vertical_frac: 0.5,
+///     max_candidates: 8,
+/// };
+/// let mut det = TwoBlockDetector::new(16, 8, limits);
+///
+/// let im = frame(cyan, magenta);
+/// let pair = det.detect(&im.view(), &ranges).unwrap().expect("found");
+/// assert_eq!((pair.left.count, pair.right.count, pair.ratio), (16, 16, 1.0));
+/// assert_eq!(pair.left.centroid, [5.5, 3.5]);
+/// assert_eq!(pair.right.bbox, [8, 2, 11, 5]);
+/// assert_eq!(det.masks()[0].count(), 16);
+/// // The accepted blocks' colour statistics, for adaptation (fast SCT: within 0.002 rad).
+/// let [l, r] = det.measure(&im.view(), &pair).unwrap();
+/// assert!((l.mean_b - Sct::from_rgb(cyan).b).abs() < 0.002 && l.sd_b == 0.0);
+/// assert!((r.mean_b - Sct::from_rgb(magenta).b).abs() < 0.002);
+///
+/// let upside_down = frame(magenta, cyan);
+/// assert_eq!(det.detect(&upside_down.view(), &ranges).unwrap(), None);
+/// ```
 #[derive(Debug, Clone)]
 pub struct TwoBlockDetector {
     width: usize,
@@ -319,6 +367,71 @@ pub struct TwoBlockParams {
 
 /// Bujold's close-dock perception for one camera: detector + colour model (+ imprinting).
 /// Allocates only in [`TwoBlockTracker::new`].
+///
+/// # Example
+///
+/// The frame of [`TwoBlockDetector`]'s example (4×4 cyan and magenta blocks side by side
+/// in a 16×8 frame): imprint on it as on departure, track it, then lose the camera.
+///
+/// ```
+/// use marsupial::perception::{
+///     ColorMode, ColorModelParams, PairLimits, RgbImage, SegmentationMode, TwoBlockParams, TwoBlockTracker,
+/// };
+///
+/// let (cyan, magenta) = ([20, 190, 210], [200, 30, 190]);
+/// let mut im = RgbImage::new(16, 8);
+/// im.fill([110, 105, 100]);
+/// for y in 2..6 {
+///     (4..8).for_each(|x| im.put(x, y, cyan));
+///     (8..12).for_each(|x| im.put(x, y, magenta));
+/// }
+/// let params = TwoBlockParams {
+///     width: 16,
+///     height: 8,
+///     colours: [cyan, magenta],
+///     table_sd: 0.05,
+///     limits: PairLimits {
+///         min_component_px: 8,
+///         max_gap_frac: 0.5,
+///         gap_slack_px: 3.0,
+///         max_vertical_frac: 0.5,
+///         max_candidates: 8,
+///     },
+///     colour: ColorModelParams {
+///         n_sd: 4.0,
+///         sd_floor: 0.01,
+///         sd_ceiling: 0.2,
+///         min_l: 20.0,
+///         min_chroma: 0.05,
+///         timeout1: 2.0,
+///         timeout2: 5.0,
+///         adaptive: true,
+///         adapt_rate: 1.0,
+///     },
+///     mode: SegmentationMode::Adaptive,
+///     // Exactly the two blocks, sampled whole.
+///     imprint_rects: [[0.25, 0.25, 0.5, 0.75], [0.5, 0.25, 0.75, 0.75]],
+///     imprint_sample_frac: 1.0,
+///     imprint_frames: 1,
+/// };
+/// let mut t = TwoBlockTracker::new(&params);
+/// assert_eq!(t.model().mode(), ColorMode::Table);
+/// t.imprint_frame(&im.view());
+/// assert!(t.finish_imprint(0.0));
+/// assert_eq!(t.model().mode(), ColorMode::Imprinted);
+///
+/// let p = t.process(&im.view(), 0.1).unwrap();
+/// assert!(p.found);
+/// assert_eq!((p.left_px, p.right_px, p.total_px), (16, 16, 32));
+/// // Pair midpoint (5.5 + 9.5)/2 = 7.5: half a pixel left of the image centre.
+/// assert_eq!(p.offset_px, -0.5);
+/// assert_eq!(p.mode, ColorMode::Imprinted); // what segmented this frame…
+/// assert_eq!(t.model().mode(), ColorMode::Adapted); // …and the next adapts to it
+///
+/// // The camera falls silent: 2.4 s without the fiducial exceeds timeout 1.
+/// assert!(!t.no_frame(2.5).found);
+/// assert_eq!(t.model().mode(), ColorMode::Imprinted);
+/// ```
 #[derive(Debug, Clone)]
 pub struct TwoBlockTracker {
     detector: TwoBlockDetector,
