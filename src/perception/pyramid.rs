@@ -34,6 +34,33 @@ use super::{VisionError, check_same_size};
 use serde::Serialize;
 
 /// An ellipse fitted to a blob by its second moments.
+///
+/// # Example
+///
+/// A filled 4×2 rectangle. Each side of n pixels has variance (n² − 1)/12 plus the
+/// 1/12 of a unit pixel, n²/12, so the semi-axes are 2·n/√12 = n/√3: 4/√3 and 2/√3, in the
+/// ratio of the sides.
+///
+/// ```
+/// use marsupial::perception::{Ellipse, Labeler, Mask};
+/// use std::f64::consts::PI;
+///
+/// let mut mask = Mask::new(6, 4);
+/// for y in 1..3 {
+///     for x in 1..5 {
+///         mask.set(x, y, true);
+///     }
+/// }
+/// let mut labeler = Labeler::new(6, 4);
+/// let e = Ellipse::from_component(&labeler.label(&mask).unwrap()[0]);
+/// assert_eq!((e.centre, e.count), ([2.5, 1.5], 8));
+/// assert!((e.semi_major - 4.0 / 3f64.sqrt()).abs() < 1e-12);
+/// assert!((e.semi_minor - 2.0 / 3f64.sqrt()).abs() < 1e-12);
+/// assert!((e.axis_ratio() - 2.0).abs() < 1e-12 && e.angle.abs() < 1e-12);
+/// // 8 px over π·a·b = 8π/3.
+/// assert!((e.fill() - 3.0 / PI).abs() < 1e-12);
+/// assert!((e.equivalent_diameter() - 2.0 * (8.0 / PI).sqrt()).abs() < 1e-12);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Ellipse {
     /// Centre (x, y), px.
@@ -236,6 +263,51 @@ impl Default for PyramidParams {
 }
 
 /// The pyramid detector. Allocates only in [`PyramidDetector::new`].
+///
+/// # Example
+///
+/// A 40×30 grey frame with a square blue frame (16 px, bars 2 px wide) and an orange disc
+/// of radius 5 (81 px) inside it, detected with the default (RAPOSA) bands and filters.
+/// Without the blue frame the ellipse is still reported, alone.
+///
+/// ```
+/// use marsupial::perception::{PyramidDetector, PyramidParams, PyramidShape, RgbImage};
+///
+/// let (orange, blue) = ([235, 120, 20], [20, 60, 220]);
+/// let scene = |with_blue: bool| {
+///     let mut im = RgbImage::new(40, 30);
+///     im.fill([120, 118, 115]);
+///     for y in 6..22 {
+///         for x in 10..26 {
+///             let bar = x < 12 || x >= 24 || y < 8 || y >= 20;
+///             let in_disc = (x as f64 - 18.0).hypot(y as f64 - 14.0) <= 5.0;
+///             if in_disc {
+///                 im.put(x, y, orange);
+///             } else if bar && with_blue {
+///                 im.put(x, y, blue);
+///             }
+///         }
+///     }
+///     im
+/// };
+/// // Ball 7 cm, blue edges 10 cm; the ball sits 16 cm from the edges' midpoint.
+/// let shape = PyramidShape { size_ratio: 0.10 / 0.07, offset_ratio: 1.6 };
+/// let mut det = PyramidDetector::new(40, 30, &PyramidParams::default(), shape);
+///
+/// let d = det.detect(&scene(true).view()).unwrap();
+/// let pair = d.pair.expect("pair");
+/// assert_eq!(d.candidates, 1);
+/// assert_eq!((pair.ellipse.centre, pair.ellipse.count), ([18.0, 14.0], 81));
+/// assert!(pair.ellipse.axis_ratio() < 1.0 + 1e-9);
+/// assert_eq!(pair.blue.bbox, [10, 6, 25, 21]);
+/// assert_eq!((pair.blue.height(), pair.blue.centre()), (16.0, [17.5, 13.5]));
+/// assert_eq!(det.masks()[1].count(), 16 * 16 - 12 * 12);
+/// assert_eq!(det.tracked(), Some([18.0, 14.0])); // the next frame looks near here
+///
+/// let d = det.detect(&scene(false).view()).unwrap();
+/// assert!(d.pair.is_none() && d.blue.is_none());
+/// assert_eq!(d.ellipse.map(|e| e.count), Some(81));
+/// ```
 #[derive(Debug, Clone)]
 pub struct PyramidDetector {
     width: usize,

@@ -66,6 +66,66 @@ pub struct PyramidTrackerParams {
 }
 
 /// RAPOSA's pyramid perception for one camera. Allocates only in [`PyramidTracker::new`].
+///
+/// # Example
+///
+/// The scene of [`PyramidDetector`]'s example (a 16 px blue frame around an orange disc
+/// of radius 5 in a 40×30 frame) seen by a camera with f = 160 px, in fixed mode: the
+/// 10 cm blue edges are 160·0.1/16 = 1 m away. Retuning the orange band to green, as the
+/// paper's operator might, loses the ball.
+///
+/// ```
+/// use marsupial::perception::{
+///     ColorModelParams, HsvLimits, HsvRange, PyramidGeometry, PyramidParams, PyramidTracker,
+///     PyramidTrackerParams, RgbImage, SegmentationMode,
+/// };
+///
+/// let mut im = RgbImage::new(40, 30);
+/// im.fill([120, 118, 115]);
+/// for y in 6..22 {
+///     for x in 10..26 {
+///         if (x as f64 - 18.0).hypot(y as f64 - 14.0) <= 5.0 {
+///             im.put(x, y, [235, 120, 20]);
+///         } else if x < 12 || x >= 24 || y < 8 || y >= 20 {
+///             im.put(x, y, [20, 60, 220]);
+///         }
+///     }
+/// }
+/// let params = PyramidTrackerParams {
+///     width: 40,
+///     height: 30,
+///     detector: PyramidParams::default(),
+///     geometry: PyramidGeometry { f_px: 160.0, principal: [20.0, 15.0], h: 0.1, m: 0.16, ball_diameter: 0.07 },
+///     mode: SegmentationMode::Fixed,
+///     colour: ColorModelParams {
+///         n_sd: 4.0,
+///         sd_floor: 0.01,
+///         sd_ceiling: 0.2,
+///         min_l: 20.0,
+///         min_chroma: 0.0,
+///         timeout1: 2.0,
+///         timeout2: 5.0,
+///         adaptive: false,
+///         adapt_rate: 1.0,
+///     },
+///     limits: HsvLimits { n_sd: 4.0, hue_sd_deg: [1.0, 20.0], sv_sd: [0.01, 0.1], min_s: 0.2, min_v: 0.05 },
+///     imprint_distance_m: 1.0,
+///     imprint_widen: 1.5,
+///     imprint_frames: 3,
+/// };
+/// let mut t = PyramidTracker::new(&params);
+/// let p = t.process(&im.view(), 0.1).unwrap();
+/// let v = p.view.expect("ball seen");
+/// assert!(p.detection.pair.is_some());
+/// assert!((v.blue_distance_m.unwrap() - 1.0).abs() < 1e-9);
+/// // The ball is half a pixel right of the blue centre: a small negative α.
+/// assert!(v.alpha.unwrap() < 0.0 && v.alpha.unwrap() > -0.1);
+/// assert_eq!(t.bands()[0], PyramidParams::default().orange, "fixed: the table bands");
+///
+/// let green = HsvRange { h: [100.0, 140.0], s: [0.4, 1.0], v: [0.2, 1.0] };
+/// t.set_bands(green, t.bands()[1]);
+/// assert!(t.process(&im.view(), 0.2).unwrap().view.is_none());
+/// ```
 #[derive(Debug, Clone)]
 pub struct PyramidTracker {
     detector: PyramidDetector,
