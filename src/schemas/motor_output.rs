@@ -69,6 +69,16 @@ fn no_commands(a: &[Option<f64>; MAX_ACTUATORS]) -> bool {
 
 impl Auxiliary {
     /// Fills each field this one leaves open with `other`'s value (self has priority).
+    ///
+    /// ```
+    /// use marsupial::schemas::{Auxiliary, Guides};
+    ///
+    /// let dock = Auxiliary { guides: Some(Guides::Closed), ..Default::default() };
+    /// let carry = Auxiliary { arm: Some(0.3), guides: Some(Guides::Open), ..Default::default() };
+    /// let merged = dock.or(carry);
+    /// assert_eq!((merged.guides, merged.arm), (Some(Guides::Closed), Some(0.3)));
+    /// assert_eq!(merged.lights, None, "nobody had an opinion");
+    /// ```
     pub fn or(self, other: Auxiliary) -> Auxiliary {
         Auxiliary {
             tether: self.tether.or(other.tether),
@@ -89,6 +99,24 @@ impl Auxiliary {
 }
 
 /// One motor schema's (or the arbiter's) output for one tick.
+///
+/// # Example
+///
+/// ```
+/// use marsupial::geometry::Twist;
+/// use marsupial::schemas::{Auxiliary, DriveCommand, MotorOutput, Posture};
+///
+/// let out = MotorOutput::twist(0.1, -0.2);
+/// assert_eq!(out.drive, DriveCommand::Twist(Twist::new(0.1, -0.2)));
+/// assert!(MotorOutput::stop().drive.is_stop());
+/// // Backing in, lowered: the base reverses at 3 cm/s without turning.
+/// let lowered = Auxiliary { posture: Some(Posture::Lowered), ..Default::default() };
+/// let out = MotorOutput::drive(DriveCommand::Straight { v: -0.03 }).with_aux(lowered);
+/// assert_eq!(out.drive.to_twist(), Twist::new(-0.03, 0.0));
+/// assert_eq!(out.aux.posture, Some(Posture::Lowered));
+/// assert!(out.is_finite());
+/// assert!(!MotorOutput::drive(DriveCommand::Turn { omega: f64::NAN }).is_finite());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct MotorOutput {
     /// Base motion.
