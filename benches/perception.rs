@@ -11,13 +11,12 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use marsupial::geometry::Pose2;
-use marsupial::perception::PyramidSchema;
 use marsupial::perception::camera_model::CameraModel;
 use marsupial::perception::{
-    ColorRange, HsvPlanes, Labeler, Mask, SctPlanes, Segmenter, TwoBlockDetector, TwoBlockSchema, hsv_from_rgb,
-    sct_from_rgb,
+    ColorRange, HsvPlanes, Labeler, Mask, SctPlanes, Segmenter, TwoBlockDetector, hsv_from_rgb, sct_from_rgb,
 };
 use marsupial::profile::Profile;
+use marsupial::schemas::{PyramidSchema, TwoBlockSchema};
 use marsupial::sim::camera::camera_pose;
 use marsupial::sim::lighting::{LightingRun, LightingSpec};
 use marsupial::sim::render::{Renderer, SensorParams};

@@ -8,7 +8,8 @@
 //!    optionally [`WheelEncoders`], a [`DockSensor`], a tether reel, arm, lights …
 //!    Here they talk to a tiny toy world (a red beacon on a floor); on your robot they
 //!    talk to your drivers.
-//! 3. **Behaviors**: a perceptual schema (find the red beacon), a motor schema (steer at
+//! 3. **Behaviors**: a perceptual schema (find the red beacon with the crate's perception:
+//!    HSV segmentation and connected components, from plain parameters), a motor schema (steer at
 //!    it), paired with an activation condition, under a priority arbiter with a
 //!    "docked" check on top.
 //!
@@ -21,7 +22,7 @@
 use marsupial::arbiter::runtime::{RuntimeConfig, StopHandle, run};
 use marsupial::arbiter::{Priority, ReactiveLoop};
 use marsupial::geometry::{Pose2, Twist, integrate_twist};
-use marsupial::perception::RgbImage;
+use marsupial::perception::{ColorRange, HsvRange, Labeler, Mask, RgbImage, Segmenter};
 use marsupial::profile::Profile;
 use marsupial::robot::{Camera, DockSensor, Drive, HardwareError, Robot, WheelEncoders, WheelTravel};
 use marsupial::schemas::{
@@ -187,7 +188,7 @@ struct Beacon {
     found: bool,
     /// Column offset from the image centre, px (positive right).
     offset_px: f64,
-    /// Red pixel count (grows as we approach).
+    /// Pixels of the largest red blob (grows as we approach).
     pixels: usize,
 }
 
@@ -200,37 +201,61 @@ impl Percept for Beacon {
     }
 }
 
-/// Perceptual schema: count red pixels and average their column.
-struct FindRed;
+/// Perceptual schema: the crate's perception with plain parameters, no profile needed.
+/// Red is a box in HSV (hue wrapping through 0°); the [`Segmenter`] writes the red pixels
+/// into a [`Mask`], the [`Labeler`] finds its 8-connected blobs, and the largest blob is
+/// the beacon. Every buffer is allocated once, for the camera's resolution.
+struct FindRed {
+    red: [ColorRange; 1],
+    segmenter: Segmenter,
+    mask: [Mask; 1],
+    labeler: Labeler,
+}
+
+impl FindRed {
+    /// Blobs smaller than this are noise, px.
+    const MIN_PIXELS: u64 = 10;
+
+    fn new(width: usize, height: usize) -> Self {
+        Self {
+            red: [ColorRange::Hsv(HsvRange {
+                h: [340.0, 20.0],
+                s: [0.5, 1.0],
+                v: [0.4, 1.0],
+            })],
+            segmenter: Segmenter::new(),
+            mask: [Mask::new(width, height)],
+            labeler: Labeler::new(width, height),
+        }
+    }
+}
+
 impl PerceptualSchema for FindRed {
     type Percept = Beacon;
     fn perceive(&mut self, inputs: &Inputs<'_>) -> Beacon {
+        let mut beacon = Beacon {
+            stamp: inputs.now,
+            found: false,
+            offset_px: 0.0,
+            pixels: 0,
+        };
         let Some(cam) = inputs.camera(0) else {
-            return Beacon {
-                stamp: inputs.now,
-                found: false,
-                offset_px: 0.0,
-                pixels: 0,
-            };
+            return beacon;
         };
-        let (mut sum_x, mut n) = (0usize, 0usize);
-        for (i, px) in cam.image.as_bytes().chunks_exact(3).enumerate() {
-            if px[0] > 150 && px[1] < 80 && px[2] < 80 {
-                sum_x += i % cam.image.width();
-                n += 1;
-            }
+        beacon.stamp = cam.stamp;
+        // A frame of the wrong size is an error, not a beacon: report nothing seen.
+        if self.segmenter.segment(&cam.image, &self.red, &mut self.mask).is_err() {
+            return beacon;
         }
-        let offset_px = if n > 0 {
-            sum_x as f64 / n as f64 - cam.image.width() as f64 / 2.0
-        } else {
-            0.0
+        let Ok(blobs) = self.labeler.label(&self.mask[0]) else {
+            return beacon;
         };
-        Beacon {
-            stamp: cam.stamp,
-            found: n > 10,
-            offset_px,
-            pixels: n,
+        if let Some(blob) = blobs.iter().max_by_key(|b| b.count) {
+            beacon.found = blob.count > Self::MIN_PIXELS;
+            beacon.offset_px = blob.centroid().0 - cam.image.width() as f64 / 2.0;
+            beacon.pixels = blob.count as usize;
         }
+        beacon
     }
 }
 
@@ -298,7 +323,7 @@ fn main() {
     robot.encoders = Some(Box::new(ToyEncoders(world.clone())));
     robot.dock_sensor = Some(Box::new(ToyDockSwitch(world.clone())));
 
-    let approach = SchemaBehavior::new("approach", FindRed, SteerAtBeacon, |b: &Beacon| b.found);
+    let approach = SchemaBehavior::new("approach", FindRed::new(160, 120), SteerAtBeacon, |b: &Beacon| b.found);
     let root = Priority::new(
         "root",
         vec![Box::new(DockedCheck), Box::new(approach), Box::new(Search)],

@@ -41,12 +41,16 @@
 
 pub mod arbiter;
 pub mod behaviors;
+#[cfg(feature = "cli")]
 pub mod cli;
 pub mod config;
 pub mod geometry;
+#[cfg(feature = "image-io")]
+pub mod image_io;
 pub mod kinematics;
 pub mod perception;
 pub mod profile;
 pub mod robot;
 pub mod schemas;
+#[cfg(feature = "sim")]
 pub mod sim;

@@ -6,9 +6,10 @@
 
 mod common;
 
-use marsupial::perception::{PyramidSchema, RgbImage, TwoBlockSchema};
+use marsupial::perception::RgbImage;
 use marsupial::profile::{Profile, SegmentationMode};
 use marsupial::schemas::{CameraInput, CameraInputs};
+use marsupial::schemas::{PyramidSchema, TwoBlockSchema};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::path::Path;

@@ -7,8 +7,9 @@
 
 use marsupial::geometry::Pose2;
 use marsupial::perception::camera_model::CameraModel;
-use marsupial::perception::{ColorMode, PyramidSchema, RgbImage};
+use marsupial::perception::{ColorMode, RgbImage};
 use marsupial::profile::{Profile, SegmentationMode};
+use marsupial::schemas::PyramidSchema;
 use marsupial::sim::camera::camera_pose;
 use marsupial::sim::lighting::{Illuminant, LightingPreset, LightingRun, LightingSpec};
 use marsupial::sim::render::{Renderer, SensorParams};

@@ -3,10 +3,10 @@
 //! and distances of the paper's experiments, and the sign of α on either side.
 
 use marsupial::geometry::Pose2;
-use marsupial::perception::PyramidSchema;
 use marsupial::perception::RgbImage;
 use marsupial::perception::camera_model::CameraModel;
 use marsupial::profile::Profile;
+use marsupial::schemas::PyramidSchema;
 use marsupial::sim::camera::camera_pose;
 use marsupial::sim::lighting::{LightingRun, LightingSpec};
 use marsupial::sim::render::{Renderer, SensorParams};

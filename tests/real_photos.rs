@@ -2,9 +2,10 @@
 //! imprint → detect loop on real sensor colour (a ColorChecker's adjacent magenta and cyan
 //! patches). Skips with a message when the photo folder is absent.
 
-use marsupial::cli::image_io::load_rgb;
-use marsupial::perception::{ColorMode, TwoBlockSchema};
+use marsupial::image_io::load_rgb;
+use marsupial::perception::ColorMode;
 use marsupial::profile::Profile;
+use marsupial::schemas::TwoBlockSchema;
 use std::path::{Path, PathBuf};
 
 fn photos() -> Option<PathBuf> {

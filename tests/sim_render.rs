@@ -7,9 +7,10 @@
 mod common;
 
 use marsupial::geometry::Pose2;
+use marsupial::perception::RgbImage;
 use marsupial::perception::camera_model::CameraModel;
-use marsupial::perception::{RgbImage, TwoBlockSchema};
 use marsupial::profile::{Mount, Profile};
+use marsupial::schemas::TwoBlockSchema;
 use marsupial::sim::camera::camera_pose;
 use marsupial::sim::lighting::{Illuminant, LightState, LightingPreset, LightingRun, LightingSpec};
 use marsupial::sim::render::{Renderer, SensorParams};

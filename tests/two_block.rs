@@ -2,8 +2,9 @@
 
 mod common;
 use common::*;
-use marsupial::perception::{ColorMode, PairLimits, TwoBlockDetector, TwoBlockSchema};
+use marsupial::perception::{ColorMode, PairLimits, TwoBlockDetector};
 use marsupial::profile::Profile;
+use marsupial::schemas::TwoBlockSchema;
 use std::path::Path;
 
 fn limits() -> PairLimits {

@@ -1,10 +1,11 @@
 //! `marsupial detect`: run the two-block perceptual schema over image files, as a stream.
 
-use super::image_io::{ImageFileError, load_rgb, save_png};
 use crate::config::ConfigError;
+use crate::image_io::{ImageFileError, load_rgb, save_png};
 use crate::perception::overlay::paint_overlay;
-use crate::perception::{RgbImage, TwoBlockPercept, TwoBlockSchema, VisionError};
+use crate::perception::{RgbImage, TwoBlockPercept, VisionError};
 use crate::profile::Profile;
+use crate::schemas::TwoBlockSchema;
 use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};

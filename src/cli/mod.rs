@@ -4,6 +4,5 @@
 pub mod calibrate;
 pub mod check;
 pub mod detect;
-pub mod image_io;
 pub mod sim_cmds;
 pub mod timeline;

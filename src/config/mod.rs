@@ -6,6 +6,7 @@
 //! at once, not just the first.
 
 pub mod error;
+#[cfg(feature = "sim")]
 pub mod patch;
 pub mod validate;
 

@@ -7,18 +7,21 @@
 
 pub mod ackermann;
 pub mod calibration;
+pub mod command;
 pub mod differential;
 pub mod odometry;
 pub mod skid_steer;
+pub mod vector;
 
 pub use ackermann::{BodyVelocity, DoubleAckermann};
 pub use calibration::{Calibration, CalibrationError, OdometrySample, calibrate, parse_log};
+pub use command::DriveCommand;
 pub use differential::Differential;
 pub use odometry::Odometry;
 pub use skid_steer::{SkidSteer, SkidSteerError};
+pub use vector::MotionVector;
 
 use crate::geometry::Twist;
-use crate::schemas::DriveCommand;
 
 /// Speed limits of a base.
 #[derive(Debug, Clone, Copy, PartialEq)]

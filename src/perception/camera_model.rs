@@ -10,10 +10,34 @@
 //!   [[c, d], [e, 1]] about the distortion centre. Projection inverts f numerically via a
 //!   monotonic table of the ray's off-axis angle.
 
-use crate::profile::{CameraModelKind, CameraSpec, Mount};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
 /// Pin-hole model with radial distortion.
+///
+/// # Example
+///
+/// Without distortion, the point (0.5, −0.2, 2) m projects to
+/// (100·0.5/2 + 80, 100·(−0.2)/2 + 60) = (105, 50), and the ray through that pixel points
+/// back at it.
+///
+/// ```
+/// use marsupial::perception::Pinhole;
+/// use nalgebra::Vector3;
+///
+/// let cam = Pinhole { fx: 100.0, fy: 100.0, cx: 80.0, cy: 60.0, k1: 0.0, k2: 0.0 };
+/// let p = Vector3::new(0.5, -0.2, 2.0);
+/// let [u, v] = cam.project(&p).unwrap();
+/// assert!((u - 105.0).abs() < 1e-12 && (v - 50.0).abs() < 1e-12);
+/// assert!((cam.ray(u, v) - p.normalize()).norm() < 1e-12);
+/// assert_eq!(cam.project(&Vector3::new(0.0, 0.0, -1.0)), None, "behind the camera");
+///
+/// // Barrel distortion (k1 < 0) pulls off-axis points toward the centre, and `ray`
+/// // undoes it.
+/// let barrel = Pinhole { k1: -0.2, ..cam };
+/// let [ud, vd] = barrel.project(&p).unwrap();
+/// assert!(ud < u && vd > v);
+/// assert!((barrel.ray(ud, vd) - p.normalize()).norm() < 1e-9);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pinhole {
     /// Focal length x, px.
@@ -59,6 +83,25 @@ impl Pinhole {
 }
 
 /// Scaramuzza omnidirectional model (see the module docs).
+///
+/// # Example
+///
+/// With the constant polynomial f(ρ) = −100 a pixel ρ px off centre maps to the ray
+/// (x, y, 100): the model reduces to a pin-hole of focal length 100 px, so the point that
+/// [`Pinhole`]'s example projects to (105, 50) lands there too (within the inverse table's
+/// interpolation).
+///
+/// ```
+/// use marsupial::perception::Fisheye;
+/// use nalgebra::Vector3;
+///
+/// let cam = Fisheye::new(vec![-100.0], [80.0, 60.0], [1.0, 0.0, 0.0], 400.0);
+/// assert!((cam.max_angle() - 4f64.atan()).abs() < 1e-9); // ρ up to 400 px
+/// assert!((cam.ray(80.0, 60.0) - Vector3::z()).norm() < 1e-12);
+/// let [u, v] = cam.project(&Vector3::new(0.5, -0.2, 2.0)).unwrap();
+/// assert!((u - 105.0).abs() < 0.01 && (v - 50.0).abs() < 0.01, "({u}, {v})");
+/// assert_eq!(cam.project(&Vector3::new(1.0, 0.0, 0.0)), None, "90° off axis: outside");
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Fisheye {
     /// f(ρ) coefficients a0, a1, a2 …
@@ -134,7 +177,21 @@ impl Fisheye {
     }
 }
 
-/// A camera model.
+/// A camera model. A profile's `[[cameras]]` entry gives one through
+/// `CameraModel::from_spec` (in `profile`).
+///
+/// # Example
+///
+/// ```
+/// use marsupial::perception::{CameraModel, Pinhole};
+/// use nalgebra::Vector3;
+///
+/// let cam = CameraModel::Pinhole(Pinhole { fx: 100.0, fy: 100.0, cx: 80.0, cy: 60.0, k1: 0.0, k2: 0.0 });
+/// // A point one metre ahead, 0.1 m right: 10 px right of the principal point.
+/// let [u, v] = cam.project(&Vector3::new(0.1, 0.0, 1.0)).unwrap();
+/// assert!((u - 90.0).abs() < 1e-12 && (v - 60.0).abs() < 1e-12);
+/// assert!((cam.ray(90.0, 60.0) - Vector3::new(0.1, 0.0, 1.0).normalize()).norm() < 1e-12);
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub enum CameraModel {
     /// Pin-hole.
@@ -144,39 +201,6 @@ pub enum CameraModel {
 }
 
 impl CameraModel {
-    /// The model a profile's camera describes.
-    pub fn from_spec(spec: &CameraSpec) -> Self {
-        match spec.model {
-            CameraModelKind::Pinhole => {
-                let k = spec.pinhole_intrinsics().unwrap_or(crate::profile::Intrinsics {
-                    fx: spec.width_px as f64,
-                    fy: spec.width_px as f64,
-                    cx: spec.width_px as f64 / 2.0,
-                    cy: spec.height_px as f64 / 2.0,
-                    k1: 0.0,
-                    k2: 0.0,
-                });
-                CameraModel::Pinhole(Pinhole {
-                    fx: k.fx,
-                    fy: k.fy,
-                    cx: k.cx,
-                    cy: k.cy,
-                    k1: k.k1,
-                    k2: k.k2,
-                })
-            }
-            CameraModelKind::Fisheye => {
-                let fe = spec.fisheye.clone().unwrap_or(crate::profile::FisheyeSpec {
-                    poly: vec![-(spec.width_px as f64) / 2.0],
-                    center_px: [spec.width_px as f64 / 2.0, spec.height_px as f64 / 2.0],
-                    affine: [1.0, 0.0, 0.0],
-                });
-                let max_rho = (spec.width_px as f64).hypot(spec.height_px as f64);
-                CameraModel::Fisheye(Fisheye::new(fe.poly, fe.center_px, fe.affine, max_rho))
-            }
-        }
-    }
-
     /// Pixel of a camera-frame point.
     pub fn project(&self, p: &Vector3<f64>) -> Option<[f64; 2]> {
         match self {
@@ -194,12 +218,53 @@ impl CameraModel {
     }
 }
 
+/// Where a camera looks on its body: the orientation part of a mounting, in degrees as a
+/// profile's `[cameras.mount]` gives it (a `&profile::Mount` converts into it).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MountAngles {
+    /// Yaw about body +z, degrees (0 looks forward, 180 backward).
+    pub yaw_deg: f64,
+    /// Pitch, degrees (positive looks down).
+    pub pitch_deg: f64,
+    /// Roll about the optical axis, degrees (180 turns the image upside down).
+    pub roll_deg: f64,
+}
+
+impl MountAngles {
+    /// True when the image is upside down (roll near ±180°).
+    pub fn is_flipped(&self) -> bool {
+        let r = self.roll_deg.rem_euclid(360.0);
+        (r - 180.0).abs() < 90.0
+    }
+}
+
 /// Rotation taking camera-frame vectors to the body frame, for a mount.
 ///
 /// With yaw = pitch = roll = 0 the camera looks along body +x with image right = body −y
 /// and image down = body −z. Then: yaw about body +z, pitch about the body's (yawed) +y
 /// (positive looks down), roll about the optical axis (180° turns the image upside down).
-pub fn body_from_camera(mount: &Mount) -> Matrix3<f64> {
+///
+/// # Example
+///
+/// A forward camera, and a rear camera rolled upside down (Bujold's): the rear camera
+/// looks along body −x, and its image right is body −y again.
+///
+/// ```
+/// use marsupial::perception::{MountAngles, body_from_camera};
+/// use nalgebra::Vector3;
+///
+/// let fwd = body_from_camera(MountAngles::default());
+/// assert!((fwd * Vector3::z() - Vector3::x()).norm() < 1e-12, "optical axis: body +x");
+/// assert!((fwd * Vector3::x() + Vector3::y()).norm() < 1e-12, "image right: body −y");
+///
+/// let rear = MountAngles { yaw_deg: 180.0, pitch_deg: 0.0, roll_deg: 180.0 };
+/// assert!(rear.is_flipped() && !MountAngles::default().is_flipped());
+/// let r = body_from_camera(rear);
+/// assert!((r * Vector3::z() + Vector3::x()).norm() < 1e-12, "optical axis: body −x");
+/// assert!((r * Vector3::x() + Vector3::y()).norm() < 1e-12, "image right: body −y");
+/// ```
+pub fn body_from_camera(mount: impl Into<MountAngles>) -> Matrix3<f64> {
+    let mount = mount.into();
     let r0 = Matrix3::new(0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, -1.0, 0.0);
     let yaw = Rotation3::from_axis_angle(&Vector3::z_axis(), mount.yaw_deg.to_radians());
     let pitch = Rotation3::from_axis_angle(&Vector3::y_axis(), mount.pitch_deg.to_radians());
@@ -249,13 +314,13 @@ mod tests {
 
     #[test]
     fn mounts() {
-        let fwd = body_from_camera(&Mount::default());
+        let fwd = body_from_camera(MountAngles::default());
         assert!((fwd * Vector3::z() - Vector3::x()).norm() < 1e-12);
         assert!(
             (fwd * Vector3::x() + Vector3::y()).norm() < 1e-12,
             "image right is body −y"
         );
-        let back = body_from_camera(&Mount {
+        let back = body_from_camera(MountAngles {
             yaw_deg: 180.0,
             roll_deg: 180.0,
             ..Default::default()
@@ -264,7 +329,7 @@ mod tests {
         // Rolled 180°: image right is body −y again when looking backwards, image down is up.
         assert!((back * Vector3::x() + Vector3::y()).norm() < 1e-12);
         assert!((back * Vector3::y() - Vector3::z()).norm() < 1e-12);
-        let down = body_from_camera(&Mount {
+        let down = body_from_camera(MountAngles {
             pitch_deg: 30.0,
             ..Default::default()
         });

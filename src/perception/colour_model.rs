@@ -23,9 +23,34 @@
 use super::image::RgbView;
 use super::sct::Sct;
 use super::segment::{ChromaGate, SctRange};
-use crate::profile::{PerceptionSpec, SegmentationMode};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
+
+/// Adaptive (imprint + adapt + fallback), static (imprint only) or fixed (table values
+/// only) segmentation. A profile's `perception.mode` (re-exported as
+/// `profile::SegmentationMode`); it lives here because the trackers act on it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SegmentationMode {
+    /// Imprint, then adapt every frame; fall back on timeouts (seed 004 Fig. 5).
+    Adaptive,
+    /// Imprint, never adapt (the paper's comparison, Table II).
+    Static,
+    /// The table values alone: no imprint, no adaptation (RAPOSA's operator-tuned HSV
+    /// bands, seed 001 §II.D).
+    Fixed,
+}
+
+impl SegmentationMode {
+    /// The name used in TOML and output.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            SegmentationMode::Adaptive => "adaptive",
+            SegmentationMode::Static => "static",
+            SegmentationMode::Fixed => "fixed",
+        }
+    }
+}
 
 /// Mean and standard deviation of the SCT angles of one colour, radians.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -57,6 +82,37 @@ impl AngleStats {
 
     /// The segmentation range mean ± `p.n_sd`·SD, with each SD clamped to
     /// [`p.sd_floor`, `p.sd_ceiling`], and the brightness and chroma gates of `p`.
+    ///
+    /// # Example
+    ///
+    /// Pure red has A = π/2 and B = 0; with an SD of 0.05 rad and 4 SDs the range is
+    /// ±0.2 rad about them, which holds a darker, slightly orange red but not blue.
+    ///
+    /// ```
+    /// use marsupial::perception::{AngleStats, ColorModelParams};
+    /// use std::f64::consts::FRAC_PI_2;
+    ///
+    /// let p = ColorModelParams {
+    ///     n_sd: 4.0,
+    ///     sd_floor: 0.01,
+    ///     sd_ceiling: 0.2,
+    ///     min_l: 20.0,
+    ///     min_chroma: 0.05,
+    ///     timeout1: 2.0,
+    ///     timeout2: 5.0,
+    ///     adaptive: true,
+    ///     adapt_rate: 1.0,
+    /// };
+    /// let red = AngleStats::nominal([255, 0, 0], 0.05);
+    /// assert_eq!((red.mean_a, red.mean_b), (FRAC_PI_2, 0.0));
+    /// let r = red.range(&p);
+    /// assert!((r.a[0] - (FRAC_PI_2 - 0.2)).abs() < 1e-12 && (r.b[1] - 0.2).abs() < 1e-12);
+    /// assert!(r.contains([200, 30, 10]));
+    /// assert!(!r.contains([10, 10, 200]));
+    /// // An SD of 0 is floored at 0.01 rad: the range never collapses.
+    /// let flat = AngleStats { sd_a: 0.0, sd_b: 0.0, ..red }.range(&p);
+    /// assert!((flat.b[1] - 0.04).abs() < 1e-12);
+    /// ```
     pub fn range(&self, p: &ColorModelParams) -> SctRange {
         let sa = self.sd_a.clamp(p.sd_floor, p.sd_ceiling) * p.n_sd;
         let sb = self.sd_b.clamp(p.sd_floor, p.sd_ceiling) * p.n_sd;
@@ -73,6 +129,19 @@ impl AngleStats {
 /// chain of [`ColorModel`] is the same whatever the colour space; only the statistics and
 /// how they become a segmentation range differ (SCT angles here, HSV in
 /// [`HsvStats`](super::HsvStats)).
+///
+/// # Example
+///
+/// ```
+/// use marsupial::perception::{AngleStats, Blend};
+///
+/// let old = AngleStats { mean_a: 0.8, sd_a: 0.02, mean_b: 0.4, sd_b: 0.02, n: 100 };
+/// let new = AngleStats { mean_a: 0.9, sd_a: 0.04, mean_b: 0.4, sd_b: 0.02, n: 50 };
+/// let half = old.blend(&new, 0.5);
+/// assert!((half.mean_a - 0.85).abs() < 1e-12 && (half.sd_a - 0.03).abs() < 1e-12);
+/// assert_eq!(half.n, 50);
+/// assert!((old.blend(&new, 1.0).mean_a - 0.9).abs() < 1e-12, "rate 1 replaces");
+/// ```
 pub trait Blend: Copy {
     /// Moves toward `new` with rate `beta` in (0, 1] (1 replaces).
     fn blend(&self, new: &Self, beta: f64) -> Self;
@@ -100,6 +169,21 @@ impl<T: Blend, const N: usize> Blend for [T; N] {
 /// Streaming mean/variance of (A, B) pairs in `f64`, by shifted sums: samples are taken
 /// relative to the first one, which keeps E[x²] − E[x]² well conditioned (the naive form
 /// loses precision; ALGORITHMS §2) without a division per sample.
+///
+/// # Example
+///
+/// ```
+/// use marsupial::perception::StatsAccumulator;
+///
+/// let mut acc = StatsAccumulator::default();
+/// acc.push(0.1, 1.0);
+/// assert!(acc.finish().is_none(), "one sample has no spread");
+/// acc.push(0.3, 1.0);
+/// let s = acc.finish().unwrap();
+/// assert_eq!(s.n, 2);
+/// assert!((s.mean_a - 0.2).abs() < 1e-12 && (s.sd_a - 0.1).abs() < 1e-12);
+/// assert!((s.mean_b - 1.0).abs() < 1e-12 && s.sd_b == 0.0);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StatsAccumulator {
     n: u64,
@@ -171,7 +255,8 @@ impl fmt::Display for ColorMode {
     }
 }
 
-/// Tuning of a [`ColorModel`]. `sd_floor`, `sd_ceiling`, `min_l` and `min_chroma` shape the SCT ranges
+/// Tuning of a [`ColorModel`] (a profile's `[perception]` gives them through
+/// `ColorModelParams::from_spec` in `profile`). `sd_floor`, `sd_ceiling`, `min_l` and `min_chroma` shape the SCT ranges
 /// of [`ColorModel::ranges`]; HSV models carry their own limits
 /// ([`HsvLimits`](super::HsvLimits)).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -197,28 +282,48 @@ pub struct ColorModelParams {
     pub adapt_rate: f64,
 }
 
-impl ColorModelParams {
-    /// The parameters a profile's `[perception]` table sets (adaptive only in
-    /// `adaptive` mode).
-    pub fn from_spec(p: &PerceptionSpec) -> Self {
-        Self {
-            n_sd: p.n_sd,
-            sd_floor: p.sd_floor_deg.to_radians(),
-            sd_ceiling: p.sd_ceiling_deg.to_radians(),
-            min_l: p.min_brightness,
-            min_chroma: p.min_chroma_deg.to_radians(),
-            timeout1: p.timeout1_s,
-            timeout2: p.timeout2_s,
-            adaptive: p.mode == SegmentationMode::Adaptive,
-            adapt_rate: p.adapt_rate,
-        }
-    }
-}
-
 /// The per-colour statistics with the fallback chain. `S` holds every colour's
 /// statistics: by default the SCT angles of two colours (index 0 is the block on the
 /// image's left, 1 the block on its right); RAPOSA's pyramid uses `[HsvStats; 2]`
 /// (orange, blue).
+///
+/// # Example
+///
+/// The fallback chain of seed 004 Fig. 5 on a hand-made timeline, with timeouts of 2 s
+/// and 5 s.
+///
+/// ```
+/// use marsupial::perception::{AngleStats, ColorMode, ColorModel, ColorModelParams};
+///
+/// let params = ColorModelParams {
+///     n_sd: 4.0,
+///     sd_floor: 0.01,
+///     sd_ceiling: 0.2,
+///     min_l: 20.0,
+///     min_chroma: 0.05,
+///     timeout1: 2.0,
+///     timeout2: 5.0,
+///     adaptive: true,
+///     adapt_rate: 1.0,
+/// };
+/// let table = [AngleStats::nominal([0, 255, 255], 0.1), AngleStats::nominal([255, 0, 255], 0.1)];
+/// let stats = |a: f64| AngleStats { mean_a: a, sd_a: 0.02, mean_b: 0.5, sd_b: 0.02, n: 100 };
+///
+/// let mut m = ColorModel::new(table, params);
+/// assert_eq!(m.mode(), ColorMode::Table);
+/// m.imprint([stats(0.70), stats(0.80)], 0.0);
+/// assert_eq!(m.mode(), ColorMode::Imprinted);
+/// m.update(1.0, Some([stats(0.72), stats(0.78)])); // found: adapt
+/// assert_eq!(m.mode(), ColorMode::Adapted);
+/// assert!((m.current()[0].mean_a - 0.72).abs() < 1e-12);
+/// // The next frame's ranges come from the adapted statistics: 0.72 ± 4·0.02.
+/// assert!((m.ranges()[0].a[0] - 0.64).abs() < 1e-12);
+/// m.update(3.5, None); // lost for 2.5 s > timeout 1
+/// assert_eq!(m.mode(), ColorMode::Imprinted);
+/// m.update(6.5, None); // lost for 5.5 s > timeout 2
+/// assert_eq!(m.mode(), ColorMode::Table);
+/// assert_eq!(m.switches(), 4);
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct ColorModel<S: Blend = [AngleStats; 2]> {
     params: ColorModelParams,
@@ -357,6 +462,36 @@ impl ColorModel<[AngleStats; 2]> {
 
 /// Collects imprint statistics from well-aligned frames: a block in the middle of each
 /// rectangle where the profile says the two coloured blocks appear.
+///
+/// # Example
+///
+/// An 8×4 frame, cyan on its left half and magenta on its right; each rectangle is one
+/// half, and the middle half of it by side (2 × 2 = 4 px per frame) is sampled. Three
+/// frames give the 10 pixels per block that [`Imprinter::finish`] needs.
+///
+/// ```
+/// use marsupial::perception::{Imprinter, RgbImage, Sct};
+///
+/// let (cyan, magenta) = ([0, 200, 220], [210, 10, 200]);
+/// let mut im = RgbImage::new(8, 4);
+/// for y in 0..4 {
+///     for x in 0..8 {
+///         im.put(x, y, if x < 4 { cyan } else { magenta });
+///     }
+/// }
+/// let mut imp = Imprinter::new([[0.0, 0.0, 0.5, 1.0], [0.5, 0.0, 1.0, 1.0]], 0.5, 20.0, 0.05);
+/// assert_eq!(imp.sample_rect(0, 8, 4), [1, 1, 3, 3]);
+/// for _ in 0..2 {
+///     imp.add_frame(&im.view());
+/// }
+/// assert!(imp.finish().is_none(), "8 px per block so far");
+/// imp.add_frame(&im.view());
+/// assert_eq!(imp.frames(), 3);
+/// let [left, right] = imp.finish().unwrap();
+/// assert_eq!((left.n, right.n), (12, 12));
+/// assert!((left.mean_b - Sct::from_rgb(cyan).b).abs() < 1e-12 && left.sd_b < 1e-9);
+/// assert!((right.mean_a - Sct::from_rgb(magenta).a).abs() < 1e-12);
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Imprinter {
     rects: [[f64; 4]; 2],

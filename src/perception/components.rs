@@ -30,6 +30,28 @@ pub struct Run {
 
 /// Statistics of one connected component. Coordinates are pixel indices (x = column,
 /// y = row, origin top-left); sums are exact integers.
+///
+/// # Example
+///
+/// A filled 3×2 rectangle: centroid in its middle, variance (n² − 1)/12 along each side
+/// (2/3 across three columns, 1/4 across two rows), no covariance.
+///
+/// ```
+/// use marsupial::perception::{Labeler, Mask};
+///
+/// let mut mask = Mask::new(5, 4);
+/// for (x, y) in [(1, 1), (2, 1), (3, 1), (1, 2), (2, 2), (3, 2)] {
+///     mask.set(x, y, true);
+/// }
+/// let mut labeler = Labeler::new(5, 4);
+/// let c = labeler.label(&mask).unwrap()[0];
+/// assert_eq!(c.count, 6);
+/// assert_eq!(c.bbox, [1, 1, 3, 2]);
+/// assert_eq!((c.width(), c.height()), (3, 2));
+/// assert_eq!(c.centroid(), (2.0, 1.5));
+/// let (mxx, myy, mxy) = c.central_moments();
+/// assert!((mxx - 2.0 / 3.0).abs() < 1e-12 && (myy - 0.25).abs() < 1e-12 && mxy.abs() < 1e-12);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Component {
     /// Pixel count (area).
@@ -100,6 +122,40 @@ impl Component {
 }
 
 /// Reusable 8-connected labeller.
+///
+/// # Example
+///
+/// A 6×4 mask with three components. The pixel at (2, 2) touches the 2×2 square only
+/// diagonally, which is enough under 8-connectivity; the lone pixel at (4, 1) and the pair
+/// at row 3 are two rows apart, so they stay separate. Labels follow the raster order of
+/// each component's first pixel.
+///
+/// ```
+/// use marsupial::perception::{Labeler, Mask, Run};
+///
+/// #[rustfmt::skip]
+/// let mask = Mask::from_vec(6, 4, vec![
+///     1, 1, 0, 0, 0, 0,
+///     1, 1, 0, 0, 1, 0,
+///     0, 0, 1, 0, 0, 0,
+///     0, 0, 0, 0, 1, 1,
+/// ]).unwrap();
+/// let mut labeler = Labeler::new(6, 4);
+/// let comps = labeler.label(&mask).unwrap();
+/// assert_eq!(comps.len(), 3);
+/// assert_eq!(comps.iter().map(|c| c.count).collect::<Vec<_>>(), [5, 1, 2]);
+/// // (0+1+0+1+2)/5 on both axes.
+/// assert_eq!(comps[0].centroid(), (0.8, 0.8));
+/// assert_eq!(comps[0].bbox, [0, 0, 2, 2]);
+/// assert_eq!(comps[2].centroid(), (4.5, 3.0));
+/// // Five runs in raster order, each tagged with its component.
+/// let runs = labeler.runs();
+/// assert_eq!(runs.len(), 5);
+/// assert_eq!(runs[2], Run { y: 1, x0: 4, x1: 5, label: 1 });
+/// assert_eq!(runs.iter().map(|r| r.label).collect::<Vec<_>>(), [0, 0, 1, 0, 2]);
+/// // A mask of another size is refused.
+/// assert!(labeler.label(&Mask::new(4, 4)).is_err());
+/// ```
 #[derive(Debug, Clone)]
 pub struct Labeler {
     width: usize,

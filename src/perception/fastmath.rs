@@ -11,6 +11,16 @@ fn atan_unit(x: f32) -> f32 {
 
 /// `atan2(y, x)` for non-negative `y` and `x` (first quadrant, result in [0, π/2]),
 /// with `atan2_pos(0, 0) = 0`. Maximum error 0.0015 rad (0.09°), tested against `f64::atan2`.
+///
+/// ```
+/// use marsupial::perception::fastmath::atan2_pos;
+/// use std::f32::consts::{FRAC_PI_2, FRAC_PI_4};
+///
+/// assert_eq!(atan2_pos(0.0, 0.0), 0.0);
+/// assert_eq!(atan2_pos(1.0, 1.0), FRAC_PI_4); // exact on the diagonal
+/// assert_eq!(atan2_pos(5.0, 0.0), FRAC_PI_2); // and on the axes
+/// assert!((atan2_pos(3.0, 4.0) - 3f32.atan2(4.0)).abs() < 0.0015);
+/// ```
 #[inline]
 pub fn atan2_pos(y: f32, x: f32) -> f32 {
     let (lo, hi) = if y <= x { (y, x) } else { (x, y) };

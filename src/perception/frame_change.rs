@@ -20,6 +20,26 @@ pub const GRID_W: usize = 16;
 pub const GRID_H: usize = 12;
 
 /// The frame-change cue, with its two grids (no allocation per frame).
+///
+/// # Example
+///
+/// A 16×12 frame has one pixel per grid cell. Brightening every pixel by 10 levels moves
+/// every cell by 10, so the cue reads exactly 10; the same frame again reads 0.
+///
+/// ```
+/// use marsupial::perception::RgbImage;
+/// use marsupial::perception::frame_change::FrameChange;
+///
+/// let mut im = RgbImage::new(16, 12);
+/// im.fill([100, 100, 100]);
+/// let mut cue = FrameChange::new();
+/// assert_eq!(cue.observe(&im.view()), None, "no previous frame");
+/// assert_eq!(cue.observe(&im.view()), Some(0.0));
+/// im.fill([110, 110, 110]);
+/// assert_eq!(cue.observe(&im.view()), Some(10.0));
+/// // A frame smaller than the 16 × 12 grid gives no reading.
+/// assert_eq!(cue.observe(&RgbImage::new(8, 8).view()), None);
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameChange {
     previous: [f32; GRID_W * GRID_H],

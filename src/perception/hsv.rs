@@ -89,6 +89,22 @@ impl HsvPlanes {
 ///
 /// # Errors
 /// [`VisionError::SizeMismatch`] when `dst` was made for another size.
+///
+/// # Example
+///
+/// A 3×1 frame: orange (H = 30.1°, stored as 15), dark green (H = 120°, stored as 60;
+/// V = 100/255) and a dark grey (no hue, no saturation).
+///
+/// ```
+/// use marsupial::perception::{HsvPlanes, RgbImage, hsv_from_rgb};
+///
+/// let im = RgbImage::from_raw(3, 1, vec![255, 128, 0, 0, 100, 0, 10, 10, 10]).unwrap();
+/// let mut planes = HsvPlanes::new(3, 1);
+/// hsv_from_rgb(&im.view(), &mut planes).unwrap();
+/// assert_eq!(planes.h, vec![15, 60, 0]);
+/// assert_eq!(planes.s, vec![255, 255, 0]);
+/// assert_eq!(planes.v, vec![255, 100, 10]);
+/// ```
 pub fn hsv_from_rgb(src: &RgbView<'_>, dst: &mut HsvPlanes) -> Result<(), VisionError> {
     check_same_size((src.width(), src.height()), dst.size())?;
     for (i, px) in src.as_bytes().chunks_exact(3).enumerate() {

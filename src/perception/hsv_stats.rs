@@ -23,6 +23,35 @@ use super::segment::HsvRange;
 use serde::Serialize;
 
 /// Mean and SD of one colour in HSV.
+///
+/// # Example
+///
+/// A learned blue becomes a band: hue 220° ± 4·2°, saturation from 0.8 − 4·0.05 up, and
+/// value from the lower of 0.6 − 4·0.05 and half the mean value (0.3) up.
+///
+/// ```
+/// use marsupial::perception::{Blend, HsvLimits, HsvRange, HsvStats};
+///
+/// let limits = HsvLimits { n_sd: 4.0, hue_sd_deg: [1.0, 20.0], sv_sd: [0.01, 0.1], min_s: 0.2, min_v: 0.05 };
+/// let blue = HsvStats { mean_h_deg: 220.0, sd_h_deg: 2.0, mean_s: 0.8, sd_s: 0.05, mean_v: 0.6, sd_v: 0.05, n: 100 };
+/// let band = blue.band(&limits);
+/// assert_eq!(band.h, [212.0, 228.0]);
+/// assert!((band.s[0] - 0.6).abs() < 1e-6 && band.s[1] == 1.0);
+/// assert!((band.v[0] - 0.3).abs() < 1e-6 && band.v[1] == 1.0);
+/// assert!(band.contains([30, 80, 150])); // H = 215°, S = 0.8, V = 0.59
+/// assert!(!band.contains([30, 150, 150]), "cyan, H = 180°");
+///
+/// // The operator's red band through 0° as statistics: centre 0°, SD 20°/4.
+/// let red = HsvRange { h: [340.0, 20.0], s: [0.5, 1.0], v: [0.2, 1.0] };
+/// let r = HsvStats::from_band(&red, 4.0);
+/// assert!(r.mean_h_deg.abs() < 1e-9 && (r.sd_h_deg - 5.0).abs() < 1e-9);
+///
+/// // Blending moves hue along the shorter arc: halfway from 350° to 10° is 0°, not 180°.
+/// let a = HsvStats { mean_h_deg: 350.0, ..r };
+/// let b = HsvStats { mean_h_deg: 10.0, ..r };
+/// let m = a.blend(&b, 0.5).mean_h_deg;
+/// assert!(m.min(360.0 - m) < 1e-9, "{m}");
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct HsvStats {
     /// Circular mean hue, degrees in [0, 360).
@@ -139,6 +168,25 @@ impl Blend for HsvStats {
 
 /// Streaming HSV statistics by shifted sums (samples relative to the first one; hue
 /// unwrapped to within ±180° of it).
+///
+/// # Example
+///
+/// Two reds on either side of 0°: the circular mean is 0° and the SD 10°.
+///
+/// ```
+/// use marsupial::perception::{Hsv, HsvAccumulator};
+///
+/// let mut acc = HsvAccumulator::default();
+/// acc.push(&Hsv { h: 350.0, s: 0.5, v: 0.8 });
+/// acc.push(&Hsv { h: 10.0, s: 0.7, v: 0.8 });
+/// let s = acc.finish().unwrap();
+/// assert_eq!(s.n, 2);
+/// assert!(s.mean_h_deg.min(360.0 - s.mean_h_deg) < 1e-9);
+/// assert!((s.sd_h_deg - 10.0).abs() < 1e-9);
+/// assert!((s.mean_s - 0.6).abs() < 1e-6 && (s.sd_s - 0.1).abs() < 1e-6 && s.sd_v == 0.0);
+/// acc.clear();
+/// assert_eq!(acc.count(), 0);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct HsvAccumulator {
     n: u64,

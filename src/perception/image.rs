@@ -32,6 +32,30 @@ pub enum ImageError {
 }
 
 /// An owned, packed RGB8 image.
+///
+/// # Example
+///
+/// A 4×3 frame filled by hand: one colour everywhere, one red pixel, then read back
+/// through a view and as packed bytes.
+///
+/// ```
+/// use marsupial::perception::RgbImage;
+///
+/// let mut im = RgbImage::new(4, 3);
+/// im.fill([10, 20, 30]);
+/// im.put(3, 2, [255, 0, 0]);
+/// im.put(9, 9, [1, 1, 1]); // outside the image: ignored
+/// let v = im.view();
+/// assert_eq!((v.width(), v.height()), (4, 3));
+/// assert_eq!(v.get(0, 0), Some([10, 20, 30]));
+/// assert_eq!(v.get(3, 2), Some([255, 0, 0]));
+/// assert_eq!(v.get(4, 0), None);
+/// // Row-major R, G, B: pixel (3, 2) starts at byte (2·4 + 3)·3 = 33.
+/// assert_eq!(&im.as_bytes()[33..36], &[255, 0, 0]);
+/// // Resizing keeps the buffer consistent with the new size.
+/// im.resize(2, 2);
+/// assert_eq!(im.as_bytes().len(), 2 * 2 * 3);
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct RgbImage {
     width: usize,
@@ -53,6 +77,21 @@ impl RgbImage {
     ///
     /// # Errors
     /// [`ImageError::BufferSize`] when `data.len() != width*height*3`.
+    ///
+    /// # Example
+    ///
+    /// ```
+    /// use marsupial::perception::{ImageError, RgbImage};
+    ///
+    /// // 2×1: a black pixel, then a white one.
+    /// let im = RgbImage::from_raw(2, 1, vec![0, 0, 0, 255, 255, 255]).unwrap();
+    /// assert_eq!(im.view().get(1, 0), Some([255, 255, 255]));
+    /// // One byte short of 2×2×3.
+    /// assert_eq!(
+    ///     RgbImage::from_raw(2, 2, vec![0; 11]),
+    ///     Err(ImageError::BufferSize { width: 2, height: 2, expected: 12, got: 11 })
+    /// );
+    /// ```
     pub fn from_raw(width: usize, height: usize, data: Vec<u8>) -> Result<Self, ImageError> {
         let expected = width * height * 3;
         if data.len() != expected {
@@ -120,6 +159,24 @@ impl RgbImage {
 }
 
 /// A borrowed, packed RGB8 image.
+///
+/// # Example
+///
+/// A view over bytes the caller owns (a camera driver's buffer, say), without copying.
+///
+/// ```
+/// use marsupial::perception::{ImageError, RgbView};
+///
+/// let bytes = [0, 0, 0, 9, 8, 7, 1, 2, 3]; // 3×1
+/// let v = RgbView::new(3, 1, &bytes).unwrap();
+/// assert_eq!(v.get(1, 0), Some([9, 8, 7]));
+/// assert_eq!(v.get(0, 1), None);
+/// assert!(!v.is_empty());
+/// assert!(matches!(
+///     RgbView::new(2, 2, &bytes),
+///     Err(ImageError::BufferSize { expected: 12, got: 9, .. })
+/// ));
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RgbView<'a> {
     width: usize,

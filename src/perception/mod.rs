@@ -3,15 +3,25 @@
 //! Everything here is a plain function or a struct that allocates its scratch space once
 //! and reuses it every frame; nothing reads a clock or a random source.
 //!
+//! Perception is a bottom layer: it knows nothing of profiles, schemas or the simulator
+//! (CI checks that nothing here names them). Every detector and tracker is built from a
+//! plain parameter struct ([`TwoBlockParams`], [`PyramidParams`],
+//! [`PyramidTrackerParams`], [`ColorModelParams`], [`MountAngles`] …). The adapters sit
+//! above: `profile` turns a profile's tables into these structs
+//! (`TwoBlockParams::from_profile`, `CameraModel::from_spec` …), and `schemas` runs the
+//! trackers as perceptual schemas over a tick's inputs (`schemas::TwoBlockSchema`,
+//! `schemas::PyramidSchema`).
+//!
 //! * [`camera_model`]: pin-hole and omnidirectional projection, camera mounting.
 //! * [`sct`] and [`hsv`]: colour spaces, exact per pixel and fast over whole frames.
 //! * [`segment`]: per-colour ranges into reusable [`Mask`]s (the SCT test is trig-free).
 //! * [`components`]: 8-connected labelling with per-component moments.
 //! * [`colour_model`]: imprinting, adaptation and the fallback chain of seed 004 Fig. 5.
 //! * [`hsv_stats`]: the HSV statistics that chain uses for RAPOSA's bands.
-//! * [`two_block`]: Bujold's two-block fiducial detector and its perceptual schema.
-//! * [`pyramid`], [`pyramid_pose`] and [`pyramid_schema`]: RAPOSA's pyramid detector, its
-//!   geometry, and its schema with fixed, imprinted or adapted HSV bands.
+//! * [`two_block`] and [`two_block_pose`]: Bujold's two-block fiducial detector, its
+//!   tracker (colour model and imprinting) and the relative pose it gives.
+//! * [`pyramid`], [`pyramid_pose`] and [`pyramid_tracker`]: RAPOSA's pyramid detector, its
+//!   geometry, and its tracker with fixed, imprinted or adapted HSV bands.
 //! * [`overlay`]: drawing a detection over its frame.
 
 pub mod camera_model;
@@ -25,23 +35,27 @@ pub mod image;
 pub mod overlay;
 pub mod pyramid;
 pub mod pyramid_pose;
-pub mod pyramid_schema;
+pub mod pyramid_tracker;
 pub mod sct;
 pub mod segment;
 pub mod two_block;
 pub mod two_block_pose;
 
-pub use colour_model::{AngleStats, Blend, ColorMode, ColorModel, ColorModelParams, Imprinter, StatsAccumulator};
+pub use camera_model::{CameraModel, Fisheye, MountAngles, Pinhole, body_from_camera};
+pub use colour_model::{
+    AngleStats, Blend, ColorMode, ColorModel, ColorModelParams, Imprinter, SegmentationMode, StatsAccumulator,
+};
 pub use components::{Component, Labeler, Run};
 pub use hsv::{Hsv, HsvPlanes, hsv_from_rgb};
 pub use hsv_stats::{HsvAccumulator, HsvLimits, HsvStats};
 pub use image::{ImageError, RgbImage, RgbView};
-pub use pyramid::{BlueRegion, Ellipse, PyramidDetection, PyramidDetector, PyramidPair, PyramidShape};
+pub use pyramid::{BlueRegion, Ellipse, PyramidDetection, PyramidDetector, PyramidPair, PyramidParams, PyramidShape};
 pub use pyramid_pose::{PyramidGeometry, PyramidPercept, PyramidView};
-pub use pyramid_schema::PyramidSchema;
+pub use pyramid_tracker::{PyramidTracker, PyramidTrackerParams};
 pub use sct::{Sct, SctPlanes, sct_from_rgb};
 pub use segment::{ColorRange, HsvRange, Mask, SctRange, Segmenter};
-pub use two_block::{Block, Pair, PairLimits, TwoBlockDetector, TwoBlockPercept, TwoBlockSchema};
+pub use two_block::{Block, Pair, PairLimits, TwoBlockDetector, TwoBlockParams, TwoBlockPercept, TwoBlockTracker};
+pub use two_block_pose::{FiducialView, TwoBlockGeometry};
 
 use thiserror::Error;
 
@@ -69,7 +83,8 @@ pub enum VisionError {
     /// The frame has no pixels.
     #[error("empty image")]
     EmptyImage,
-    /// The profile lacks what a schema needs.
+    /// The configuration lacks what a detector needs (e.g. a profile without the
+    /// fiducial or the camera a schema is built for).
     #[error("{what}")]
     Profile {
         /// What is missing.

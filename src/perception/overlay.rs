@@ -12,6 +12,52 @@ pub const RIGHT_PAINT: ([u8; 3], [u8; 3]) = ([255, 255, 0], [120, 120, 0]);
 /// Copies `frame` into `out` and paints the detector's last segmentation over it: pixels
 /// of the accepted blocks in bright green (left) and yellow (right), other segmented
 /// pixels of the same colours dimmer, and a white box around the accepted pair.
+///
+/// # Example
+///
+/// The pair of [`TwoBlockDetector`]'s example (blocks at x = 4…11, rows 2…5 of a 16×8
+/// frame), boxed 2 px outside its bounds (clipped to the frame).
+///
+/// ```
+/// use marsupial::perception::overlay::{LEFT_PAINT, RIGHT_PAINT, paint_overlay};
+/// use marsupial::perception::{PairLimits, RgbImage, SctRange, TwoBlockDetector};
+///
+/// let grey = [110, 105, 100];
+/// let mut im = RgbImage::new(16, 8);
+/// im.fill(grey);
+/// for y in 2..6 {
+///     (4..8).for_each(|x| im.put(x, y, [20, 190, 210]));
+///     (8..12).for_each(|x| im.put(x, y, [200, 30, 190]));
+/// }
+/// let d = |deg: f64| deg.to_radians();
+/// let ranges = [
+///     SctRange { a: [d(30.0), d(60.0)], b: [d(70.0), d(90.0)], min_l: 30.0, min_chroma: 0.0 },
+///     SctRange { a: [d(30.0), d(60.0)], b: [d(0.0), d(20.0)], min_l: 30.0, min_chroma: 0.0 },
+/// ];
+/// let limits = PairLimits {
+///     min_component_px: 8,
+///     max_gap_frac: 0.5,
+///     gap_slack_px: 3.0,
+///     max_vertical_frac: 0.5,
+///     max_candidates: 8,
+/// };
+/// let mut det = TwoBlockDetector::new(16, 8, limits);
+/// let pair = det.detect(&im.view(), &ranges).unwrap().unwrap();
+///
+/// let mut out = RgbImage::default();
+/// paint_overlay(&im.view(), &det, Some(&pair), &mut out);
+/// let px = |x, y| out.view().get(x, y).unwrap();
+/// assert_eq!(px(5, 3), LEFT_PAINT.0);
+/// assert_eq!(px(9, 3), RIGHT_PAINT.0);
+/// assert_eq!(px(2, 0), [255, 255, 255]); // box corner: (4 − 2, 2 − 2)
+/// assert_eq!(px(13, 7), [255, 255, 255]); // (11 + 2, min(5 + 2, 7))
+/// assert_eq!(px(3, 3), grey); // inside the box, off the blocks
+///
+/// // Without an accepted pair the segmented pixels are painted dim, unboxed.
+/// paint_overlay(&im.view(), &det, None, &mut out);
+/// assert_eq!(out.view().get(5, 3), Some(LEFT_PAINT.1));
+/// assert_eq!(out.view().get(2, 0), Some(grey));
+/// ```
 pub fn paint_overlay(frame: &RgbView<'_>, detector: &TwoBlockDetector, pair: Option<&Pair>, out: &mut RgbImage) {
     let (w, h) = (frame.width(), frame.height());
     out.resize(w, h);

@@ -31,10 +31,36 @@ use super::components::{Component, Labeler};
 use super::image::RgbView;
 use super::segment::{ColorRange, HsvRange, Mask, Segmenter};
 use super::{VisionError, check_same_size};
-use crate::profile::PyramidPerceptionSpec;
 use serde::Serialize;
 
 /// An ellipse fitted to a blob by its second moments.
+///
+/// # Example
+///
+/// A filled 4×2 rectangle. Each side of n pixels has variance (n² − 1)/12 plus the
+/// 1/12 of a unit pixel, n²/12, so the semi-axes are 2·n/√12 = n/√3: 4/√3 and 2/√3, in the
+/// ratio of the sides.
+///
+/// ```
+/// use marsupial::perception::{Ellipse, Labeler, Mask};
+/// use std::f64::consts::PI;
+///
+/// let mut mask = Mask::new(6, 4);
+/// for y in 1..3 {
+///     for x in 1..5 {
+///         mask.set(x, y, true);
+///     }
+/// }
+/// let mut labeler = Labeler::new(6, 4);
+/// let e = Ellipse::from_component(&labeler.label(&mask).unwrap()[0]);
+/// assert_eq!((e.centre, e.count), ([2.5, 1.5], 8));
+/// assert!((e.semi_major - 4.0 / 3f64.sqrt()).abs() < 1e-12);
+/// assert!((e.semi_minor - 2.0 / 3f64.sqrt()).abs() < 1e-12);
+/// assert!((e.axis_ratio() - 2.0).abs() < 1e-12 && e.angle.abs() < 1e-12);
+/// // 8 px over π·a·b = 8π/3.
+/// assert!((e.fill() - 3.0 / PI).abs() < 1e-12);
+/// assert!((e.equivalent_diameter() - 2.0 * (8.0 / PI).sqrt()).abs() < 1e-12);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Ellipse {
     /// Centre (x, y), px.
@@ -167,12 +193,126 @@ pub struct PyramidShape {
     pub offset_ratio: f64,
 }
 
+/// The pyramid detector's bands, shape and pair filters, in plain numbers. A profile's
+/// `[perception.pyramid]` gives them (`PyramidParams::from(&spec)` in `profile`);
+/// [`Default`] holds the values tuned for RAPOSA (seed 001 §II.D), which are also the
+/// profile's defaults.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PyramidParams {
+    /// The orange guide's HSV band.
+    pub orange: HsvRange,
+    /// The blue edges' HSV band.
+    pub blue: HsvRange,
+    /// Smallest orange blob kept as an ellipse, px (the range limit: seed 001 §III).
+    pub min_ellipse_px: u32,
+    /// Largest ellipse axis ratio (major / minor) kept.
+    pub max_axis_ratio: f64,
+    /// Smallest fill of the fitted ellipse (blob pixels / π·a·b); rejects ragged blobs.
+    pub min_fill: f64,
+    /// Smallest blue blob kept, px.
+    pub min_blue_px: u32,
+    /// Loose pair limits; when several pairs pass, the same tests run again with every
+    /// tolerance multiplied by `tighten` (in (0, 1]).
+    pub tighten: f64,
+    /// Largest relative deviation of the blue height from the height the ball's size
+    /// predicts (1 allows a factor of 2 either way).
+    pub max_size_dev: f64,
+    /// Largest vertical offset of the ellipse centre from the blue region's centre, in
+    /// blue heights.
+    pub max_vertical_dev: f64,
+    /// Slack on the horizontal offset the geometry allows, as a fraction of it.
+    pub max_horizontal_dev: f64,
+    /// Ellipse pixels / blue bounding-box area: [lo, hi].
+    pub area_ratio: [f64; 2],
+    /// Radius of the tracking ball around the previous ellipse, px (paper: 20).
+    pub tracking_ball_px: f64,
+    /// The tracking ball is dropped after this many frames without a detection.
+    pub tracking_reset_frames: u32,
+    /// At most this many blobs per colour are considered (the largest), bounding time in
+    /// clutter.
+    pub max_candidates: u32,
+}
+
+impl Default for PyramidParams {
+    fn default() -> Self {
+        Self {
+            orange: HsvRange {
+                h: [8.0, 45.0],
+                s: [0.45, 1.0],
+                v: [0.25, 1.0],
+            },
+            blue: HsvRange {
+                h: [200.0, 250.0],
+                s: [0.40, 1.0],
+                v: [0.12, 1.0],
+            },
+            min_ellipse_px: 40,
+            max_axis_ratio: 2.5,
+            min_fill: 0.7,
+            min_blue_px: 20,
+            tighten: 0.5,
+            max_size_dev: 1.0,
+            max_vertical_dev: 0.6,
+            max_horizontal_dev: 0.5,
+            area_ratio: [0.08, 6.0],
+            tracking_ball_px: 20.0,
+            tracking_reset_frames: 5,
+            max_candidates: 16,
+        }
+    }
+}
+
 /// The pyramid detector. Allocates only in [`PyramidDetector::new`].
+///
+/// # Example
+///
+/// A 40×30 grey frame with a square blue frame (16 px, bars 2 px wide) and an orange disc
+/// of radius 5 (81 px) inside it, detected with the default (RAPOSA) bands and filters.
+/// Without the blue frame the ellipse is still reported, alone.
+///
+/// ```
+/// use marsupial::perception::{PyramidDetector, PyramidParams, PyramidShape, RgbImage};
+///
+/// let (orange, blue) = ([235, 120, 20], [20, 60, 220]);
+/// let scene = |with_blue: bool| {
+///     let mut im = RgbImage::new(40, 30);
+///     im.fill([120, 118, 115]);
+///     for y in 6..22 {
+///         for x in 10..26 {
+///             let bar = x < 12 || x >= 24 || y < 8 || y >= 20;
+///             let in_disc = (x as f64 - 18.0).hypot(y as f64 - 14.0) <= 5.0;
+///             if in_disc {
+///                 im.put(x, y, orange);
+///             } else if bar && with_blue {
+///                 im.put(x, y, blue);
+///             }
+///         }
+///     }
+///     im
+/// };
+/// // Ball 7 cm, blue edges 10 cm; the ball sits 16 cm from the edges' midpoint.
+/// let shape = PyramidShape { size_ratio: 0.10 / 0.07, offset_ratio: 1.6 };
+/// let mut det = PyramidDetector::new(40, 30, &PyramidParams::default(), shape);
+///
+/// let d = det.detect(&scene(true).view()).unwrap();
+/// let pair = d.pair.expect("pair");
+/// assert_eq!(d.candidates, 1);
+/// assert_eq!((pair.ellipse.centre, pair.ellipse.count), ([18.0, 14.0], 81));
+/// assert!(pair.ellipse.axis_ratio() < 1.0 + 1e-9);
+/// assert_eq!(pair.blue.bbox, [10, 6, 25, 21]);
+/// assert_eq!((pair.blue.height(), pair.blue.centre()), (16.0, [17.5, 13.5]));
+/// assert_eq!(det.masks()[1].count(), 16 * 16 - 12 * 12);
+/// assert_eq!(det.tracked(), Some([18.0, 14.0])); // the next frame looks near here
+///
+/// let d = det.detect(&scene(false).view()).unwrap();
+/// assert!(d.pair.is_none() && d.blue.is_none());
+/// assert_eq!(d.ellipse.map(|e| e.count), Some(81));
+/// ```
 #[derive(Debug, Clone)]
 pub struct PyramidDetector {
     width: usize,
     height: usize,
-    spec: PyramidPerceptionSpec,
+    params: PyramidParams,
     shape: PyramidShape,
     bands: [HsvRange; 2],
     segmenter: Segmenter,
@@ -188,14 +328,14 @@ pub struct PyramidDetector {
 
 impl PyramidDetector {
     /// A detector for `width × height` frames.
-    pub fn new(width: usize, height: usize, spec: &PyramidPerceptionSpec, shape: PyramidShape) -> Self {
-        let n = spec.max_candidates as usize;
+    pub fn new(width: usize, height: usize, params: &PyramidParams, shape: PyramidShape) -> Self {
+        let n = params.max_candidates as usize;
         Self {
             width,
             height,
-            spec: *spec,
+            params: *params,
             shape,
-            bands: [spec.orange.range(), spec.blue.range()],
+            bands: [params.orange, params.blue],
             segmenter: Segmenter::new(),
             masks: [Mask::new(width, height), Mask::new(width, height)],
             labelers: [Labeler::new(width, height), Labeler::new(width, height)],
@@ -257,7 +397,7 @@ impl PyramidDetector {
             }
             None => {
                 self.missed += 1;
-                if self.missed > self.spec.tracking_reset_frames {
+                if self.missed > self.params.tracking_reset_frames {
                     self.previous = None;
                 }
             }
@@ -274,17 +414,17 @@ impl PyramidDetector {
             .extend((0..comps.len() as u32).filter(|&i| comps[i as usize].count >= min));
         self.order
             .sort_unstable_by(|&a, &b| comps[b as usize].count.cmp(&comps[a as usize].count).then(a.cmp(&b)));
-        self.order.truncate(self.spec.max_candidates as usize);
+        self.order.truncate(self.params.max_candidates as usize);
     }
 
     fn collect_ellipses(&mut self) -> Result<(), VisionError> {
         self.labelers[0].label(&self.masks[0])?;
-        self.largest(0, self.spec.min_ellipse_px as u64);
+        self.largest(0, self.params.min_ellipse_px as u64);
         self.ellipses.clear();
         let comps = self.labelers[0].components();
         for &i in &self.order {
             let e = Ellipse::from_component(&comps[i as usize]);
-            if e.axis_ratio() <= self.spec.max_axis_ratio && e.fill() >= self.spec.min_fill {
+            if e.axis_ratio() <= self.params.max_axis_ratio && e.fill() >= self.params.min_fill {
                 self.ellipses.push(e);
             }
         }
@@ -293,7 +433,7 @@ impl PyramidDetector {
 
     fn collect_blues(&mut self) -> Result<(), VisionError> {
         self.labelers[1].label(&self.masks[1])?;
-        self.largest(1, self.spec.min_blue_px as u64);
+        self.largest(1, self.params.min_blue_px as u64);
         self.blues.clear();
         let comps = self.labelers[1].components();
         for &i in &self.order {
@@ -327,13 +467,13 @@ impl PyramidDetector {
 
     fn in_ball(&self, e: &Ellipse) -> bool {
         self.previous
-            .is_none_or(|p| (e.centre[0] - p[0]).hypot(e.centre[1] - p[1]) <= self.spec.tracking_ball_px)
+            .is_none_or(|p| (e.centre[0] - p[0]).hypot(e.centre[1] - p[1]) <= self.params.tracking_ball_px)
     }
 
     /// Pair test at tolerance scale `t` (1 loose, `tighten` tight): the normalised
     /// deviation, or `None` when a limit is exceeded.
     fn pair_score(&self, e: &Ellipse, b: &BlueRegion, t: f64) -> Option<f64> {
-        let s = &self.spec;
+        let s = &self.params;
         let g = b.height();
         // Size: the blue height against the ball's diameter.
         let size = (g / (self.shape.size_ratio * e.equivalent_diameter())).ln().abs();
@@ -378,7 +518,7 @@ impl PyramidDetector {
             }
         };
         if self.survivors.len() > 1 {
-            let t = self.spec.tighten;
+            let t = self.params.tighten;
             for p in &self.survivors {
                 if let Some(score) = self.pair_score(&p.ellipse, &p.blue, t) {
                     consider(&mut best, PyramidPair { score, ..*p });
@@ -457,7 +597,7 @@ mod tests {
     fn moment_ellipse_of_a_disc_and_a_bar() {
         let mut im = grey(80, 60);
         disc(&mut im, 40.0, 30.0, 10.0, ORANGE);
-        let mut d = PyramidDetector::new(80, 60, &PyramidPerceptionSpec::default(), shape());
+        let mut d = PyramidDetector::new(80, 60, &PyramidParams::default(), shape());
         let det = d.detect(&im.view()).unwrap();
         let e = det.ellipse.expect("disc found");
         assert!((e.centre[0] - 40.0).abs() < 0.1 && (e.centre[1] - 30.0).abs() < 0.1);
@@ -479,7 +619,7 @@ mod tests {
         let mut im = grey(160, 120);
         frame(&mut im, 60, 40, 30, 4);
         disc(&mut im, 75.0, 56.0, 10.0, ORANGE);
-        let mut d = PyramidDetector::new(160, 120, &PyramidPerceptionSpec::default(), shape());
+        let mut d = PyramidDetector::new(160, 120, &PyramidParams::default(), shape());
         let det = d.detect(&im.view()).unwrap();
         let p = det.pair.expect("pair");
         assert_eq!(p.blue.bbox, [60, 40, 89, 69]);
@@ -497,7 +637,7 @@ mod tests {
 
     #[test]
     fn tracking_ball_ignores_far_jumps_and_resets() {
-        let spec = PyramidPerceptionSpec::default();
+        let spec = PyramidParams::default();
         let mut d = PyramidDetector::new(160, 120, &spec, shape());
         let mut a = grey(160, 120);
         disc(&mut a, 40.0, 60.0, 8.0, ORANGE);
@@ -524,7 +664,7 @@ mod tests {
         frame(&mut im, 80, 40, 30, 4);
         disc(&mut im, 95.0, 55.0, 10.0, ORANGE);
         disc(&mut im, 150.0, 70.0, 10.0, ORANGE);
-        let mut d = PyramidDetector::new(200, 120, &PyramidPerceptionSpec::default(), shape());
+        let mut d = PyramidDetector::new(200, 120, &PyramidParams::default(), shape());
         let det = d.detect(&im.view()).unwrap();
         assert!(det.candidates >= 2, "{}", det.candidates);
         assert!((det.pair.unwrap().ellipse.centre[0] - 95.0).abs() < 0.5);
@@ -540,7 +680,7 @@ mod tests {
             }
         }
         disc(&mut im, 75.0, 55.0, 10.0, ORANGE);
-        let mut d = PyramidDetector::new(160, 120, &PyramidPerceptionSpec::default(), shape());
+        let mut d = PyramidDetector::new(160, 120, &PyramidParams::default(), shape());
         let det = d.detect(&im.view()).unwrap();
         assert_eq!(det.blue.unwrap().bbox, [60, 40, 89, 69]);
     }
@@ -549,7 +689,7 @@ mod tests {
     fn live_band_change_takes_effect() {
         let mut im = grey(80, 60);
         disc(&mut im, 40.0, 30.0, 10.0, [40, 200, 40]); // green
-        let mut d = PyramidDetector::new(80, 60, &PyramidPerceptionSpec::default(), shape());
+        let mut d = PyramidDetector::new(80, 60, &PyramidParams::default(), shape());
         assert!(d.detect(&im.view()).unwrap().ellipse.is_none());
         let [_, blue] = d.bands();
         d.set_bands(
@@ -565,21 +705,21 @@ mod tests {
 
     #[test]
     fn segmentation_matches_the_reference_over_the_cube() {
-        let spec = PyramidPerceptionSpec::default();
+        let spec = PyramidParams::default();
         let im = crate::perception::image::rgb_cube(5);
         let mut d = PyramidDetector::new(im.width(), im.height(), &spec, shape());
         d.detect(&im.view()).unwrap();
         let [o, b] = d.masks();
         for (idx, px) in im.as_bytes().chunks_exact(3).enumerate() {
             let rgb = [px[0], px[1], px[2]];
-            assert_eq!(o.data()[idx] != 0, spec.orange.range().contains(rgb), "{rgb:?}");
-            assert_eq!(b.data()[idx] != 0, spec.blue.range().contains(rgb), "{rgb:?}");
+            assert_eq!(o.data()[idx] != 0, spec.orange.contains(rgb), "{rgb:?}");
+            assert_eq!(b.data()[idx] != 0, spec.blue.contains(rgb), "{rgb:?}");
         }
     }
 
     #[test]
     fn wrong_size_is_an_error() {
-        let mut d = PyramidDetector::new(80, 60, &PyramidPerceptionSpec::default(), shape());
+        let mut d = PyramidDetector::new(80, 60, &PyramidParams::default(), shape());
         assert!(matches!(
             d.detect(&RgbImage::new(40, 30).view()),
             Err(VisionError::SizeMismatch { .. })

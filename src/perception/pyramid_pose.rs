@@ -18,13 +18,18 @@
 //! +y. Seen from +y the blue edges (behind the ball) appear to the right of the ball, so a
 //! ball left of the blue centre means α > 0.
 
-use super::VisionError;
 use super::pyramid::{PyramidDetection, PyramidPair, PyramidShape};
-use crate::profile::Profile;
-use crate::schemas::Percept;
 use serde::Serialize;
 
 /// The largest angle the quadratic can return, atan(2m/h), rad.
+///
+/// ```
+/// use marsupial::perception::pyramid_pose::{alpha_from_k, max_alpha};
+/// // The paper's pyramid: h = 10 cm, m = 16 cm.
+/// let peak = max_alpha(0.10, 0.16);
+/// assert!((peak.to_degrees() - 72.6).abs() < 0.1);
+/// assert_eq!(alpha_from_k(1.0, 0.10, 0.16), peak, "K beyond the peak saturates");
+/// ```
 pub fn max_alpha(h: f64, m: f64) -> f64 {
     (2.0 * m / h).atan()
 }
@@ -49,7 +54,54 @@ pub fn alpha_from_k(k: f64, h: f64, m: f64) -> f64 {
     s.clamp(0.0, 1.0).asin()
 }
 
-/// Camera and target constants of the pyramid geometry.
+/// Camera and target constants of the pyramid geometry. A profile gives them through
+/// `PyramidGeometry::from_profile` (in `profile`).
+///
+/// # Example
+///
+/// With f = 360 px and blue edges h = 10 cm tall, blue edges 18 px tall are
+/// 360·0.1/18 = 2 m away. A ball whose centre is 9 px (half the blue height) from the
+/// blue box's far side gives K = h/2, α = 0: the robot is on the axis; the ball further
+/// left means α > 0. Without the blue edges the distance comes from the ball's area.
+///
+/// ```
+/// use marsupial::perception::{BlueRegion, Ellipse, PyramidDetection, PyramidGeometry, PyramidPair};
+///
+/// let g = PyramidGeometry { f_px: 360.0, principal: [80.0, 60.0], h: 0.1, m: 0.16, ball_diameter: 0.07 };
+/// assert!((g.distance_from_blue(18.0) - 2.0).abs() < 1e-12);
+/// assert!((g.distance_from_area(g.reference_area_px() / 4.0) - 2.0).abs() < 1e-12);
+/// assert!((g.shape().offset_ratio - 1.6).abs() < 1e-12);
+///
+/// let blue = BlueRegion { bbox: [60, 40, 77, 57], count: 200 }; // 18 × 18 px, centre x 68.5
+/// let ball = |x: f64| Ellipse {
+///     centre: [x, 50.0],
+///     semi_major: 5.0,
+///     semi_minor: 5.0,
+///     angle: 0.0,
+///     count: 80,
+///     bbox: [0; 4],
+/// };
+/// let pair = |x: f64| PyramidPair { ellipse: ball(x), blue, score: 0.0 };
+/// let (alpha, saturated) = g.alpha(&pair(68.5)); // c = 77 + 1 − 68.5 − 0.5 = 9 px
+/// assert!(alpha.abs() < 1e-9 && !saturated);
+/// assert!(g.alpha(&pair(62.5)).0 > 0.2); // c = 15 px
+///
+/// let det = PyramidDetection { pair: Some(pair(68.5)), ellipse: Some(ball(68.5)), blue: Some(blue), candidates: 1 };
+/// let v = g.view(&det).unwrap();
+/// assert!((v.blue_distance_m.unwrap() - 2.0).abs() < 1e-12);
+/// assert!((v.ball_distance_m - (2.0 - 0.16)).abs() < 1e-9); // the ball is m in front
+/// // The ball is 11 px left of the principal point: a bearing to the left (positive).
+/// assert_eq!(v.dev_px, [-11.0, -9.5]);
+/// assert!((v.bearing - (11.0f64 / 360.0).atan()).abs() < 1e-12);
+///
+/// // A ninth of the ball's area at 1 m (498.8 px): about 3 m.
+/// let alone = Ellipse { count: 55, ..ball(68.5) };
+/// let det = PyramidDetection { pair: None, ellipse: Some(alone), blue: None, candidates: 0 };
+/// let v = g.view(&det).unwrap();
+/// assert!(v.alpha.is_none() && v.blue_distance_m.is_none());
+/// assert_eq!(v.ball_distance_m, g.distance_from_area(55.0));
+/// assert!((v.ball_distance_m - 3.0).abs() < 0.02);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PyramidGeometry {
     /// Focal length, px.
@@ -85,32 +137,6 @@ pub struct PyramidView {
 }
 
 impl PyramidGeometry {
-    /// From a profile's first camera and `[fiducial.pyramid]`.
-    ///
-    /// # Errors
-    /// [`VisionError::Profile`] without a pin-hole camera or a pyramid fiducial.
-    pub fn from_profile(profile: &Profile, camera: usize) -> Result<Self, VisionError> {
-        let err = |what: String| VisionError::Profile { what };
-        let pyr = profile
-            .fiducial
-            .pyramid
-            .ok_or_else(|| err(format!("profile `{}` has no [fiducial.pyramid]", profile.name)))?;
-        let cam = profile
-            .cameras
-            .get(camera)
-            .ok_or_else(|| err(format!("profile `{}` has no camera {camera}", profile.name)))?;
-        let k = cam
-            .pinhole_intrinsics()
-            .ok_or_else(|| err(format!("camera `{}` is not a pin-hole camera", cam.name)))?;
-        Ok(Self {
-            f_px: k.fx,
-            principal: [k.cx, k.cy],
-            h: pyr.blue_edge_length_m,
-            m: pyr.edge_to_ball_m,
-            ball_diameter: pyr.ball_diameter_m,
-        })
-    }
-
     /// The proportions the detector's pair filters use.
     pub fn shape(&self) -> PyramidShape {
         PyramidShape {
@@ -202,16 +228,6 @@ impl PyramidPercept {
             view: None,
             image_size,
         }
-    }
-}
-
-impl Percept for PyramidPercept {
-    fn stamp(&self) -> f64 {
-        self.stamp
-    }
-    /// Found when the orange guide is seen (blue alone is not the target).
-    fn found(&self) -> bool {
-        self.view.is_some()
     }
 }
 

@@ -45,6 +45,15 @@ impl Sct {
     }
 
     /// Fast SCT (f32, polynomial arctangent): angles within 0.0015 rad of [`Sct::from_rgb`].
+    ///
+    /// ```
+    /// use marsupial::perception::Sct;
+    /// // L = √(30² + 40² + 120²) = 130, A = atan(50/120), B = atan(40/30).
+    /// let (l, a, b) = Sct::from_rgb_fast([30, 40, 120]);
+    /// assert_eq!(l, 130.0);
+    /// assert!((a as f64 - (50f64 / 120.0).atan()).abs() < 0.0015);
+    /// assert!((b as f64 - (40f64 / 30.0).atan()).abs() < 0.0015);
+    /// ```
     #[inline]
     pub fn from_rgb_fast(rgb: [u8; 3]) -> (f32, f32, f32) {
         let [r, g, b] = rgb.map(f32::from);
@@ -92,6 +101,28 @@ impl SctPlanes {
 ///
 /// # Errors
 /// [`VisionError::SizeMismatch`] when `dst` was made for another size.
+///
+/// # Example
+///
+/// A 2×2 frame of red, green, blue and black. Red and green lie on the r-g plane
+/// (A = π/2, the last bin), blue on the blue axis (A = 0); B is 0 for red and π/2 for
+/// green. Black is L = 0 with both angles 0.
+///
+/// ```
+/// use marsupial::perception::{RgbImage, SctPlanes, VisionError, sct_from_rgb};
+///
+/// let im = RgbImage::from_raw(2, 2, vec![255, 0, 0, 0, 255, 0, 0, 0, 255, 0, 0, 0]).unwrap();
+/// let mut planes = SctPlanes::new(2, 2);
+/// sct_from_rgb(&im.view(), &mut planes).unwrap();
+/// assert_eq!(planes.l, vec![255, 255, 255, 0]);
+/// assert_eq!(planes.a, vec![255, 255, 0, 0]);
+/// assert_eq!(planes.b, vec![0, 255, 0, 0]);
+/// // Planes sized for another frame are refused.
+/// assert!(matches!(
+///     sct_from_rgb(&im.view(), &mut SctPlanes::new(3, 2)),
+///     Err(VisionError::SizeMismatch { .. })
+/// ));
+/// ```
 pub fn sct_from_rgb(src: &RgbView<'_>, dst: &mut SctPlanes) -> Result<(), VisionError> {
     check_same_size((src.width(), src.height()), dst.size())?;
     for (i, px) in src.as_bytes().chunks_exact(3).enumerate() {

@@ -65,6 +65,22 @@ pub enum ColorRange {
 
 impl SctRange {
     /// Reference classification with `f64` trigonometry (slow; for tests and tools).
+    ///
+    /// ```
+    /// use marsupial::perception::SctRange;
+    ///
+    /// // Cyan: A near 45° (as much blue as green), B near 90° (green, no red).
+    /// let cyan = SctRange {
+    ///     a: [35f64.to_radians(), 55f64.to_radians()],
+    ///     b: [75f64.to_radians(), std::f64::consts::FRAC_PI_2],
+    ///     min_l: 30.0,
+    ///     min_chroma: 0.0,
+    /// };
+    /// assert!(cyan.contains([0, 200, 210]));
+    /// assert!(cyan.contains([0, 50, 52]), "darker, same angles");
+    /// assert!(!cyan.contains([0, 10, 11]), "too dark: L < 30");
+    /// assert!(!cyan.contains([200, 10, 200]), "magenta: B near 0");
+    /// ```
     pub fn contains(&self, rgb: [u8; 3]) -> bool {
         let s = Sct::from_rgb(rgb);
         s.l >= self.min_l.max(1.0)
@@ -78,6 +94,16 @@ impl SctRange {
 
 /// Angle between an RGB colour vector and the grey axis r = g = b, radians (0 for grey
 /// and black, at most acos(1/√3) ≈ 54.7° for a primary).
+///
+/// ```
+/// use marsupial::perception::segment::chroma;
+///
+/// assert!(chroma([90, 90, 90]) < 1e-6, "on the grey axis");
+/// assert_eq!(chroma([0, 0, 0]), 0.0);
+/// let red = chroma([255, 0, 0]);
+/// assert!((red - (1.0 / 3f64.sqrt()).acos()).abs() < 1e-12);
+/// assert!(chroma([87, 90, 93]) < 2f64.to_radians(), "a bluish grey is nearly grey");
+/// ```
 pub fn chroma(rgb: [u8; 3]) -> f64 {
     let [r, g, b] = rgb.map(f64::from);
     let l = (r * r + g * g + b * b).sqrt();
@@ -123,6 +149,18 @@ impl ChromaGate {
 
 impl HsvRange {
     /// True when the pixel falls in the box.
+    ///
+    /// ```
+    /// use marsupial::perception::HsvRange;
+    ///
+    /// // A red band wrapping through 0°.
+    /// let red = HsvRange { h: [340.0, 20.0], s: [0.5, 1.0], v: [0.2, 1.0] };
+    /// assert!(red.contains([250, 10, 30])); // H ≈ 355°
+    /// assert!(red.contains([250, 30, 10])); // H ≈ 5°
+    /// assert!(!red.contains([10, 250, 30]), "green");
+    /// assert!(!red.contains([120, 110, 110]), "S ≈ 0.08: too grey");
+    /// assert!(!red.contains([40, 2, 2]), "V ≈ 0.16: too dark");
+    /// ```
     #[inline]
     pub fn contains(&self, rgb: [u8; 3]) -> bool {
         self.contains_hsv(&Hsv::from_rgb(rgb))
@@ -130,6 +168,15 @@ impl HsvRange {
 
     /// True when an already converted pixel falls in the box (lets several ranges share
     /// one conversion).
+    ///
+    /// ```
+    /// use marsupial::perception::{Hsv, HsvRange};
+    ///
+    /// let orange = HsvRange { h: [8.0, 45.0], s: [0.45, 1.0], v: [0.25, 1.0] };
+    /// let blue = HsvRange { h: [200.0, 250.0], s: [0.4, 1.0], v: [0.12, 1.0] };
+    /// let p = Hsv::from_rgb([235, 120, 20]); // H ≈ 27.9°
+    /// assert!(orange.contains_hsv(&p) && !blue.contains_hsv(&p));
+    /// ```
     #[inline]
     pub fn contains_hsv(&self, p: &Hsv) -> bool {
         let h_ok = if self.h[0] <= self.h[1] {
@@ -143,6 +190,23 @@ impl HsvRange {
 
 impl ColorRange {
     /// Reference classification of one pixel.
+    ///
+    /// ```
+    /// use marsupial::perception::{ColorRange, HsvRange, SctRange};
+    ///
+    /// let green_hsv = ColorRange::Hsv(HsvRange { h: [100.0, 140.0], s: [0.4, 1.0], v: [0.2, 1.0] });
+    /// // The same green in SCT: A near 90° (no blue), B near 90° (no red).
+    /// let green_sct = ColorRange::Sct(SctRange {
+    ///     a: [80f64.to_radians(), 90f64.to_radians()],
+    ///     b: [75f64.to_radians(), 90f64.to_radians()],
+    ///     min_l: 30.0,
+    ///     min_chroma: 0.0,
+    /// });
+    /// for range in [green_hsv, green_sct] {
+    ///     assert!(range.contains([20, 200, 10]));
+    ///     assert!(!range.contains([200, 20, 10]));
+    /// }
+    /// ```
     pub fn contains(&self, rgb: [u8; 3]) -> bool {
         match self {
             ColorRange::Sct(r) => r.contains(rgb),
@@ -152,6 +216,25 @@ impl ColorRange {
 }
 
 /// A binary mask: one byte per pixel, 0 or 1, row-major.
+///
+/// # Example
+///
+/// ```
+/// use marsupial::perception::Mask;
+///
+/// let mut m = Mask::new(4, 3);
+/// m.set(1, 0, true);
+/// m.set(3, 2, true);
+/// m.set(7, 7, true); // outside: ignored
+/// assert!(m.get(1, 0) && m.get(3, 2) && !m.get(0, 0) && !m.get(7, 7));
+/// assert_eq!(m.count(), 2);
+/// assert_eq!(m.data()[2 * 4 + 3], 1); // row-major
+///
+/// // Any non-zero byte counts as set.
+/// let m = Mask::from_vec(2, 2, vec![0, 7, 1, 0]).unwrap();
+/// assert_eq!(m.data(), &[0, 1, 1, 0]);
+/// assert!(Mask::from_vec(2, 2, vec![0; 3]).is_err());
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct Mask {
     width: usize,
@@ -304,6 +387,39 @@ impl SctThresholds {
 
 /// Segments frames into one mask per colour range. Holds its tables and scratch so that
 /// segmenting allocates nothing once sized.
+///
+/// # Example
+///
+/// A 4×3 grey frame with two red pixels in its top row and one cyan pixel in its
+/// bottom-right corner, segmented with an HSV range for red and an SCT range for cyan in
+/// one call.
+///
+/// ```
+/// use marsupial::perception::{ColorRange, HsvRange, Mask, RgbImage, SctRange, Segmenter};
+/// use std::f64::consts::FRAC_PI_2;
+///
+/// let mut im = RgbImage::new(4, 3);
+/// im.fill([128, 128, 128]);
+/// im.put(0, 0, [250, 10, 30]);
+/// im.put(1, 0, [240, 30, 10]);
+/// im.put(3, 2, [0, 200, 210]);
+///
+/// let red = ColorRange::Hsv(HsvRange { h: [340.0, 20.0], s: [0.5, 1.0], v: [0.2, 1.0] });
+/// let cyan = ColorRange::Sct(SctRange {
+///     a: [35f64.to_radians(), 55f64.to_radians()],
+///     b: [75f64.to_radians(), FRAC_PI_2],
+///     min_l: 30.0,
+///     min_chroma: 0.0,
+/// });
+/// let mut masks = [Mask::new(4, 3), Mask::new(4, 3)];
+/// let mut seg = Segmenter::new();
+/// seg.segment(&im.view(), &[red, cyan], &mut masks).unwrap();
+/// assert_eq!(masks[0].data(), &[1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0]);
+/// assert_eq!(masks[1].count(), 1);
+/// assert!(masks[1].get(3, 2));
+/// // One mask per range, each of the frame's size.
+/// assert!(seg.segment(&im.view(), &[red], &mut masks).is_err());
+/// ```
 #[derive(Debug, Clone)]
 pub struct Segmenter {
     /// Per-frame thresholds of the SCT ranges.

@@ -1,4 +1,6 @@
-//! Bujold's two-block fiducial (seed 004 §IV.B): detector and perceptual schema.
+//! Bujold's two-block fiducial (seed 004 §IV.B): detector and tracker (detector, colour
+//! model and imprinting for one camera's frames; `schemas::TwoBlockSchema` runs it on a
+//! tick's inputs).
 //!
 //! Per frame: segment both colours (SCT ranges from the [`ColorModel`]), label each mask,
 //! drop components under `min_component_px`, and test every (left-colour, right-colour)
@@ -17,17 +19,17 @@
 //! to the larger total, then to the lower component indices, so the choice is
 //! deterministic.
 
-use super::colour_model::{AngleStats, ColorMode, ColorModel, ColorModelParams, Imprinter, StatsAccumulator};
+use super::colour_model::{
+    AngleStats, ColorMode, ColorModel, ColorModelParams, Imprinter, SegmentationMode, StatsAccumulator,
+};
 use super::components::Labeler;
 use super::image::RgbView;
 use super::sct::Sct;
 use super::segment::{ColorRange, Mask, SctRange, Segmenter};
 use super::{VisionError, check_same_size};
-use crate::profile::{PerceptionSpec, Profile, SegmentationMode};
-use crate::schemas::{Inputs, Percept, PerceptualSchema};
 use serde::Serialize;
 
-/// Pairing limits (from the profile's `[perception]`).
+/// Pairing limits (a profile's `[perception]` gives them: `PairLimits::from(&spec)`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PairLimits {
     /// Smallest component considered, px.
@@ -40,18 +42,6 @@ pub struct PairLimits {
     pub max_vertical_frac: f64,
     /// Largest number of components per colour paired.
     pub max_candidates: usize,
-}
-
-impl From<&PerceptionSpec> for PairLimits {
-    fn from(p: &PerceptionSpec) -> Self {
-        Self {
-            min_component_px: p.min_component_px as u64,
-            max_gap_frac: p.max_gap_frac,
-            gap_slack_px: p.gap_slack_px,
-            max_vertical_frac: p.max_vertical_frac,
-            max_candidates: p.max_candidates as usize,
-        }
-    }
 }
 
 /// One accepted block.
@@ -79,6 +69,54 @@ pub struct Pair {
 }
 
 /// Segments, labels and pairs; owns all scratch buffers.
+///
+/// # Example
+///
+/// A 16×8 grey frame with a 4×4 cyan block at x = 4…7 and a 4×4 magenta block right of
+/// it at x = 8…11 (rows 2…5): the pair is found with both blocks' counts, centroids and
+/// boxes; the same blocks in the other order (the fiducial upside down) are rejected.
+///
+/// ```
+/// use marsupial::perception::{PairLimits, RgbImage, Sct, SctRange, TwoBlockDetector};
+///
+/// let (cyan, magenta) = ([20, 190, 210], [200, 30, 190]);
+/// let frame = |left: [u8; 3], right: [u8; 3]| {
+///     let mut im = RgbImage::new(16, 8);
+///     im.fill([110, 105, 100]);
+///     for y in 2..6 {
+///         (4..8).for_each(|x| im.put(x, y, left));
+///         (8..12).for_each(|x| im.put(x, y, right));
+///     }
+///     im
+/// };
+/// let d = |deg: f64| deg.to_radians();
+/// let ranges = [
+///     SctRange { a: [d(30.0), d(60.0)], b: [d(70.0), d(90.0)], min_l: 30.0, min_chroma: 0.0 },
+///     SctRange { a: [d(30.0), d(60.0)], b: [d(0.0), d(20.0)], min_l: 30.0, min_chroma: 0.0 },
+/// ];
+/// let limits = PairLimits {
+///     min_component_px: 8,
+///     max_gap_frac: 0.5,
+///     gap_slack_px: 3.0,
+///     max_vertical_frac: 0.5,
+///     max_candidates: 8,
+/// };
+/// let mut det = TwoBlockDetector::new(16, 8, limits);
+///
+/// let im = frame(cyan, magenta);
+/// let pair = det.detect(&im.view(), &ranges).unwrap().expect("found");
+/// assert_eq!((pair.left.count, pair.right.count, pair.ratio), (16, 16, 1.0));
+/// assert_eq!(pair.left.centroid, [5.5, 3.5]);
+/// assert_eq!(pair.right.bbox, [8, 2, 11, 5]);
+/// assert_eq!(det.masks()[0].count(), 16);
+/// // The accepted blocks' colour statistics, for adaptation (fast SCT: within 0.002 rad).
+/// let [l, r] = det.measure(&im.view(), &pair).unwrap();
+/// assert!((l.mean_b - Sct::from_rgb(cyan).b).abs() < 0.002 && l.sd_b == 0.0);
+/// assert!((r.mean_b - Sct::from_rgb(magenta).b).abs() < 0.002);
+///
+/// let upside_down = frame(magenta, cyan);
+/// assert_eq!(det.detect(&upside_down.view(), &ranges).unwrap(), None);
+/// ```
 #[derive(Debug, Clone)]
 pub struct TwoBlockDetector {
     width: usize,
@@ -297,19 +335,105 @@ impl TwoBlockPercept {
     }
 }
 
-impl Percept for TwoBlockPercept {
-    fn stamp(&self) -> f64 {
-        self.stamp
-    }
-    fn found(&self) -> bool {
-        self.found
-    }
+/// Everything a [`TwoBlockTracker`] needs, in plain numbers. A profile gives them through
+/// `TwoBlockParams::from_profile` (in `profile`); an embedder without profiles fills
+/// them in directly.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TwoBlockParams {
+    /// Frame width, px.
+    pub width: usize,
+    /// Frame height, px.
+    pub height: usize,
+    /// Nominal sRGB paint of the block on the image's left, then on its right, as this
+    /// camera delivers the image (a 180°-rolled camera swaps the fiducial's sides): the
+    /// table defaults of the colour model.
+    pub colours: [[u8; 3]; 2],
+    /// SD of the table defaults on both SCT angles, rad.
+    pub table_sd: f64,
+    /// Pairing limits.
+    pub limits: PairLimits,
+    /// Colour model tuning; its `adaptive` flag is replaced by `mode == Adaptive`.
+    pub colour: ColorModelParams,
+    /// Adaptive, static or fixed segmentation (fixed installs no imprint).
+    pub mode: SegmentationMode,
+    /// Where the image-left and image-right blocks appear as the robot leaves the dock:
+    /// (x0, y0, x1, y1) as fractions of the frame's width and height.
+    pub imprint_rects: [[f64; 4]; 2],
+    /// Fraction of each imprint rectangle (per side, centred) that is sampled, in (0, 1].
+    pub imprint_sample_frac: f64,
+    /// Frames to imprint on.
+    pub imprint_frames: u32,
 }
 
-/// The close-dock perceptual schema: detector + colour model (+ imprinting).
+/// Bujold's close-dock perception for one camera: detector + colour model (+ imprinting).
+/// Allocates only in [`TwoBlockTracker::new`].
+///
+/// # Example
+///
+/// The frame of [`TwoBlockDetector`]'s example (4×4 cyan and magenta blocks side by side
+/// in a 16×8 frame): imprint on it as on departure, track it, then lose the camera.
+///
+/// ```
+/// use marsupial::perception::{
+///     ColorMode, ColorModelParams, PairLimits, RgbImage, SegmentationMode, TwoBlockParams, TwoBlockTracker,
+/// };
+///
+/// let (cyan, magenta) = ([20, 190, 210], [200, 30, 190]);
+/// let mut im = RgbImage::new(16, 8);
+/// im.fill([110, 105, 100]);
+/// for y in 2..6 {
+///     (4..8).for_each(|x| im.put(x, y, cyan));
+///     (8..12).for_each(|x| im.put(x, y, magenta));
+/// }
+/// let params = TwoBlockParams {
+///     width: 16,
+///     height: 8,
+///     colours: [cyan, magenta],
+///     table_sd: 0.05,
+///     limits: PairLimits {
+///         min_component_px: 8,
+///         max_gap_frac: 0.5,
+///         gap_slack_px: 3.0,
+///         max_vertical_frac: 0.5,
+///         max_candidates: 8,
+///     },
+///     colour: ColorModelParams {
+///         n_sd: 4.0,
+///         sd_floor: 0.01,
+///         sd_ceiling: 0.2,
+///         min_l: 20.0,
+///         min_chroma: 0.05,
+///         timeout1: 2.0,
+///         timeout2: 5.0,
+///         adaptive: true,
+///         adapt_rate: 1.0,
+///     },
+///     mode: SegmentationMode::Adaptive,
+///     // Exactly the two blocks, sampled whole.
+///     imprint_rects: [[0.25, 0.25, 0.5, 0.75], [0.5, 0.25, 0.75, 0.75]],
+///     imprint_sample_frac: 1.0,
+///     imprint_frames: 1,
+/// };
+/// let mut t = TwoBlockTracker::new(&params);
+/// assert_eq!(t.model().mode(), ColorMode::Table);
+/// t.imprint_frame(&im.view());
+/// assert!(t.finish_imprint(0.0));
+/// assert_eq!(t.model().mode(), ColorMode::Imprinted);
+///
+/// let p = t.process(&im.view(), 0.1).unwrap();
+/// assert!(p.found);
+/// assert_eq!((p.left_px, p.right_px, p.total_px), (16, 16, 32));
+/// // Pair midpoint (5.5 + 9.5)/2 = 7.5: half a pixel left of the image centre.
+/// assert_eq!(p.offset_px, -0.5);
+/// assert_eq!(p.mode, ColorMode::Imprinted); // what segmented this frame…
+/// assert_eq!(t.model().mode(), ColorMode::Adapted); // …and the next adapts to it
+///
+/// // The camera falls silent: 2.4 s without the fiducial exceeds timeout 1.
+/// assert!(!t.no_frame(2.5).found);
+/// assert_eq!(t.model().mode(), ColorMode::Imprinted);
+/// ```
 #[derive(Debug, Clone)]
-pub struct TwoBlockSchema {
-    camera: usize,
+pub struct TwoBlockTracker {
     detector: TwoBlockDetector,
     model: ColorModel,
     imprinter: Imprinter,
@@ -319,46 +443,22 @@ pub struct TwoBlockSchema {
     last_pair: Option<Pair>,
 }
 
-impl TwoBlockSchema {
-    /// Builds the schema for camera `camera` of `profile`, which needs a
-    /// `[fiducial.two_block]`. Table defaults come from the fiducial's paint colours, in
-    /// the order they appear in this camera's image.
-    ///
-    /// # Errors
-    /// [`VisionError::Profile`] when the profile has no two-block fiducial or no such camera.
-    pub fn from_profile(profile: &Profile, camera: usize) -> Result<Self, VisionError> {
-        let fid = profile.fiducial.two_block.ok_or_else(|| VisionError::Profile {
-            what: format!("profile `{}` has no [fiducial.two_block]", profile.name),
-        })?;
-        let cam = profile.cameras.get(camera).ok_or_else(|| VisionError::Profile {
-            what: format!("profile `{}` has no camera {camera}", profile.name),
-        })?;
-        let p = &profile.perception;
-        let (img_left, img_right) = if cam.mount.is_flipped() {
-            (fid.right_color, fid.left_color)
-        } else {
-            (fid.left_color, fid.right_color)
+impl TwoBlockTracker {
+    /// Builds the tracker; the colour model starts on the table defaults of `p.colours`.
+    pub fn new(p: &TwoBlockParams) -> Self {
+        let table = p.colours.map(|rgb| AngleStats::nominal(rgb, p.table_sd));
+        let params = ColorModelParams {
+            adaptive: p.mode == SegmentationMode::Adaptive,
+            ..p.colour
         };
-        let table_sd = p.table_sd_deg.to_radians();
-        let table = [
-            AngleStats::nominal(img_left.rgb(), table_sd),
-            AngleStats::nominal(img_right.rgb(), table_sd),
-        ];
-        let params = ColorModelParams::from_spec(p);
-        Ok(Self {
-            camera,
-            detector: TwoBlockDetector::new(cam.width_px, cam.height_px, PairLimits::from(p)),
+        Self {
+            detector: TwoBlockDetector::new(p.width, p.height, p.limits),
             model: ColorModel::new(table, params),
-            imprinter: Imprinter::new(
-                [p.imprint.left_rect, p.imprint.right_rect],
-                p.imprint.sample_frac,
-                params.min_l,
-                params.min_chroma,
-            ),
-            imprint_frames: p.imprint.frames,
+            imprinter: Imprinter::new(p.imprint_rects, p.imprint_sample_frac, params.min_l, params.min_chroma),
+            imprint_frames: p.imprint_frames,
             fixed: p.mode == SegmentationMode::Fixed,
             last_pair: None,
-        })
+        }
     }
 
     /// The colour model.
@@ -386,7 +486,7 @@ impl TwoBlockSchema {
         self.last_pair.as_ref()
     }
 
-    /// Frames the profile asks to imprint on.
+    /// Frames to imprint on (`imprint_frames` of the params).
     pub fn imprint_frames_wanted(&self) -> u32 {
         self.imprint_frames
     }
@@ -422,7 +522,14 @@ impl TwoBlockSchema {
         }
     }
 
-    /// Runs the schema on one frame taken at `stamp`: detect with the current ranges,
+    /// No frame arrived by `now` (the camera is silent): the colour model counts it
+    /// toward its timeouts, and the percept is "not found" at the detector's size.
+    pub fn no_frame(&mut self, now: f64) -> TwoBlockPercept {
+        self.model.update(now, None);
+        TwoBlockPercept::not_found(now, self.model.mode(), self.detector.size())
+    }
+
+    /// Runs the tracker on one frame taken at `stamp`: detect with the current ranges,
     /// adapt, and report.
     ///
     /// # Errors
@@ -455,22 +562,5 @@ impl TwoBlockSchema {
             mode,
             image_size: size,
         })
-    }
-}
-
-impl PerceptualSchema for TwoBlockSchema {
-    type Percept = TwoBlockPercept;
-
-    fn perceive(&mut self, inputs: &Inputs<'_>) -> TwoBlockPercept {
-        let size = self.detector.size();
-        match inputs.camera(self.camera) {
-            Some(cam) => self
-                .process(&cam.image, cam.stamp)
-                .unwrap_or_else(|_| TwoBlockPercept::not_found(cam.stamp, self.model.mode(), size)),
-            None => {
-                self.model.update(inputs.now, None);
-                TwoBlockPercept::not_found(inputs.now, self.model.mode(), size)
-            }
-        }
     }
 }

@@ -15,12 +15,12 @@
 //! Sign conventions come from the camera mount, so the same code serves a rear camera
 //! rolled 180° (Bujold) and a forward camera.
 
-use super::camera_model::{CameraModel, body_from_camera};
+use super::camera_model::{CameraModel, MountAngles, body_from_camera};
 use super::two_block::TwoBlockPercept;
-use crate::profile::{CameraSpec, TwoBlockSpec};
 use nalgebra::Vector3;
 
-/// What a motor schema needs to know about the camera and the fiducial.
+/// What a motor schema needs to know about the camera and the fiducial. A profile gives
+/// one through `TwoBlockGeometry::new(camera, fiducial)` (in `profile`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TwoBlockGeometry {
     /// Horizontal focal length, px.
@@ -34,18 +34,31 @@ pub struct TwoBlockGeometry {
 }
 
 impl TwoBlockGeometry {
-    /// From the profile's camera and fiducial.
-    pub fn new(camera: &CameraSpec, fiducial: &TwoBlockSpec) -> Self {
-        let fx = match CameraModel::from_spec(camera) {
+    /// From a camera's model, image width (px) and mounting, and the fiducial's (width,
+    /// height) in metres. A fisheye camera's focal length is taken as half the width.
+    ///
+    /// ```
+    /// use marsupial::perception::{CameraModel, MountAngles, Pinhole, TwoBlockGeometry};
+    ///
+    /// let cam = CameraModel::Pinhole(Pinhole { fx: 100.0, fy: 100.0, cx: 80.0, cy: 60.0, k1: 0.0, k2: 0.0 });
+    /// let fwd = TwoBlockGeometry::from_camera(&cam, 160, MountAngles::default(), (0.2, 0.1));
+    /// assert_eq!((fwd.fx, fwd.image_right_sign, fwd.drive_dir), (100.0, 1.0, 1.0));
+    /// // Bujold's rear camera, rolled 180°: the robot backs in, image right is still its right.
+    /// let rear = MountAngles { yaw_deg: 180.0, pitch_deg: 0.0, roll_deg: 180.0 };
+    /// let back = TwoBlockGeometry::from_camera(&cam, 160, rear, (0.2, 0.1));
+    /// assert_eq!((back.image_right_sign, back.drive_dir), (1.0, -1.0));
+    /// ```
+    pub fn from_camera(model: &CameraModel, width_px: usize, mount: MountAngles, size_m: (f64, f64)) -> Self {
+        let fx = match model {
             CameraModel::Pinhole(p) => p.fx,
-            CameraModel::Fisheye(_) => camera.width_px as f64 / 2.0,
+            CameraModel::Fisheye(_) => width_px as f64 / 2.0,
         };
-        let r = body_from_camera(&camera.mount);
+        let r = body_from_camera(mount);
         let right = r * Vector3::x();
         let axis = r * Vector3::z();
         Self {
             fx,
-            size: (fiducial.width_m, fiducial.height_m),
+            size: size_m,
             image_right_sign: if right.y < 0.0 { 1.0 } else { -1.0 },
             drive_dir: if axis.x < 0.0 { -1.0 } else { 1.0 },
         }
@@ -53,6 +66,43 @@ impl TwoBlockGeometry {
 }
 
 /// Estimated relative pose.
+///
+/// # Example
+///
+/// A forward camera with f = 100 px sees a 0.2 × 0.1 m fiducial whose blocks are 20 px
+/// tall, so it is 100·0.1/20 = 0.5 m away. The blocks sit symmetrically about the image
+/// centre (no bearing), but the image-left block has 500 px against 400: the asymmetry is
+/// −100/900 for this mount, and sin α = 2·0.5·(−1/9)/0.2 = −5/9.
+///
+/// ```
+/// use marsupial::perception::{ColorMode, FiducialView, TwoBlockGeometry, TwoBlockPercept};
+///
+/// let g = TwoBlockGeometry { fx: 100.0, size: (0.2, 0.1), image_right_sign: 1.0, drive_dir: 1.0 };
+/// let p = TwoBlockPercept {
+///     found: true,
+///     left_px: 500,
+///     right_px: 400,
+///     total_px: 900,
+///     left_centroid: [70.0, 60.0],
+///     right_centroid: [90.0, 60.0],
+///     left_bbox: [60, 50, 79, 69],
+///     right_bbox: [80, 50, 99, 69],
+///     ..TwoBlockPercept::not_found(0.0, ColorMode::Table, (160, 120))
+/// };
+/// let v = FiducialView::from_percept(&p, &g).unwrap();
+/// assert!((v.distance - 0.5).abs() < 1e-12);
+/// assert!((v.asym + 1.0 / 9.0).abs() < 1e-12);
+/// assert!((v.alpha - (-5f64 / 9.0).asin()).abs() < 1e-12);
+/// assert_eq!((v.bearing, v.height_px), (0.0, 20.0));
+/// // Facing the fiducial, the heading is α itself, and the pose follows.
+/// assert!((v.heading - v.alpha).abs() < 1e-12);
+/// let pose = v.dock_pose();
+/// assert!((pose.y - 0.5 * (-5.0 / 9.0)).abs() < 1e-12 && pose.x > 0.0);
+/// // A filtered α replaces the estimate and the heading with it.
+/// assert_eq!(v.with_alpha(0.1).heading, 0.1);
+/// // Nothing found, nothing estimated.
+/// assert!(FiducialView::from_percept(&TwoBlockPercept { found: false, ..p }, &g).is_none());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FiducialView {
     /// Camera-to-fiducial distance, m.

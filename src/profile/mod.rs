@@ -10,6 +10,7 @@
 //! assert_eq!(p.cameras[0].width_px, 256);
 //! ```
 
+pub mod adapters;
 pub mod behavior;
 pub mod camera;
 pub mod devices;

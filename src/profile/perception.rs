@@ -4,30 +4,7 @@ use super::pyramid_perception::{PyramidPerceptionSpec, validate_pyramid_percepti
 use crate::config::Validator;
 use serde::{Deserialize, Serialize};
 
-/// Adaptive (imprint + adapt + fallback), static (imprint only) or fixed (table values
-/// only) segmentation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SegmentationMode {
-    /// Imprint, then adapt every frame; fall back on timeouts (seed 004 Fig. 5).
-    Adaptive,
-    /// Imprint, never adapt (the paper's comparison, Table II).
-    Static,
-    /// The table values alone: no imprint, no adaptation (RAPOSA's operator-tuned HSV
-    /// bands, seed 001 §II.D).
-    Fixed,
-}
-
-impl SegmentationMode {
-    /// The name used in TOML and output.
-    pub fn as_str(&self) -> &'static str {
-        match self {
-            SegmentationMode::Adaptive => "adaptive",
-            SegmentationMode::Static => "static",
-            SegmentationMode::Fixed => "fixed",
-        }
-    }
-}
+pub use crate::perception::SegmentationMode;
 
 /// Where the two blocks appear in the image as the daughter leaves the dock.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -11,6 +11,40 @@
 use crate::geometry::{Pose2, Twist, wrap_angle};
 
 /// Limits and gains of the point controller and the rotations.
+///
+/// # Example
+///
+/// From the origin facing +x, the point (1, 1) is 45° to the left at √2 m: unsaturated,
+/// v = 0.4·√2·cos 45° = 0.4 m/s and ω = 1.5·π/4 rad/s, both then scaled by 0.08/0.4 so
+/// that the speed limit holds and the path's curvature is kept.
+///
+/// ```
+/// use marsupial::geometry::Pose2;
+/// use marsupial::schemas::PointController;
+/// use std::f64::consts::FRAC_PI_4;
+///
+/// let c = PointController {
+///     k_rho: 0.4,
+///     k_heading: 1.5,
+///     max_speed: 0.08,
+///     max_turn: 0.35,
+///     position_tolerance: 0.03,
+///     rotation_tolerance: 2f64.to_radians(),
+/// };
+/// let origin = Pose2::new(0.0, 0.0, 0.0);
+/// let t = c.travel(&origin, (1.0, 1.0), false).unwrap();
+/// assert!((t.v - 0.08).abs() < 1e-12);
+/// assert!((t.omega - 1.5 * FRAC_PI_4 * 0.08 / 0.4).abs() < 1e-12);
+/// // Back first: the same point is behind the robot's rear, so it turns before driving.
+/// let t = c.travel(&origin, (1.0, 1.0), true).unwrap();
+/// assert_eq!(t.v, 0.0);
+/// assert!(c.travel(&origin, (0.02, 0.0), false).is_none(), "within 3 cm: done");
+///
+/// // Turning in place to 1 rad: counter-clockwise, capped at 0.35 rad/s, no speed.
+/// let t = c.rotate(&origin, 1.0).unwrap();
+/// assert!(t.v == 0.0 && (t.omega - 0.35).abs() < 1e-12);
+/// assert!(c.rotate(&origin, 0.01).is_none());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PointController {
     /// Speed per metre of remaining distance, 1/s.

@@ -4,6 +4,10 @@
 //! turns the percept into a [`MotorOutput`]; a [`Behavior`] pairs them with an activation
 //! condition and reports [`Feedback`] and a typed [`Outcome`]. Motion vectors compose by
 //! Arkin's gain-weighted sum ([`MotionVector::weighted_sum`]).
+//!
+//! The perceptual schemas of the shipped robots ([`TwoBlockSchema`], [`PyramidSchema`])
+//! run perception's trackers on one camera of the inputs; perception itself knows
+//! nothing of schemas.
 
 pub mod avoid;
 pub mod behavior;
@@ -13,9 +17,11 @@ pub mod mission;
 pub mod motor_output;
 pub mod percept;
 pub mod potential_field;
+pub mod pyramid;
 pub mod ratio_steering;
 pub mod search;
 pub mod traits;
+pub mod two_block;
 pub mod vector;
 pub mod visual_servo;
 
@@ -27,8 +33,10 @@ pub use mission::{Agent, AgentStats, Mission, MissionError};
 pub use motor_output::{Auxiliary, DriveCommand, Guides, MotorOutput, Posture, TetherCommand};
 pub use percept::{Percept, Stamped};
 pub use potential_field::PotentialField;
+pub use pyramid::PyramidSchema;
 pub use ratio_steering::RatioSteering;
 pub use search::{DeadReckoning, SearchRotation};
 pub use traits::{MotorSchema, PerceptualSchema};
+pub use two_block::TwoBlockSchema;
 pub use vector::MotionVector;
 pub use visual_servo::ServoLaw;

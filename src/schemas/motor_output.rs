@@ -1,67 +1,9 @@
 //! Motor outputs: what a motor schema proposes and the arbiter commands.
 
-use super::vector::MotionVector;
 use crate::geometry::Twist;
 use serde::{Deserialize, Serialize};
 
-/// How the base should move this tick.
-///
-/// `Turn` and `Straight` are the two halves of the restricted skid-steer command of
-/// Bujold's VGTv (turn in place OR drive straight, never both); a gradual turn alternates
-/// them. `Vector` is an Arkin-style desired velocity in the body frame, turned into a
-/// twist by a heading controller (see [`MotionVector::to_twist`]).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-pub enum DriveCommand {
-    /// Zero velocity.
-    #[default]
-    Stop,
-    /// Continuous body twist.
-    Twist(Twist),
-    /// Turn in place at `omega` rad/s (CCW positive).
-    Turn {
-        /// Yaw rate, rad/s.
-        omega: f64,
-    },
-    /// Drive straight at `v` m/s (negative reverses).
-    Straight {
-        /// Forward speed, m/s.
-        v: f64,
-    },
-    /// A desired body-frame velocity vector (m/s), Arkin style.
-    Vector(MotionVector),
-}
-
-impl DriveCommand {
-    /// The equivalent body twist. Vectors are converted with the default heading
-    /// controller ([`MotionVector::to_twist`] with `k_theta = 1.5`).
-    pub fn to_twist(&self) -> Twist {
-        match *self {
-            DriveCommand::Stop => Twist::ZERO,
-            DriveCommand::Twist(t) => t,
-            DriveCommand::Turn { omega } => Twist::new(0.0, omega),
-            DriveCommand::Straight { v } => Twist::new(v, 0.0),
-            DriveCommand::Vector(m) => m.to_twist(1.5),
-        }
-    }
-
-    /// True when every number in the command is finite.
-    pub fn is_finite(&self) -> bool {
-        match *self {
-            DriveCommand::Stop => true,
-            DriveCommand::Twist(t) => t.is_finite(),
-            DriveCommand::Turn { omega } => omega.is_finite(),
-            DriveCommand::Straight { v } => v.is_finite(),
-            DriveCommand::Vector(m) => m.x.is_finite() && m.y.is_finite(),
-        }
-    }
-
-    /// True when the command asks for no motion.
-    pub fn is_stop(&self) -> bool {
-        let t = self.to_twist();
-        t.v == 0.0 && t.omega == 0.0
-    }
-}
+pub use crate::kinematics::DriveCommand;
 
 /// Most `[[actuators]]` a profile may declare: their commands travel in a fixed array,
 /// so a tick's output never allocates.
@@ -127,6 +69,16 @@ fn no_commands(a: &[Option<f64>; MAX_ACTUATORS]) -> bool {
 
 impl Auxiliary {
     /// Fills each field this one leaves open with `other`'s value (self has priority).
+    ///
+    /// ```
+    /// use marsupial::schemas::{Auxiliary, Guides};
+    ///
+    /// let dock = Auxiliary { guides: Some(Guides::Closed), ..Default::default() };
+    /// let carry = Auxiliary { arm: Some(0.3), guides: Some(Guides::Open), ..Default::default() };
+    /// let merged = dock.or(carry);
+    /// assert_eq!((merged.guides, merged.arm), (Some(Guides::Closed), Some(0.3)));
+    /// assert_eq!(merged.lights, None, "nobody had an opinion");
+    /// ```
     pub fn or(self, other: Auxiliary) -> Auxiliary {
         Auxiliary {
             tether: self.tether.or(other.tether),
@@ -147,6 +99,24 @@ impl Auxiliary {
 }
 
 /// One motor schema's (or the arbiter's) output for one tick.
+///
+/// # Example
+///
+/// ```
+/// use marsupial::geometry::Twist;
+/// use marsupial::schemas::{Auxiliary, DriveCommand, MotorOutput, Posture};
+///
+/// let out = MotorOutput::twist(0.1, -0.2);
+/// assert_eq!(out.drive, DriveCommand::Twist(Twist::new(0.1, -0.2)));
+/// assert!(MotorOutput::stop().drive.is_stop());
+/// // Backing in, lowered: the base reverses at 3 cm/s without turning.
+/// let lowered = Auxiliary { posture: Some(Posture::Lowered), ..Default::default() };
+/// let out = MotorOutput::drive(DriveCommand::Straight { v: -0.03 }).with_aux(lowered);
+/// assert_eq!(out.drive.to_twist(), Twist::new(-0.03, 0.0));
+/// assert_eq!(out.aux.posture, Some(Posture::Lowered));
+/// assert!(out.is_finite());
+/// assert!(!MotorOutput::drive(DriveCommand::Turn { omega: f64::NAN }).is_finite());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct MotorOutput {
     /// Base motion.

@@ -29,6 +29,41 @@ use super::vector::MotionVector;
 use crate::geometry::{Pose2, Twist, wrap_angle};
 
 /// The potential-field docking schema.
+///
+/// # Example
+///
+/// On the axis the field is pure attraction, straight at the dock (−x) at the gain.
+/// 60° off the axis (outside the 22.5° sector) it swings toward the axis: its −y
+/// component outweighs its pull toward the dock. A robot backing in (`drive_dir` −1) on
+/// the axis, facing away from the dock, backs straight in.
+///
+/// ```
+/// use marsupial::geometry::Pose2;
+/// use marsupial::schemas::PotentialField;
+///
+/// let pf = PotentialField {
+///     sector: 22.5f64.to_radians(),
+///     coercive_attraction: 0.3,
+///     gain: 0.1,
+///     k_theta: 1.5,
+///     max_off_sight: std::f64::consts::PI,
+///     final_radius: 0.0,
+/// };
+/// let v = pf.field(1.0, 0.0);
+/// assert!((v.x + 0.1).abs() < 1e-12 && v.y.abs() < 1e-12);
+///
+/// let a = 60f64.to_radians();
+/// let v = pf.field(1.0, a);
+/// let toward_dock = -(v.x * a.cos() + v.y * a.sin());
+/// let toward_axis = -(v.x * -a.sin() + v.y * a.cos());
+/// assert!(toward_axis > toward_dock && toward_dock > 0.0);
+/// assert!((v.norm() - 0.1).abs() < 1e-12);
+/// // Within half a metre the field slows down.
+/// assert!(pf.field(0.2, 0.0).norm() < 0.1);
+///
+/// let t = pf.twist(&Pose2::new(1.0, 0.0, 0.0), -1.0);
+/// assert!((t.v + 0.1).abs() < 1e-12 && t.omega.abs() < 1e-12);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PotentialField {
     /// Half-width of the approach sector α_z, rad.

@@ -15,12 +15,59 @@
 
 use super::motor_output::{DriveCommand, MotorOutput};
 use crate::geometry::Twist;
-use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
+use crate::perception::{FiducialView, TwoBlockGeometry};
 
 /// Largest aim angle, rad (25°).
 pub const MAX_AIM_RAD: f64 = 25.0 * std::f64::consts::PI / 180.0;
 
 /// The ratio-steering motor schema.
+///
+/// # Example
+///
+/// Bujold's rear camera, rolled 180° (f = 182.8 px, 256 px wide), on a turn-or-drive
+/// base. Centred on the axis, a fiducial 3 px off centre is inside the 5 % dead band: the
+/// robot backs straight in, at a speed reduced by the pixel count (1000 of the 9000 at
+/// the dock). 30 px off centre it turns in place, counter-clockwise for a fiducial on the
+/// image's right, by 0.6 of the angle error per 0.1 s tick, capped at 0.5 rad/s.
+///
+/// ```
+/// use marsupial::perception::{FiducialView, TwoBlockGeometry};
+/// use marsupial::schemas::{DriveCommand, RatioSteering};
+///
+/// let s = RatioSteering {
+///     geometry: TwoBlockGeometry { fx: 182.8, size: (0.18, 0.11), image_right_sign: 1.0, drive_dir: -1.0 },
+///     image_width: 256.0,
+///     dead_band: 0.05,
+///     understeer: 0.6,
+///     turn_rate: 0.5,
+///     speed: 0.06,
+///     dock_total_px: 9000.0,
+///     tick_s: 0.1,
+///     restricted: true,
+/// };
+/// let view = |alpha: f64, offset_px: f64| FiducialView {
+///     distance: 1.0,
+///     alpha,
+///     asym: 0.0,
+///     offset_px,
+///     bearing: 0.0,
+///     heading: 0.0,
+///     total_px: 1000,
+///     height_px: 30.0,
+/// };
+/// let DriveCommand::Straight { v } = s.act(&view(0.0, 3.0)).drive else { panic!() };
+/// assert!((v - -0.06 * (1.0 - 1000.0 / 9000.0)).abs() < 1e-12);
+///
+/// let DriveCommand::Turn { omega } = s.act(&view(0.0, 30.0)).drive else { panic!() };
+/// let full = (30.0f64 / 182.8).atan() / 0.1; // the whole angle error in one tick
+/// assert!(omega > 0.0 && (omega - (0.6 * full).min(0.5)).abs() < 1e-9);
+/// let DriveCommand::Turn { omega } = s.act(&view(0.0, -30.0)).drive else { panic!() };
+/// assert!(omega < 0.0);
+///
+/// // 40° off the axis the aim point wants the fiducial off centre: centred is an error.
+/// assert!(RatioSteering::aim_angle(&view(40f64.to_radians(), 0.0)) > 0.1);
+/// assert!(s.error(&view(40f64.to_radians(), 0.0)) > s.dead_band);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RatioSteering {
     /// Camera and fiducial geometry.

@@ -5,6 +5,23 @@ use super::motor_output::DriveCommand;
 /// Rotate in place to (re)acquire the target. With `doubling`, the sweep alternates sides
 /// and doubles after each switch (RAPOSA, seed 001 §II.E); otherwise it keeps turning one
 /// way (Bujold, seed 004 §V: "rotate until it is acquired").
+///
+/// # Example
+///
+/// A doubling search at 0.5 rad/s from a 0.5 rad sweep: 1 s counter-clockwise, then 2 s
+/// clockwise, then 4 s counter-clockwise…
+///
+/// ```
+/// use marsupial::schemas::{DriveCommand, SearchRotation};
+///
+/// let s = SearchRotation { rate: 0.5, first_sweep: 0.5, doubling: true };
+/// assert_eq!(s.act(0.5), DriveCommand::Turn { omega: 0.5 });
+/// assert_eq!(s.act(1.5), DriveCommand::Turn { omega: -0.5 });
+/// assert_eq!(s.act(3.1), DriveCommand::Turn { omega: 0.5 });
+/// // Without doubling it keeps turning one way.
+/// let plain = SearchRotation { doubling: false, ..s };
+/// assert_eq!(plain.act(100.0), DriveCommand::Turn { omega: 0.5 });
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SearchRotation {
     /// Turn rate, rad/s (sign: first direction).
@@ -47,6 +64,16 @@ impl SearchRotation {
 pub const MAX_SWEEP_DEG: f64 = 350.0;
 
 /// Drive straight a set distance by odometry (the paper's blind back-in).
+///
+/// # Example
+///
+/// ```
+/// use marsupial::schemas::{DeadReckoning, DriveCommand};
+///
+/// let back_in = DeadReckoning { speed: -0.03, distance: 0.5 };
+/// assert_eq!(back_in.act(0.2), Some(DriveCommand::Straight { v: -0.03 }));
+/// assert_eq!(back_in.act(0.5), None, "50 cm covered");
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DeadReckoning {
     /// Signed speed, m/s (negative backs up).

@@ -17,6 +17,30 @@
 use crate::geometry::Twist;
 
 /// The state-1 law's gains.
+///
+/// # Example
+///
+/// ```
+/// use marsupial::schemas::ServoLaw;
+///
+/// let law = ServoLaw {
+///     k_lin: 0.045,
+///     k_ang: 0.004,
+///     k_arm: 0.003,
+///     far_speed: 0.05,
+///     far_distance: 1.0,
+///     camera_backward: true,
+/// };
+/// assert_eq!(law.speed(2.0, 2.0), 0.05, "far: constant");
+/// // Near: K_lin·√(A₁/A); the ball's area is 4 × its area at 1 m, so √(A₁/A) = 0.5.
+/// assert!((law.speed(0.5, 0.5) - 0.0225).abs() < 1e-12);
+/// // A ball 10 px right of centre: turn clockwise; 20 px low: arm −0.06 rad.
+/// assert!((law.turn(10.0) + 0.04).abs() < 1e-12);
+/// assert!((law.arm(20.0) + 0.06).abs() < 1e-12);
+/// // The camera looks backward: travel toward the target is body-backward.
+/// let t = law.twist(0.03, 0.1);
+/// assert_eq!((t.v, t.omega), (-0.03, 0.1));
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ServoLaw {
     /// K_lin, m/s at 1 m.

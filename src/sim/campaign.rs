@@ -113,7 +113,7 @@ pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
         .scenario
         .backgrounds
         .iter()
-        .map(|b| crate::cli::image_io::load_rgb(&dir.join(b)).map(Arc::new))
+        .map(|b| crate::image_io::load_rgb(&dir.join(b)).map(Arc::new))
         .collect::<Result<_, _>>()?;
     let world = world::build(&loaded.profile, &loaded.scenario.clutter, &backdrops)?;
     let runs = loaded.scenario.runs(&loaded.profile);

@@ -25,7 +25,7 @@ pub enum SimError {
     Config(#[from] crate::config::ConfigError),
     /// An image (backdrop) could not be loaded.
     #[error(transparent)]
-    Image(#[from] crate::cli::image_io::ImageFileError),
+    Image(#[from] crate::image_io::ImageFileError),
     /// Output could not be written.
     #[error("{path}: {source}")]
     Io {

@@ -76,7 +76,7 @@ impl Recording<'_> {
         {
             for (i, f) in frames.iter().enumerate() {
                 let path = dir.join(format!("{prefix}-{n:05}-cam{i}.png"));
-                if let Err(e) = crate::cli::image_io::save_png(&path, f) {
+                if let Err(e) = crate::image_io::save_png(&path, f) {
                     tracing::warn!(target: "marsupial::sim", path = %path.display(), %e, "frame not saved");
                 }
             }

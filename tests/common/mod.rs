@@ -4,6 +4,7 @@
 
 use marsupial::perception::{RgbImage, SctRange};
 use marsupial::profile::Profile;
+#[cfg(feature = "sim")]
 use marsupial::sim::render::SensorParams;
 use std::path::Path;
 
@@ -14,6 +15,7 @@ pub fn shipped_profile(name: &str) -> Profile {
 
 /// A sensor without noise or auto-exposure (fixed exposure 1), for renders whose pixel
 /// values a test reads.
+#[cfg(feature = "sim")]
 pub fn quiet_sensor() -> SensorParams {
     SensorParams {
         read_noise: 0.0,

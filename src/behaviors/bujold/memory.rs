@@ -12,10 +12,11 @@ use super::params::BujoldTuning;
 use crate::behaviors::BuildError;
 use crate::behaviors::composed::SharedMemory;
 use crate::geometry::Pose2;
-use crate::perception::TwoBlockSchema;
+use crate::perception::TwoBlockPercept;
 use crate::perception::frame_change::FrameChange;
 use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
 use crate::profile::{ApproachKind, Profile};
+use crate::schemas::TwoBlockSchema;
 use crate::schemas::{
     Auxiliary, DriveCommand, Feedback, Inputs, Mission, MissionError, MotionVector, MotorOutput, Percept,
     PerceptualSchema, Posture, PotentialField, RatioSteering, Step,
@@ -227,13 +228,22 @@ impl Memory {
     /// Runs the perceptual schema on this tick's inputs and updates the views and the
     /// memory of the fiducial.
     pub fn perceive(&mut self, inputs: &Inputs<'_>) {
+        let percept = self.schema.perceive(inputs);
+        self.digest(inputs, &percept);
+    }
+
+    /// What [`Memory::perceive`] does with the two-block schema's percept: the viewing
+    /// angle's trust, low-pass and median window, the dock's pose in odometry, the last
+    /// sighting. Public so that a percept computed elsewhere (replayed from a log, or on
+    /// another core) can drive the same memory, and so that the decision's cost can be
+    /// measured without perception (`benches/tick.rs`).
+    pub fn digest(&mut self, inputs: &Inputs<'_>, percept: &TwoBlockPercept) {
         let now = inputs.now;
         self.now = now;
         self.run_start.get_or_insert(now);
         self.odo = inputs.odometry.map(|o| o.value.pose).unwrap_or_default();
-        let percept = self.schema.perceive(inputs);
         let p = self.tuning;
-        let mut view = FiducialView::from_percept(&percept, &self.geometry);
+        let mut view = FiducialView::from_percept(percept, &self.geometry);
         self.planning = None;
         if let Some(v) = view.as_mut() {
             // The ratio cue is only as good as the blocks are big: at 1.3 m two-pixel noise

@@ -15,8 +15,9 @@ use super::region2::Region2Plan;
 use crate::behaviors::BuildError;
 use crate::behaviors::composed::SharedMemory;
 use crate::geometry::{Pose2, Twist, wrap_angle};
-use crate::perception::{PyramidPercept, PyramidSchema};
+use crate::perception::PyramidPercept;
 use crate::profile::{Profile, SegmentationMode, SevenStateGains};
+use crate::schemas::PyramidSchema;
 use crate::schemas::{
     AgentStats, Auxiliary, DriveCommand, Feedback, Guides, Inputs, Mission, MissionError, MotorOutput,
     PerceptualSchema, PointController, ServoLaw, Step,

@@ -2,7 +2,7 @@
 //! tether pyramid, its phase schemas one file each in this folder, combined by the
 //! arbiters the way `profiles/raposa.toml` declares in `[behavior.tree]`.
 //!
-//! Every tick the [pyramid schema](crate::perception::PyramidSchema) reports the best
+//! Every tick the [pyramid schema](crate::schemas::PyramidSchema) reports the best
 //! (ellipse, blue region) pair, or an ellipse or blue region alone, with distance and α,
 //! into the shared [`Memory`]. The `servo` sequencer's selector ([`selector`], the rules
 //! of [`states`]) picks one of seven states each tick unless the current one is latched:

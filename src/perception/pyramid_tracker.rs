@@ -1,11 +1,11 @@
-//! The pyramid perceptual schema: detector, geometry and the HSV colour model for one
-//! camera.
+//! The pyramid tracker: detector, geometry and the HSV colour model for one camera's
+//! frames (`schemas::PyramidSchema` runs it on a tick's inputs).
 //!
 //! The paper segments with HSV bands an operator tunes, and retunes live when the light
 //! changes (seed 001 §II.D); its future work is to replace that operator with the
 //! imprint/adapt method of seed 004. Both are here, chosen by `perception.mode`:
 //!
-//! * **fixed**: the profile's bands, changed only through [`PyramidSchema::set_bands`]
+//! * **fixed**: the table bands, changed only through [`PyramidTracker::set_bands`]
 //!   (the paper's method);
 //! * **static**: on departure the robot imprints the bands from the pyramid it is
 //!   leaving, and keeps them;
@@ -22,16 +22,14 @@
 //! 004 samples "the middle of each block"), and for the blue edges the segmented pixels
 //! of the region's box outside the ellipse. HSV statistics and bands are in [`HsvStats`].
 
-use super::colour_model::{ColorMode, ColorModel, ColorModelParams};
+use super::colour_model::{ColorMode, ColorModel, ColorModelParams, SegmentationMode};
 use super::hsv::Hsv;
 use super::hsv_stats::{HsvAccumulator, HsvLimits, HsvStats, hue_band};
 use super::image::RgbView;
-use super::pyramid::{PyramidDetector, PyramidPair};
+use super::pyramid::{PyramidDetector, PyramidPair, PyramidParams};
 use super::pyramid_pose::{PyramidGeometry, PyramidPercept};
 use super::segment::{HsvRange, Mask};
 use super::{VisionError, check_same_size};
-use crate::profile::{Profile, SegmentationMode};
-use crate::schemas::{Inputs, PerceptualSchema};
 
 /// Largest |α| and |bearing| of a pair accepted for imprinting, rad (12°).
 const IMPRINT_ANGLE: f64 = 0.21;
@@ -40,10 +38,96 @@ const IMPRINT_DISTANCE_ERROR: f64 = 0.35;
 /// Fewest pixels per colour for statistics.
 const MIN_SAMPLES: u64 = 10;
 
-/// The pyramid perceptual schema. Allocates only in [`PyramidSchema::from_profile`].
+/// Everything a [`PyramidTracker`] needs, in plain numbers. A profile gives them through
+/// `PyramidTrackerParams::from_profile` (in `profile`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PyramidTrackerParams {
+    /// Frame width, px.
+    pub width: usize,
+    /// Frame height, px.
+    pub height: usize,
+    /// The detector's table bands and filters.
+    pub detector: PyramidParams,
+    /// Camera and pyramid constants.
+    pub geometry: PyramidGeometry,
+    /// Fixed (table bands only), static (imprint) or adaptive (imprint and adapt).
+    pub mode: SegmentationMode,
+    /// Fallback-chain timing and blend rate (its `adaptive` flag is replaced by
+    /// `mode == Adaptive`; the SCT fields are unused here).
+    pub colour: ColorModelParams,
+    /// How learned statistics become bands.
+    pub limits: HsvLimits,
+    /// Camera-to-ball distance at which the departing robot imprints, m.
+    pub imprint_distance_m: f64,
+    /// The imprint finds the pyramid with the table bands widened by this factor (≥ 1).
+    pub imprint_widen: f64,
+    /// Frames to imprint on.
+    pub imprint_frames: u32,
+}
+
+/// RAPOSA's pyramid perception for one camera. Allocates only in [`PyramidTracker::new`].
+///
+/// # Example
+///
+/// The scene of [`PyramidDetector`]'s example (a 16 px blue frame around an orange disc
+/// of radius 5 in a 40×30 frame) seen by a camera with f = 160 px, in fixed mode: the
+/// 10 cm blue edges are 160·0.1/16 = 1 m away. Retuning the orange band to green, as the
+/// paper's operator might, loses the ball.
+///
+/// ```
+/// use marsupial::perception::{
+///     ColorModelParams, HsvLimits, HsvRange, PyramidGeometry, PyramidParams, PyramidTracker,
+///     PyramidTrackerParams, RgbImage, SegmentationMode,
+/// };
+///
+/// let mut im = RgbImage::new(40, 30);
+/// im.fill([120, 118, 115]);
+/// for y in 6..22 {
+///     for x in 10..26 {
+///         if (x as f64 - 18.0).hypot(y as f64 - 14.0) <= 5.0 {
+///             im.put(x, y, [235, 120, 20]);
+///         } else if x < 12 || x >= 24 || y < 8 || y >= 20 {
+///             im.put(x, y, [20, 60, 220]);
+///         }
+///     }
+/// }
+/// let params = PyramidTrackerParams {
+///     width: 40,
+///     height: 30,
+///     detector: PyramidParams::default(),
+///     geometry: PyramidGeometry { f_px: 160.0, principal: [20.0, 15.0], h: 0.1, m: 0.16, ball_diameter: 0.07 },
+///     mode: SegmentationMode::Fixed,
+///     colour: ColorModelParams {
+///         n_sd: 4.0,
+///         sd_floor: 0.01,
+///         sd_ceiling: 0.2,
+///         min_l: 20.0,
+///         min_chroma: 0.0,
+///         timeout1: 2.0,
+///         timeout2: 5.0,
+///         adaptive: false,
+///         adapt_rate: 1.0,
+///     },
+///     limits: HsvLimits { n_sd: 4.0, hue_sd_deg: [1.0, 20.0], sv_sd: [0.01, 0.1], min_s: 0.2, min_v: 0.05 },
+///     imprint_distance_m: 1.0,
+///     imprint_widen: 1.5,
+///     imprint_frames: 3,
+/// };
+/// let mut t = PyramidTracker::new(&params);
+/// let p = t.process(&im.view(), 0.1).unwrap();
+/// let v = p.view.expect("ball seen");
+/// assert!(p.detection.pair.is_some());
+/// assert!((v.blue_distance_m.unwrap() - 1.0).abs() < 1e-9);
+/// // The ball is half a pixel right of the blue centre: a small negative α.
+/// assert!(v.alpha.unwrap() < 0.0 && v.alpha.unwrap() > -0.1);
+/// assert_eq!(t.bands()[0], PyramidParams::default().orange, "fixed: the table bands");
+///
+/// let green = HsvRange { h: [100.0, 140.0], s: [0.4, 1.0], v: [0.2, 1.0] };
+/// t.set_bands(green, t.bands()[1]);
+/// assert!(t.process(&im.view(), 0.2).unwrap().view.is_none());
+/// ```
 #[derive(Debug, Clone)]
-pub struct PyramidSchema {
-    camera: usize,
+pub struct PyramidTracker {
     detector: PyramidDetector,
     geometry: PyramidGeometry,
     mode: SegmentationMode,
@@ -57,40 +141,27 @@ pub struct PyramidSchema {
     imprinted_frames: u32,
 }
 
-impl PyramidSchema {
-    /// Builds the schema for camera `camera` of a profile with a `[fiducial.pyramid]`;
-    /// bands, filters and imprint/adapt settings come from `[perception]` and
-    /// `[perception.pyramid]`.
-    ///
-    /// # Errors
-    /// [`VisionError::Profile`] when the profile lacks the fiducial or the camera.
-    pub fn from_profile(profile: &Profile, camera: usize) -> Result<Self, VisionError> {
-        let geometry = PyramidGeometry::from_profile(profile, camera)?;
-        let cam = &profile.cameras[camera];
-        let p = &profile.perception;
-        let spec = &p.pyramid;
-        let table = [spec.orange.range(), spec.blue.range()];
-        let params = ColorModelParams::from_spec(p);
-        Ok(Self {
-            camera,
-            detector: PyramidDetector::new(cam.width_px, cam.height_px, spec, geometry.shape()),
-            geometry,
+impl PyramidTracker {
+    /// Builds the tracker; the colour model starts on the detector's table bands.
+    pub fn new(p: &PyramidTrackerParams) -> Self {
+        let table = [p.detector.orange, p.detector.blue];
+        let params = ColorModelParams {
+            adaptive: p.mode == SegmentationMode::Adaptive,
+            ..p.colour
+        };
+        Self {
+            detector: PyramidDetector::new(p.width, p.height, &p.detector, p.geometry.shape()),
+            geometry: p.geometry,
             mode: p.mode,
             table,
-            model: ColorModel::new(table.map(|b| HsvStats::from_band(&b, p.n_sd)), params),
-            limits: HsvLimits {
-                n_sd: p.n_sd,
-                hue_sd_deg: spec.hue_sd_deg,
-                sv_sd: spec.sv_sd,
-                min_s: spec.min_s,
-                min_v: spec.min_v,
-            },
-            imprint_distance: spec.imprint_distance_m,
-            imprint_widen: spec.imprint_widen,
-            imprint_frames: spec.imprint_frames,
+            model: ColorModel::new(table.map(|b| HsvStats::from_band(&b, p.limits.n_sd)), params),
+            limits: p.limits,
+            imprint_distance: p.imprint_distance_m,
+            imprint_widen: p.imprint_widen,
+            imprint_frames: p.imprint_frames,
             imprint_acc: [HsvAccumulator::default(); 2],
             imprinted_frames: 0,
-        })
+        }
     }
 
     /// The geometry constants.
@@ -129,6 +200,18 @@ impl PyramidSchema {
         self.model = ColorModel::new(self.table.map(|b| HsvStats::from_band(&b, n)), *self.model.params());
     }
 
+    /// Forgets the tracked ellipse (after the robot moved blind).
+    pub fn reset_tracking(&mut self) {
+        self.detector.reset_tracking();
+    }
+
+    /// No frame arrived by `now` (the camera is silent): the colour model counts it
+    /// toward its timeouts, and the percept is "nothing seen" at the detector's size.
+    pub fn no_frame(&mut self, now: f64) -> PyramidPercept {
+        self.model.update(now, None);
+        PyramidPercept::not_found(now, self.detector.size())
+    }
+
     /// Tells the colour model whether the robot expects the pyramid in view
     /// ([`ColorModel::set_looking`]): turning away must not discard a good imprint.
     pub fn set_looking(&mut self, looking: bool, now: f64) {
@@ -140,7 +223,7 @@ impl PyramidSchema {
         self.imprint_distance
     }
 
-    /// Frames the profile asks to imprint on.
+    /// Frames to imprint on (`imprint_frames` of the params).
     pub fn imprint_frames_wanted(&self) -> u32 {
         self.imprint_frames
     }
@@ -269,27 +352,6 @@ fn sample_pair(view: &RgbView<'_>, pair: &PyramidPair, masks: &[Mask; 2], acc: &
     };
     add(0, e.bbox, &|x, y| inside(x, y, 0.8));
     add(1, pair.blue.bbox, &|x, y| !inside(x, y, 1.0));
-}
-
-impl PerceptualSchema for PyramidSchema {
-    type Percept = PyramidPercept;
-
-    fn perceive(&mut self, inputs: &Inputs<'_>) -> PyramidPercept {
-        let size = self.detector.size();
-        match inputs.camera(self.camera) {
-            Some(cam) => self
-                .process(&cam.image, cam.stamp)
-                .unwrap_or_else(|_| PyramidPercept::not_found(cam.stamp, size)),
-            None => {
-                self.model.update(inputs.now, None);
-                PyramidPercept::not_found(inputs.now, size)
-            }
-        }
-    }
-
-    fn reset(&mut self) {
-        self.detector.reset_tracking();
-    }
 }
 
 #[cfg(test)]

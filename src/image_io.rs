@@ -1,4 +1,6 @@
-//! Reading and writing image files for the CLI (PNG and JPEG; grey and RGBA are converted).
+//! Reading and writing image files (PNG and JPEG; grey and RGBA are converted), for the
+//! simulator's backdrops and recorded frames and the CLI's `detect`. Behind the `image-io`
+//! feature so the core does not build an image codec.
 
 use crate::perception::RgbImage;
 use std::path::{Path, PathBuf};
