@@ -6,8 +6,8 @@
 //!    cameras, body, dock and loop timing. `marsupial check` validates it.
 //! 2. **The hardware traits** from [`marsupial::robot`]: a [`Camera`], a [`Drive`], and
 //!    optionally [`WheelEncoders`], a [`DockSensor`], a tether reel, arm, lights …
-//!    Here they talk to a tiny toy world (a red beacon on a floor); on your robot they
-//!    talk to your drivers.
+//!    Here they talk to a tiny toy world (a red beacon on a floor,
+//!    `examples/common/toy_world.rs`); on your robot they talk to your drivers.
 //! 3. **Behaviors**: a perceptual schema (find the red beacon with the crate's perception:
 //!    HSV segmentation and connected components, from plain parameters), a motor schema (steer at
 //!    it), paired with an activation condition, under a priority arbiter with a
@@ -19,19 +19,23 @@
 //!
 //! Run it with `cargo run --example custom_robot`.
 
+#[path = "common/toy_world.rs"]
+#[allow(dead_code)] // the post, range finder and bumper are the compose example's
+mod toy_world;
+
 use marsupial::arbiter::runtime::{RuntimeConfig, StopHandle, run};
 use marsupial::arbiter::{Priority, ReactiveLoop};
-use marsupial::geometry::{Pose2, Twist, integrate_twist};
-use marsupial::perception::{ColorRange, HsvRange, Labeler, Mask, RgbImage, Segmenter};
+use marsupial::geometry::Pose2;
+use marsupial::perception::{ColorRange, HsvRange, Labeler, Mask, Segmenter};
 use marsupial::profile::Profile;
-use marsupial::robot::{Camera, DockSensor, Drive, HardwareError, Robot, WheelEncoders, WheelTravel};
+use marsupial::robot::Robot;
 use marsupial::schemas::{
     Behavior, DriveCommand, Feedback, Inputs, MotorOutput, MotorSchema, Outcome, Percept, PerceptualSchema,
     SchemaBehavior, Step,
 };
 use std::path::Path;
-use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use toy_world::{ToyCamera, ToyDockSwitch, ToyDrive, ToyEncoders, World};
 
 /// 1. The profile. Every field is checked; try misspelling one.
 const PROFILE: &str = r#"
@@ -85,97 +89,9 @@ timeout_s = 30.0
 "#;
 
 // ---------------------------------------------------------------------------------------
-// 2. Hardware. A toy world stands in for your drivers: the robot on a floor, a beacon.
+// 2. Hardware: the toy world's devices (examples/common/toy_world.rs) stand in for your
+//    drivers: a camera, a drive, wheel encoders and a dock switch.
 // ---------------------------------------------------------------------------------------
-
-const BEACON: (f64, f64) = (2.0, 0.6);
-
-struct World {
-    pose: Pose2,
-    twist: Twist,
-    travel: WheelTravel,
-    last: Instant,
-}
-
-impl World {
-    /// Moves the robot along its current twist up to the present.
-    fn advance(&mut self) {
-        let now = Instant::now();
-        let dt = (now - self.last).as_secs_f64();
-        self.last = now;
-        self.pose = integrate_twist(&self.pose, &self.twist, dt);
-        let half = self.twist.omega * 0.30 / 2.0;
-        self.travel.left += (self.twist.v - half) * dt;
-        self.travel.right += (self.twist.v + half) * dt;
-    }
-}
-
-type Shared = Arc<Mutex<World>>;
-
-/// Renders the beacon as a red bar on a grey floor, pin-hole, 60° field of view.
-struct ToyCamera(Shared);
-impl Camera for ToyCamera {
-    fn resolution(&self) -> (usize, usize) {
-        (160, 120)
-    }
-    fn capture(&mut self, frame: &mut RgbImage) -> Result<(), HardwareError> {
-        std::thread::sleep(Duration::from_millis(33)); // a 30 fps sensor
-        let pose = {
-            let mut w = self.0.lock().map_err(|_| HardwareError::Fault {
-                device: "world".into(),
-                detail: "poisoned".into(),
-            })?;
-            w.advance();
-            w.pose
-        };
-        frame.fill([90, 90, 90]);
-        let (lx, ly) = pose.to_local(BEACON.0, BEACON.1);
-        if lx > 0.05 {
-            let f = 80.0 / (30f64.to_radians()).tan();
-            let u = 80.0 - f * ly / lx;
-            let half_w = (f * 0.05 / lx).max(1.0);
-            let half_h = (f * 0.3 / lx).min(60.0);
-            for x in (u - half_w).max(0.0) as usize..(u + half_w).clamp(0.0, 160.0) as usize {
-                for y in (60.0 - half_h) as usize..(60.0 + half_h) as usize {
-                    frame.put(x, y, [220, 30, 30]);
-                }
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Applies twists to the toy world (your motor controller goes here).
-struct ToyDrive(Shared);
-impl Drive for ToyDrive {
-    fn apply(&mut self, command: &DriveCommand) -> Result<(), HardwareError> {
-        let mut w = self.0.lock().map_err(|_| HardwareError::Fault {
-            device: "world".into(),
-            detail: "poisoned".into(),
-        })?;
-        w.advance();
-        w.twist = command.to_twist();
-        Ok(())
-    }
-}
-
-struct ToyEncoders(Shared);
-impl WheelEncoders for ToyEncoders {
-    fn read(&mut self) -> Result<WheelTravel, HardwareError> {
-        let mut w = self.0.lock().map_err(|_| HardwareError::NotReady)?;
-        w.advance();
-        Ok(w.travel)
-    }
-}
-
-/// Closes when the robot's front is within 20 cm of the beacon.
-struct ToyDockSwitch(Shared);
-impl DockSensor for ToyDockSwitch {
-    fn in_contact(&mut self) -> Result<bool, HardwareError> {
-        let w = self.0.lock().map_err(|_| HardwareError::NotReady)?;
-        Ok((w.pose.x - BEACON.0).hypot(w.pose.y - BEACON.1) < 0.35)
-    }
-}
 
 // ---------------------------------------------------------------------------------------
 // 3. Behaviors.
@@ -310,12 +226,7 @@ fn main() {
     };
 
     // Start facing away from the beacon so the search behavior has work to do.
-    let world: Shared = Arc::new(Mutex::new(World {
-        pose: Pose2::new(0.0, 0.0, -2.0),
-        twist: Twist::ZERO,
-        travel: WheelTravel::default(),
-        last: Instant::now(),
-    }));
+    let world = World::shared(Pose2::new(0.0, 0.0, -2.0), None);
     let mut robot = Robot::new(
         vec![Box::new(ToyCamera(world.clone()))],
         Box::new(ToyDrive(world.clone())),

@@ -1,9 +1,14 @@
 //! The papers' behaviors, as compositions of schemas, and the agents that run them.
 //!
-//! An [`Agent`] is everything one robot runs for a docking experiment: optionally a
-//! departure phase (undock, imprint the fiducial on the way out) and the docking phase.
-//! It is itself a [`Behavior`](crate::schemas::Behavior) whose tick dispatches on the current phase, so the reactive
-//! loop, the threaded runtime and the simulator all drive it the same way.
+//! An [`Agent`](crate::schemas::Agent) is everything one robot runs for a docking
+//! experiment: optionally a departure mission (undock, imprint the fiducial on the way
+//! out) and the docking mission. Every robot's agent is a [`Composed`]: its shared memory
+//! (the perceptual schemas, run once per tick) and the tree its profile's
+//! `[behavior.tree]` declares, built by a [`registry::Registry`] of named schemas from
+//! `common` (any robot), `bujold` and `raposa`. It is itself a
+//! [`Behavior`](crate::schemas::Behavior), so the reactive loop, the threaded runtime and
+//! the simulator all drive it the same way. `examples/compose.rs` composes a user's robot
+//! from its own schemas and the crate's.
 
 pub mod agent;
 pub mod bujold;

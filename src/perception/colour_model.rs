@@ -167,7 +167,7 @@ impl<T: Blend, const N: usize> Blend for [T; N] {
 }
 
 /// Streaming mean/variance of (A, B) pairs in `f64`, by shifted sums: samples are taken
-/// relative to the first one, which keeps E[x²] − E[x]² well conditioned (the naive form
+/// relative to the first one, which keeps E\[x²\] − E\[x\]² well conditioned (the naive form
 /// loses precision; ALGORITHMS §2) without a division per sample.
 ///
 /// # Example

@@ -1,8 +1,8 @@
 //! The camera renderer: ray casting over screen-space bounding boxes, front-to-back
 //! compositing, analytic anti-aliasing, then a sensor model.
 //!
-//! Each frame, every primitive is moved into the camera frame once ([`hits::Surface`]);
-//! per-pixel rays are a table computed when the renderer is built ([`rays::RayTable`]), so
+//! Each frame, every primitive is moved into the camera frame once (`hits::Surface`);
+//! per-pixel rays are a table computed when the renderer is built (`rays::RayTable`), so
 //! pin-hole and fisheye cameras share one path. Primitives are drawn near to far, each only
 //! over the pixels its projected bounds cover, and each pixel accumulates coverage until it
 //! is full; the ground and sky fill what is left. Edges are anti-aliased analytically: the
@@ -11,9 +11,9 @@
 //! behind, so moving a target by a fraction of a pixel changes the image.
 //!
 //! Each primitive is drawn a row at a time in two passes: a branch-free kernel intersects
-//! the row's rays ([`hits::hit_row`], vectorised by the compiler), then a shading pass
-//! visits only the covered pixels that are not yet full ([`texture`], shadows, glare).
-//! The [`sensor`] then turns radiance into 8-bit RGB.
+//! the row's rays (`hits::hit_row`, vectorised by the compiler), then a shading pass
+//! visits only the covered pixels that are not yet full (`texture`, shadows, glare).
+//! The `sensor` module then turns radiance into 8-bit RGB.
 
 mod hits;
 mod rays;
