@@ -29,7 +29,9 @@ pub enum BuildError {
     },
 }
 
-/// Builds the agent a profile selects.
+/// Builds the agent a profile selects: Bujold's for ratio steering or a potential field on
+/// a two-block flap; RAPOSA's for the seven-state servo, on a pyramid or, through the
+/// two-block adapter ([`super::raposa::source`]), on a two-block flap.
 ///
 /// # Errors
 /// [`BuildError`] when the profile's approach has no implementation or lacks what it needs.
@@ -38,7 +40,9 @@ pub fn agent_for(profile: &Profile) -> Result<Box<dyn Agent>, BuildError> {
         ApproachKind::RatioSteering | ApproachKind::PotentialField if profile.fiducial.two_block.is_some() => {
             Ok(Box::new(super::bujold::agent(profile)?))
         }
-        ApproachKind::SevenState if profile.fiducial.pyramid.is_some() => Ok(Box::new(super::raposa::agent(profile)?)),
+        ApproachKind::SevenState if profile.fiducial.pyramid.is_some() || profile.fiducial.two_block.is_some() => {
+            Ok(Box::new(super::raposa::agent(profile)?))
+        }
         approach => Err(BuildError::NoBehavior {
             profile: profile.name.clone(),
             approach,

@@ -12,7 +12,7 @@ use super::memory::Memory;
 use super::params::{LeaveDeadZoneParams, RetreatParams};
 use crate::arbiter::Blackboard;
 use crate::geometry::Pose2;
-use crate::schemas::{Behavior, Inputs, PerceptualSchema, Step};
+use crate::schemas::{Behavior, Inputs, Step};
 
 /// How far a back-away goes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -73,7 +73,7 @@ impl Behavior for BackAway {
         let mut m = self.mem.lock();
         let phase = self.phase();
         if m.travelled(&self.mark) >= self.distance {
-            m.schema.reset();
+            m.source.reset();
             return Some(m.hold(phase).with_event("cleared"));
         }
         let omega = m.percept.view.map_or(0.0, |v| m.law.turn(v.dev_px[0]));

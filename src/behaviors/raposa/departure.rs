@@ -1,7 +1,8 @@
 //! The departure (seed 001's robot leaves the pyramid to explore; the imprint is seed
 //! 004's method, seed 001's future work): `raposa.depart` drives straight out, body
 //! forward, until the camera is the profile's `perception.pyramid.imprint_distance_m` from
-//! the ball (event `stopped`), `raposa.imprint` stands still with the pyramid straight
+//! the ball (event `stopped`; for a two-block flap `perception.imprint.at_distance_m` from
+//! the flap), `raposa.imprint` stands still with the target straight
 //! behind and imprints its colours (the common leaf
 //! [`crate::behaviors::common::docking::Imprint`], skipping the first frame after
 //! stopping, which may still be blurred; its outcome is the departure's). The perception
@@ -23,11 +24,12 @@ pub struct Depart {
 impl Depart {
     /// A leaf named `name`.
     pub fn new(name: &str, mem: Blackboard<Memory>) -> Self {
-        // Docked, the camera is `socket_inset` from the ball, and the body's forward
-        // direction leads away from it.
+        // Docked, the camera is `docked_distance` from the target (the ball at the socket,
+        // or the flap over the pouch the robot sits in), and the body's forward direction
+        // leads away from it.
         let travel = {
             let m = mem.lock();
-            (m.schema.imprint_distance() - m.socket_inset).max(0.0)
+            (m.source.imprint_distance() - m.docked_distance).max(0.0)
         };
         Self {
             name: name.into(),

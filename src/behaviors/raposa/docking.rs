@@ -1,6 +1,6 @@
 //! RAPOSA's side of the common `imprint` and `dock_switch` leaves
 //! ([`crate::behaviors::common::docking`]): she imprints the pyramid's bands with her
-//! lights and guides as they are, and docked (the pyramid in the socket) she closes the
+//! (or a two-block flap's blocks) with her lights and guides as they are, and docked (the pyramid in the socket) she closes the
 //! guides.
 
 use super::memory::Memory;
@@ -11,11 +11,11 @@ use crate::schemas::{Auxiliary, Feedback, Guides};
 impl DockingMemory for Memory {
     fn imprint_frame(&mut self, image: &RgbView<'_>) {
         // A frame without the pyramid adds nothing; the finish says whether any did.
-        let _ = self.schema.imprint_frame(image);
+        self.source.imprint_frame(image);
     }
 
     fn finish_imprint(&mut self) -> bool {
-        self.imprinted = self.schema.finish_imprint(self.now);
+        self.imprinted = self.source.finish_imprint(self.now);
         self.imprinted
     }
 

@@ -7,7 +7,7 @@
 
 use super::memory::Memory;
 use crate::arbiter::Blackboard;
-use crate::schemas::{Behavior, Inputs, PerceptualSchema, Step};
+use crate::schemas::{Behavior, Inputs, Step};
 
 /// Which part of the manoeuvre a [`Manoeuvre`] leaf runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -75,7 +75,7 @@ impl Behavior for Manoeuvre {
                 match m.ctrl.rotate(&odo, heading) {
                     Some(t) => m.turn(t.omega, "state_2_rotate_phi"),
                     None => {
-                        m.schema.reset();
+                        m.source.reset();
                         m.hold("state_2_rotate_phi").with_event("facing")
                     }
                 }

@@ -1,9 +1,11 @@
-//! What RAPOSA's phase schemas share: the pyramid perceptual schema and this tick's
-//! percept, the odometry pose, the auxiliary commands (arm, lights, guides) every output
+//! What RAPOSA's phase schemas share: the perception source and this tick's percept, the
+//! odometry pose, the auxiliary commands (arm, lights, guides) every output
 //! carries, the search and retry counters, and the region-II plan one phase hands the
 //! next.
 //!
-//! The perceptual schema runs once per tick for the whole tree ([`Memory::perceive`],
+//! The source is the pyramid perceptual schema, or Bujold's two-block schema through the
+//! adapter of [`super::source`] when the profile's fiducial is a two-block flap
+//! ([`Source::from_profile`]). It runs once per tick for the whole tree ([`Memory::perceive`],
 //! called by the robot's [`Composed`](crate::behaviors::composed::Composed) root before the
 //! arbiters), in the order the seven-state robot needs: not at all during the departure
 //! (the robot drives out and imprints, [`Memory::perceiving`]), told that it is not
@@ -12,21 +14,22 @@
 //! the next tick's perception reads them.
 
 use super::region2::Region2Plan;
+use super::source::Source;
 use crate::behaviors::BuildError;
 use crate::behaviors::composed::SharedMemory;
 use crate::geometry::{Pose2, Twist, wrap_angle};
 use crate::perception::PyramidPercept;
 use crate::profile::{Profile, SegmentationMode, SevenStateGains};
-use crate::schemas::PyramidSchema;
 use crate::schemas::{
-    AgentStats, Auxiliary, DriveCommand, Feedback, Guides, Inputs, Mission, MissionError, MotorOutput,
-    PerceptualSchema, PointController, ServoLaw, Step,
+    AgentStats, Auxiliary, DriveCommand, Feedback, Guides, Inputs, Mission, MissionError, MotorOutput, PointController,
+    ServoLaw, Step,
 };
 
 /// RAPOSA's shared memory (see the module docs).
 pub struct Memory {
-    /// The pyramid perceptual schema (detector, colour model, imprint).
-    pub schema: PyramidSchema,
+    /// The perception source (detector, colour model, imprint): the pyramid schema, or the
+    /// two-block schema through its adapter.
+    pub source: Source,
     /// The seven states' gains and thresholds (`[behavior.seven_state]`).
     pub gains: SevenStateGains,
     /// The state-1 servo law.
@@ -41,6 +44,10 @@ pub struct Memory {
     pub half_length: f64,
     /// Camera distance in front of the socket (camera-to-ball minus socket-to-ball), m.
     pub socket_inset: f64,
+    /// Camera-to-target distance when docked, m: `socket_inset` for a target that meets
+    /// the socket's mouth (the pyramid), less the dock's depth for a target over a pouch
+    /// the robot backs into (the two-block flap; negative: the camera is inside).
+    pub docked_distance: f64,
     /// Half the image width, px.
     pub half_width_px: f64,
     /// Loop time of this tick, s.
@@ -81,7 +88,8 @@ pub struct Memory {
 
 impl Memory {
     /// The memory of a robot just switched on, built from a profile with a
-    /// `[fiducial.pyramid]`, a pin-hole back camera and `[behavior.seven_state]`.
+    /// `[fiducial.pyramid]` or a `[fiducial.two_block]`, a pin-hole back camera and
+    /// `[behavior.seven_state]`.
     ///
     /// # Errors
     /// [`BuildError::Profile`] naming what is missing.
@@ -94,15 +102,20 @@ impl Memory {
             .behavior
             .seven_state
             .ok_or_else(|| missing("needs [behavior.seven_state]".into()))?;
-        let schema = PyramidSchema::from_profile(profile, 0).map_err(|e| missing(e.to_string()))?;
+        let source = Source::from_profile(profile).map_err(missing)?;
         let cam = &profile.cameras[0];
         let camera_backward = wrap_angle(cam.mount.yaw_deg.to_radians()).abs() > std::f64::consts::FRAC_PI_2;
         let half_length = profile.body.length_m / 2.0;
         let camera_x = cam.mount.x_m;
         let limits = profile.drive.limits();
-        let size = schema.detector().size();
+        let size = source.image_size();
+        let socket_inset = (half_length + camera_x).max(0.0);
+        let docked_distance = match (&source, profile.dock) {
+            (Source::TwoBlock(_), Some(dock)) => socket_inset - dock.depth_m,
+            _ => socket_inset,
+        };
         Ok(Self {
-            schema,
+            source,
             gains,
             law: ServoLaw {
                 k_lin: gains.k_lin,
@@ -123,7 +136,8 @@ impl Memory {
             vision_turn: gains.vision_turn_rate_dps.to_radians(),
             camera_x,
             half_length,
-            socket_inset: (half_length + camera_x).max(0.0),
+            socket_inset,
+            docked_distance,
             half_width_px: cam.width_px as f64 / 2.0,
             now: 0.0,
             odo: Pose2::default(),
@@ -153,8 +167,7 @@ impl Memory {
         if !self.perceiving {
             return;
         }
-        self.schema.set_looking(!self.blind, now);
-        let p = self.schema.perceive(inputs);
+        let p = self.source.perceive(inputs, !self.blind);
         if p.view.is_some() || p.detection.blue.is_some() {
             self.unseen = 0;
         }
@@ -200,7 +213,7 @@ impl Memory {
             return self.hold(phase);
         };
         // √(A₁/A) is the area's distance estimate.
-        let area_root = self.schema.geometry().distance_from_area(v.area_px as f64);
+        let area_root = self.source.distance_from_area(v.area_px as f64);
         let speed = if far {
             self.law.far_speed
         } else {
@@ -227,7 +240,7 @@ impl SharedMemory for Memory {
     fn begin(&mut self, mission: &Mission) -> Result<(), MissionError> {
         match mission {
             Mission::Departure => {
-                if self.schema.mode() == SegmentationMode::Fixed {
+                if self.source.mode() == SegmentationMode::Fixed {
                     return Err(MissionError::Unavailable {
                         robot: "raposa".into(),
                         mission: "departure",
@@ -252,7 +265,7 @@ impl SharedMemory for Memory {
                 self.plan = None;
                 self.perceiving = true;
                 self.blind = false;
-                self.schema.reset();
+                self.source.reset();
             }
         }
         Ok(())

@@ -4,8 +4,11 @@
 //!
 //! Every tick the [pyramid schema](crate::schemas::PyramidSchema) reports the best
 //! (ellipse, blue region) pair, or an ellipse or blue region alone, with distance and α,
-//! into the shared [`Memory`]. The `servo` sequencer's selector ([`selector`], the rules
-//! of [`states`]) picks one of seven states each tick unless the current one is latched:
+//! into the shared [`Memory`]; on a profile whose fiducial is Bujold's two-block flap,
+//! the two-block schema does, through the adapter of [`source`] (which of the pyramid's
+//! cues a flap gives, and which it cannot, is listed there). The `servo` sequencer's
+//! selector ([`selector`], the rules of [`states`]) picks one of seven states each tick
+//! unless the current one is latched:
 //!
 //! 1. **approach** (region I): the servo law of [`ServoLaw`](crate::schemas::ServoLaw)
 //!    (constant speed beyond 1 m, v = K_lin·√(A₁/A) closer, ω = −K_ang·x_dev);
@@ -49,10 +52,12 @@ pub mod rotate7;
 pub mod search;
 pub mod selector;
 pub mod servo;
+pub mod source;
 pub mod states;
 
 pub use memory::Memory;
 pub use region2::Region2Plan;
+pub use source::{Source, TwoBlockCues};
 pub use states::{ServoState, select_state};
 
 use super::agent::BuildError;
@@ -79,7 +84,7 @@ pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
             a.no_params()?;
             // The first frame after stopping is skipped (motion blur); the imprint's
             // result is the departure's.
-            let frames = m.lock().schema.imprint_frames_wanted();
+            let frames = m.lock().source.imprint_frames_wanted();
             Ok(Box::new(Imprint::new(
                 a.node,
                 m.clone(),
@@ -166,11 +171,12 @@ pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
         });
 }
 
-/// RAPOSA's robot: the pyramid perceptual schema in the shared [`Memory`] and the tree of
-/// `[behavior.tree]`.
+/// RAPOSA's robot: the perception source (the pyramid schema, or the two-block adapter)
+/// in the shared [`Memory`] and the tree of `[behavior.tree]`.
 pub type RaposaAgent = Composed<Memory>;
 
-/// Builds RAPOSA's robot from a profile with a `[fiducial.pyramid]`, a pin-hole back
+/// Builds RAPOSA's robot from a profile with a `[fiducial.pyramid]` (or a
+/// `[fiducial.two_block]`, read through [`source::TwoBlockCues`]), a pin-hole back
 /// camera, `[behavior.seven_state]` and a `[behavior.tree]` of RAPOSA's schemas (or the
 /// user's, registered in `registry`).
 ///

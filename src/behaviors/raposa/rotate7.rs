@@ -78,7 +78,7 @@ impl Behavior for Rotate7 {
         // moves the ellipse toward the image side `dir` (+1: right).
         let per_frame = step.abs().max(self.last_step.abs());
         let predicted_rot = rotated + per_frame;
-        let x_next = v.dev_px[0] + dir * per_frame * m.schema.geometry().f_px;
+        let x_next = v.dev_px[0] + dir * per_frame * m.source.f_px();
         let near_edge = x_next * dir > m.half_width_px - m.gains.fov_margin_px;
         let done = predicted_rot >= want - m.ctrl.rotation_tolerance;
         if done || near_edge {
