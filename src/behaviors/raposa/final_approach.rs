@@ -2,33 +2,45 @@
 //! `final_distance_m` (the area threshold). On entry the arm goes to −K_arm·y_dev and the
 //! lights turn on; the first tick still runs the state-1 law, then the robot drives at the
 //! slow constant `final_speed_mps`, steering on the ellipse when seen, for
-//! `final_time_s`. Without the dock switch by then (it subsumes this phase) the lights go
-//! off and the attempt counts as a retry: event `retry` (back away and try again), or the
-//! docking fails with retries exhausted after the profile's `behavior.max_retries`.
+//! `final_time_s`. With the node's `posture` param it also commands that posture (a robot
+//! that lowers itself into its dock). Without the dock switch by then (it subsumes this
+//! phase) the lights go off, the posture is raised again, and the attempt counts as a
+//! retry: event `retry` (back away and try again), or the docking fails with retries
+//! exhausted after the profile's `behavior.max_retries`.
 
 use super::memory::Memory;
+use super::params::FinalParams;
 use crate::arbiter::Blackboard;
-use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, Step};
+use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, Posture, Step};
 
 /// See the module docs.
 pub struct FinalApproach {
     name: String,
     mem: Blackboard<Memory>,
     max_retries: u32,
+    params: FinalParams,
     start: f64,
     first: bool,
 }
 
 impl FinalApproach {
-    /// A leaf named `name`, failing after `max_retries` retries.
+    /// A leaf named `name`, failing after `max_retries` retries, with the default params.
     pub fn new(name: &str, mem: Blackboard<Memory>, max_retries: u32) -> Self {
         Self {
             name: name.into(),
             mem,
             max_retries,
+            params: FinalParams::default(),
             start: 0.0,
             first: true,
         }
+    }
+}
+
+impl FinalApproach {
+    /// The same leaf with the node's params.
+    pub fn with_params(self, params: FinalParams) -> Self {
+        Self { params, ..self }
     }
 }
 
@@ -42,6 +54,9 @@ impl Behavior for FinalApproach {
         let dev = m.percept.view.map_or(0.0, |v| v.dev_px[1]);
         m.aux.arm = Some(m.law.arm(dev));
         m.aux.lights = Some(true);
+        if let Some(p) = self.params.posture {
+            m.aux.posture = Some(p);
+        }
         self.start = m.now;
         self.first = true;
     }
@@ -58,6 +73,9 @@ impl Behavior for FinalApproach {
         }
         // Time is up without the dock switch: stop, and retry from further out.
         m.aux.lights = Some(false);
+        if self.params.posture.is_some() {
+            m.aux.posture = Some(Posture::Raised);
+        }
         m.retries += 1;
         if m.retries > self.max_retries {
             return Some(

@@ -121,12 +121,10 @@ pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
             )))
         })
         .register("raposa.final", |m: &Ctx, a: &LeafArgs<'_>| {
-            a.no_params()?;
-            Ok(Box::new(final_approach::FinalApproach::new(
-                a.node,
-                m.clone(),
-                a.profile.behavior.max_retries,
-            )))
+            Ok(Box::new(
+                final_approach::FinalApproach::new(a.node, m.clone(), a.profile.behavior.max_retries)
+                    .with_params(a.params()?),
+            ))
         })
         .register("raposa.leave_dead_zone", |m: &Ctx, a: &LeafArgs<'_>| {
             Ok(Box::new(BackAway::new(

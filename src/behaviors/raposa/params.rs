@@ -6,6 +6,7 @@
 //! states only what it changes; the shipped profile states them all, with where each
 //! value comes from.
 
+use crate::schemas::Posture;
 use serde::{Deserialize, Serialize};
 
 /// `search` (state 5): the slow doubling search when nothing is seen.
@@ -79,4 +80,15 @@ impl Default for RetreatParams {
     fn default() -> Self {
         Self { distance_m: 0.4 }
     }
+}
+
+/// `final` (state 6): the final approach.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FinalParams {
+    /// The body posture the final approach commands, and leaves raised again when it
+    /// retries (`"lowered"` for a robot that must lower itself into its dock, as Bujold
+    /// enters the pouch; RAPOSA lowers its back with the arm command instead). Absent (the
+    /// default): no posture command.
+    pub posture: Option<Posture>,
 }
