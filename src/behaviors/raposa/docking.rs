@@ -1,7 +1,7 @@
 //! RAPOSA's side of the common `imprint` and `dock_switch` leaves
-//! ([`crate::behaviors::common::docking`]): she imprints the pyramid's bands with her
-//! (or a two-block flap's blocks) with her lights and guides as they are, and docked (the pyramid in the socket) she closes the
-//! guides.
+//! ([`crate::behaviors::common::docking`]): she imprints the pyramid's bands (or a
+//! two-block flap's blocks) with her lights and guides as they are, and docked (the
+//! pyramid in the socket) she closes the guides.
 
 use super::memory::Memory;
 use crate::behaviors::common::docking::DockingMemory;
