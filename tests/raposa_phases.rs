@@ -441,7 +441,7 @@ fn departure_drives_out_to_the_imprint_distance_then_imprints() {
     // Imprint: the first frame skipped, then `imprint_frames` (5); nothing sampled here
     // (no camera), so the departure fails.
     // As `raposa.imprint` is registered.
-    let frames = mem.lock().schema.imprint_frames_wanted();
+    let frames = mem.lock().source.imprint_frames_wanted();
     let mut im = Imprint::new("imprint", mem.clone(), 1, frames, ImprintEnd::Outcome);
     enter(&mut im, &mem, 0.3, at(0.5), nothing());
     for k in 1..=5 {

@@ -7,9 +7,9 @@
 //! arbiters), so colour adaptation
 //! follows the light whichever phase runs; the phase schemas then read the views.
 
-use super::median::MedianWindow;
 use super::params::BujoldTuning;
 use crate::behaviors::BuildError;
+use crate::behaviors::common::median::MedianWindow;
 use crate::behaviors::composed::SharedMemory;
 use crate::geometry::Pose2;
 use crate::perception::TwoBlockPercept;

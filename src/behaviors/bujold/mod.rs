@@ -20,7 +20,6 @@ pub mod back_in;
 pub mod decide;
 pub mod departure;
 pub mod docking;
-pub mod median;
 pub mod memory;
 pub mod move_away;
 pub mod params;

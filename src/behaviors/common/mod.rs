@@ -2,10 +2,12 @@
 //! inputs and their own params (`avoid_obstacles`) to a robot's registry under their plain
 //! names; the docking leaves every robot has (`imprint`, `dock_switch`, in [`docking`])
 //! reach the robot's perception through its memory's [`docking::DockingMemory`], and each
-//! robot registers them under its own names with its own settings.
+//! robot registers them under its own names with its own settings. [`median`] is the
+//! median window both robots smooth their viewing-angle estimates with.
 
 pub mod avoid;
 pub mod docking;
+pub mod median;
 
 use super::registry::{LeafArgs, Registry};
 

@@ -41,7 +41,7 @@
 //! edges leave its 25° window, the paper's dead zone) and holds far; the block ratio's α
 //! is noisy far (two pixels are ±35° at 1.3 m) and good close.
 
-use crate::behaviors::bujold::memory::MedianWindow;
+use crate::behaviors::common::median::MedianWindow;
 use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
 use crate::perception::{PyramidDetection, PyramidPercept, PyramidView, RgbView, TwoBlockPercept};
 use crate::profile::{Profile, SegmentationMode};

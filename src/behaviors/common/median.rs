@@ -1,7 +1,7 @@
-//! A fixed ring of the last samples and their median: the repositioning decision's
-//! robust summary of the viewing angle.
+//! A fixed ring of the last samples and their median: the robust summary of the viewing
+//! angle that Bujold's repositioning decision and RAPOSA's two-block cues both read.
 
-/// Largest median window the repositioning decision may look back over, frames.
+/// Largest median window a viewing-angle estimate may look back over, frames.
 pub const MAX_ALPHA_WINDOW: usize = 64;
 
 /// The last `capacity` samples in a fixed ring, with their median: a robust summary that
