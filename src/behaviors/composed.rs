@@ -96,15 +96,13 @@ impl<M: SharedMemory> Composed<M> {
     pub fn is_active(&self) -> bool {
         self.active
     }
-}
 
-impl<M: SharedMemory> Behavior for Composed<M> {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
-        self.memory.with(|m| m.perceive(inputs));
+    /// One tick with this tick's perception done by `perceive` instead of
+    /// [`SharedMemory::perceive`]: for percepts replayed from a log, perception run on
+    /// another core, or measuring the decision alone (`benches/tick.rs`). Otherwise the
+    /// same as [`Behavior::tick`].
+    pub fn tick_perceived(&mut self, inputs: &Inputs<'_>, perceive: impl FnOnce(&mut M)) -> Option<Step> {
+        self.memory.with(perceive);
         if !self.active {
             return None;
         }
@@ -113,6 +111,16 @@ impl<M: SharedMemory> Behavior for Composed<M> {
             self.active = false;
         }
         Some(step)
+    }
+}
+
+impl<M: SharedMemory> Behavior for Composed<M> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+        self.tick_perceived(inputs, |m| m.perceive(inputs))
     }
 
     fn reset(&mut self) {
