@@ -3,14 +3,15 @@
 use std::f32::consts::FRAC_PI_2;
 
 /// Polynomial arctangent on [0, 1] (Rajan et al. 2006, ALGORITHMS §3):
-/// atan(x) ≈ π/4·x − x(x − 1)(0.2447 + 0.0663x), max error 0.0015 rad.
+/// atan(x) ≈ π/4·x − x(x − 1)(0.2447 + 0.0663x), max error about 0.0015 rad (as published).
 #[inline]
 fn atan_unit(x: f32) -> f32 {
     std::f32::consts::FRAC_PI_4 * x - x * (x - 1.0) * (0.2447 + 0.0663 * x)
 }
 
 /// `atan2(y, x)` for non-negative `y` and `x` (first quadrant, result in [0, π/2]),
-/// with `atan2_pos(0, 0) = 0`. Maximum error 0.0015 rad (0.09°), tested against `f64::atan2`.
+/// with `atan2_pos(0, 0) = 0`. Maximum error 0.00151 rad (0.087°) against `f64::atan2`,
+/// measured in f32 over every 8-bit colour as SCT uses it (`sct` tests).
 ///
 /// ```
 /// use marsupial::perception::fastmath::atan2_pos;
@@ -43,7 +44,7 @@ mod tests {
                 worst = worst.max((atan2_pos(y, x) as f64 - exact).abs());
             }
         }
-        assert!(worst < 0.0016, "worst error {worst}");
+        assert!(worst <= 0.00151, "worst error {worst}");
         assert_eq!(atan2_pos(0.0, 0.0), 0.0);
         assert!((atan2_pos(1.0, 0.0) - FRAC_PI_2).abs() < 1e-6);
     }

@@ -141,18 +141,38 @@ mod tests {
 
     #[test]
     fn frame_error_is_bounded_over_the_cube() {
-        // Quantised planes are within half a step of the exact values: 1° of hue (with
-        // wrap-around), 0.5/255 of saturation and value.
-        let im = crate::perception::image::rgb_cube(7);
-        let mut p = HsvPlanes::new(im.width(), im.height());
-        hsv_from_rgb(&im.view(), &mut p).unwrap();
-        for (n, px) in im.as_bytes().chunks_exact(3).enumerate() {
-            let e = Hsv::from_rgb([px[0], px[1], px[2]]);
-            let dh = (p.h[n] as f32 * 2.0 - e.h).abs();
-            assert!(dh.min(360.0 - dh) <= 1.0 + 1e-3, "{px:?}");
-            assert!((p.s[n] as f32 / 255.0 - e.s).abs() <= 0.5 / 255.0 + 1e-6);
-            assert!((p.v[n] as f32 / 255.0 - e.v).abs() <= 0.5 / 255.0 + 1e-6);
-        }
+        // On all 2²⁴ colours, the quantised planes are within half a step of the exact
+        // (f64, rational) values: 1° of hue with wrap-around, half a level of saturation,
+        // and V is max(r, g, b) itself. No slack: the exact values lie at least 1/510 of a
+        // step from a rounding tie unless on it, far beyond f32's error (< 1e-4 step), so
+        // rounding the f32 values never lands on the wrong side.
+        crate::perception::image::for_each_cube_slab(|_, slab| {
+            let mut p = HsvPlanes::new(slab.width(), slab.height());
+            hsv_from_rgb(&slab.view(), &mut p).unwrap();
+            for (n, px) in slab.as_bytes().chunks_exact(3).enumerate() {
+                let [r, g, b] = [px[0], px[1], px[2]].map(f64::from);
+                let (max, min) = (r.max(g).max(b), r.min(g).min(b));
+                let d = max - min;
+                let h = if d == 0.0 {
+                    0.0
+                } else if max == r {
+                    (60.0 * (g - b) / d).rem_euclid(360.0)
+                } else if max == g {
+                    60.0 * (b - r) / d + 120.0
+                } else {
+                    60.0 * (r - g) / d + 240.0
+                };
+                let s = if max == 0.0 { 0.0 } else { 255.0 * d / max };
+                let dh = (f64::from(p.h[n]) * 2.0 - h).abs();
+                assert!(dh.min(360.0 - dh) <= 1.0, "{px:?}: H {h}, plane {}", p.h[n]);
+                assert!(
+                    (f64::from(p.s[n]) - s).abs() <= 0.5,
+                    "{px:?}: S·255 {s}, plane {}",
+                    p.s[n]
+                );
+                assert_eq!(f64::from(p.v[n]), max, "{px:?}");
+            }
+        });
     }
 
     #[test]

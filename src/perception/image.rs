@@ -233,22 +233,29 @@ impl<'a> RgbView<'a> {
     }
 }
 
-/// Every RGB value on a grid of `step` per channel, for tests against per-pixel
-/// references: R and G vary along x (R slowest), B along y; n² × n pixels with
-/// n = ⌈256 / step⌉.
+/// Every one of the 2²⁴ RGB colours, as 256 slabs of 256 × 256 pixels (slab `r` holds
+/// red `r`, green along x, blue along y), each handed to `f` with its red value. The
+/// slabs are split across the machine's cores, so exhaustive tests against per-pixel
+/// references take seconds in the optimised test profile.
 #[cfg(test)]
-pub(crate) fn rgb_cube(step: usize) -> RgbImage {
-    let vals: Vec<u8> = (0..=255).step_by(step).collect();
-    let n = vals.len();
-    let mut im = RgbImage::new(n * n, n);
-    for (i, &r) in vals.iter().enumerate() {
-        for (j, &g) in vals.iter().enumerate() {
-            for (k, &b) in vals.iter().enumerate() {
-                im.put(i * n + j, k, [r, g, b]);
-            }
+pub(crate) fn for_each_cube_slab(f: impl Fn(u8, &RgbImage) + Sync) {
+    let threads = std::thread::available_parallelism().map_or(2, |n| n.get()).min(8);
+    std::thread::scope(|scope| {
+        for t in 0..threads {
+            let f = &f;
+            scope.spawn(move || {
+                let mut slab = RgbImage::new(256, 256);
+                for r in (t..256).step_by(threads) {
+                    for b in 0..256 {
+                        for g in 0..256 {
+                            slab.put(g, b, [r as u8, g as u8, b as u8]);
+                        }
+                    }
+                    f(r as u8, &slab);
+                }
+            });
         }
-    }
-    im
+    });
 }
 
 #[cfg(test)]

@@ -13,9 +13,10 @@
 //! The thresholds are 4 × 256 numbers per colour, computed once per frame (the ranges adapt
 //! every frame). The two B bounds of up to eight colours are then folded into one 64 KB
 //! table indexed by (r, g), so a pixel costs one table lookup, and only pixels passing some
-//! colour's B test go on to the A test. The result is the exact SCT classification
-//! (agreeing with `f64` trigonometry except within 1e-5 rad of a bound, tested over the
-//! whole RGB cube). In 2003 the SCT took over 80 % of the cycle (seed 004 §V); here
+//! colour's B test go on to the A test. The result is the exact SCT classification: it
+//! agrees with the `f64` trigonometry of [`SctRange::contains`] on every one of the 2²⁴
+//! colours, for ranges with bounds that pixels sit on exactly and for arbitrary ones
+//! (tested exhaustively, with no tolerance). In 2003 the SCT took over 80 % of the cycle (seed 004 §V); here
 //! segmenting both colours of a 640×480 frame is cheaper than labelling them.
 
 use super::hsv::Hsv;
@@ -595,8 +596,9 @@ mod tests {
 
     #[test]
     fn fast_test_agrees_with_trigonometry_on_the_whole_cube() {
-        // Every 3rd value per channel against the f64 reference, for ranges with each bound
-        // active or disabled. Disagreements are allowed only within 1e-5 rad of a bound.
+        // All 2²⁴ colours (so all 65,536 (r, g) cells of the B table) against the f64
+        // reference, for ranges with each bound active or disabled, bounds that pixels
+        // sit on exactly, and arbitrary ones. No tolerance: every colour agrees.
         let ranges = [
             SctRange {
                 a: [0.3, 1.1],
@@ -628,36 +630,36 @@ mod tests {
                 min_l: 1.0,
                 min_chroma: 0.0,
             },
+            // Bounds pixels sit on exactly: B = 45° (r = g), A = 45° (r² + g² = b²,
+            // e.g. (3, 4, 5)), the chroma of a primary.
+            SctRange {
+                a: [std::f64::consts::FRAC_PI_4, 1.2],
+                b: [std::f64::consts::FRAC_PI_4, 1.4],
+                min_l: 1.0,
+                min_chroma: chroma([1, 0, 0]),
+            },
+            // Bounds as an adaptation leaves them: arbitrary reals.
+            SctRange {
+                a: [0.712_345_678_9, 0.987_654_321],
+                b: [1.234_567_89, 1.456_789_123],
+                min_l: 29.7,
+                min_chroma: 0.061_234_5,
+            },
         ];
-        let im = crate::perception::image::rgb_cube(3);
-        let (w, h) = (im.width(), im.height());
         let cr: Vec<ColorRange> = ranges.iter().map(|r| ColorRange::Sct(*r)).collect();
-        let mut masks: Vec<Mask> = (0..cr.len()).map(|_| Mask::new(w, h)).collect();
-        Segmenter::new().segment(&im.view(), &cr, &mut masks).unwrap();
-        for (range, mask) in ranges.iter().zip(&masks) {
-            for y in 0..h {
-                for x in 0..w {
-                    let px = im.view().get(x, y).unwrap();
-                    let exact = range.contains(px);
-                    if mask.get(x, y) != exact {
-                        let s = Sct::from_rgb(px);
-                        let c = chroma(px);
-                        let near = [
-                            range.a[0] - s.a,
-                            range.a[1] - s.a,
-                            range.b[0] - s.b,
-                            range.b[1] - s.b,
-                            range.min_chroma - c,
-                        ]
-                        .iter()
-                        .any(|d| d.abs() < 1e-5);
-                        assert!(near, "{px:?} {s:?} {range:?}: fast {} exact {exact}", mask.get(x, y));
-                    }
+        crate::perception::image::for_each_cube_slab(|_, slab| {
+            let (w, h) = (slab.width(), slab.height());
+            let mut masks: Vec<Mask> = (0..cr.len()).map(|_| Mask::new(w, h)).collect();
+            Segmenter::new().segment(&slab.view(), &cr, &mut masks).unwrap();
+            for (range, mask) in ranges.iter().zip(&masks) {
+                for (i, px) in slab.as_bytes().chunks_exact(3).enumerate() {
+                    let px = [px[0], px[1], px[2]];
+                    assert_eq!(mask.data()[i] != 0, range.contains(px), "{px:?} {range:?}");
                 }
             }
-        }
-        assert_eq!(masks[4].count(), 0, "an inverted range matches nothing");
-        assert!(!masks[3].get(0, 0), "black never matches");
+            assert_eq!(masks[4].count(), 0, "an inverted range matches nothing");
+        });
+        assert!(!ranges[3].contains([0, 0, 0]), "black never matches");
     }
 
     #[test]
@@ -748,15 +750,85 @@ mod tests {
                 v: [0.12, 1.0],
             }),
         ];
-        let im = crate::perception::image::rgb_cube(5);
-        let mut masks: Vec<Mask> = ranges.iter().map(|_| Mask::new(im.width(), im.height())).collect();
-        Segmenter::new().segment(&im.view(), &ranges, &mut masks).unwrap();
-        for (idx, px) in im.as_bytes().chunks_exact(3).enumerate() {
-            let rgb = [px[0], px[1], px[2]];
-            for (r, m) in ranges.iter().zip(&masks) {
-                assert_eq!(m.data()[idx] != 0, r.contains(rgb), "{rgb:?} {r:?}");
+        // All 2²⁴ colours, no tolerance.
+        crate::perception::image::for_each_cube_slab(|_, slab| {
+            let mut masks: Vec<Mask> = ranges.iter().map(|_| Mask::new(slab.width(), slab.height())).collect();
+            Segmenter::new().segment(&slab.view(), &ranges, &mut masks).unwrap();
+            for (idx, px) in slab.as_bytes().chunks_exact(3).enumerate() {
+                let rgb = [px[0], px[1], px[2]];
+                for (r, m) in ranges.iter().zip(&masks) {
+                    assert_eq!(m.data()[idx] != 0, r.contains(rgb), "{rgb:?} {r:?}");
+                }
             }
+        });
+    }
+
+    /// HSV in f64 from the textbook definition (hue in degrees, [0, 360)).
+    fn hsv64(rgb: [u8; 3]) -> (f64, f64, f64) {
+        let [r, g, b] = rgb.map(f64::from);
+        let (max, min) = (r.max(g).max(b), r.min(g).min(b));
+        let d = max - min;
+        if d == 0.0 {
+            return (0.0, 0.0, max / 255.0);
         }
+        let h = if max == r {
+            60.0 * (g - b) / d
+        } else if max == g {
+            60.0 * (b - r) / d + 120.0
+        } else {
+            60.0 * (r - g) / d + 240.0
+        };
+        (h.rem_euclid(360.0), d / max, max / 255.0)
+    }
+
+    #[test]
+    fn hsv_classification_agrees_with_f64_on_the_whole_cube() {
+        // HsvRange::contains (f32, what the segmenter runs) against an f64 reference on
+        // all 2²⁴ colours, no tolerance. The ranges include bounds pixels sit on exactly
+        // (H = 60°, 0°, 240°; S = 1/2; V = 51/255 = 0.2) and arbitrary ones.
+        let ranges = [
+            HsvRange {
+                h: [340.0, 20.0],
+                s: [0.5, 1.0],
+                v: [0.2, 1.0],
+            },
+            HsvRange {
+                h: [60.0, 240.0],
+                s: [0.25, 0.75],
+                v: [0.2, 0.8],
+            },
+            HsvRange {
+                h: [0.0, 60.0],
+                s: [0.0, 0.5],
+                v: [0.0, 1.0],
+            },
+            HsvRange {
+                h: [13.37, 201.9],
+                s: [0.123, 0.987],
+                v: [0.0777, 0.9333],
+            },
+        ];
+        // The bounds as written (0.2, not the f32 nearest to it, 0.2000000030): a pixel
+        // with V = 51/255 is on the bound and inside.
+        let written: Vec<[f64; 6]> = ranges
+            .iter()
+            .map(|r| [r.h[0], r.h[1], r.s[0], r.s[1], r.v[0], r.v[1]].map(|x| x.to_string().parse().unwrap()))
+            .collect();
+        crate::perception::image::for_each_cube_slab(|_, slab| {
+            for px in slab.as_bytes().chunks_exact(3) {
+                let rgb = [px[0], px[1], px[2]];
+                let (h, s, v) = hsv64(rgb);
+                for (r, &[h0, h1, s0, s1, v0, v1]) in ranges.iter().zip(&written) {
+                    let h_ok = if h0 <= h1 {
+                        h >= h0 && h <= h1
+                    } else {
+                        h >= h0 || h <= h1
+                    };
+                    let exact = h_ok && s >= s0 && s <= s1 && v >= v0 && v <= v1;
+                    assert_eq!(r.contains(rgb), exact, "{rgb:?} {r:?}: H {h}, S {s}, V {v}");
+                }
+            }
+        });
     }
 
     #[test]
