@@ -5,7 +5,7 @@
 use marsupial::arbiter::{InputKind, Lockstep, LoopConfig, LoopStatus, ReactiveLoop, Staleness, StopReason};
 use marsupial::kinematics::{Differential, DriveLimits, DriveModel};
 use marsupial::perception::RgbImage;
-use marsupial::robot::{Camera, Drive, HardwareError, Robot, Sensor, WheelEncoders, WheelTravel};
+use marsupial::robot::{Camera, DockSensor, Drive, Exposure, HardwareError, Robot, Sensor, WheelEncoders, WheelTravel};
 use marsupial::schemas::{Behavior, DriveCommand, Feedback, Inputs, MotorOutput, Step};
 use std::sync::{Arc, Mutex};
 
@@ -19,13 +19,13 @@ impl Camera for Silent {
     fn resolution(&self) -> (usize, usize) {
         (4, 3)
     }
-    fn capture(&mut self, frame: &mut RgbImage) -> Result<(), HardwareError> {
+    fn capture(&mut self, frame: &mut RgbImage) -> Result<Exposure, HardwareError> {
         self.captures += 1;
         if self.captures > self.silent_from {
             return Err(HardwareError::NotReady);
         }
         frame.fill([self.captures as u8, 0, 0]);
-        Ok(())
+        Ok(Exposure::NOW)
     }
 }
 
@@ -85,6 +85,7 @@ fn config(sensor_stale: Option<f64>) -> LoopConfig {
             camera: Some(0.25),
             odometry: Some(0.25),
             tether: None,
+            dock_switch: None,
             sensors: vec![sensor_stale],
         },
         frame_sizes: vec![(4, 3)],
@@ -187,4 +188,85 @@ fn a_required_sensor_that_never_reads_stops_the_robot() {
     );
     assert_eq!(out.command.drive, DriveCommand::Stop);
     assert_eq!(step.take_errors().count(), 0, "NotReady is not a fault");
+}
+
+/// A dock switch that answers `false` for `answers` reads, then never again.
+struct FadingSwitch {
+    answers: u32,
+}
+impl DockSensor for FadingSwitch {
+    fn in_contact(&mut self) -> Result<bool, HardwareError> {
+        if self.answers == 0 {
+            return Err(HardwareError::NotReady);
+        }
+        self.answers -= 1;
+        Ok(false)
+    }
+}
+
+/// A camera whose frames come from a one-second driver buffer, and which says so.
+struct Buffered;
+impl Camera for Buffered {
+    fn resolution(&self) -> (usize, usize) {
+        (4, 3)
+    }
+    fn capture(&mut self, frame: &mut RgbImage) -> Result<Exposure, HardwareError> {
+        frame.fill([7, 0, 0]);
+        Ok(Exposure::ago(std::time::Duration::from_secs(1)))
+    }
+}
+
+#[test]
+fn the_dock_switch_and_buffered_frames_are_checked_for_age() {
+    let statuses = |camera: Box<dyn Camera>, dock_switch: Option<f64>| {
+        let mut robot = Robot::new(vec![camera], Box::new(Log::default()));
+        robot.encoders = Some(Box::new(Rolling(0.0)));
+        robot.dock_sensor = Some(Box::new(FadingSwitch { answers: 3 }));
+        let mut cfg = config(None);
+        cfg.staleness.sensors.clear();
+        cfg.staleness.dock_switch = dock_switch;
+        let mut lp = ReactiveLoop::new(Box::new(Watch::default()), cfg);
+        let mut step = Lockstep::new(&robot, lp.config());
+        (0..8)
+            .map(|k| step.tick(&mut robot, &mut lp, k as f64 * 0.1).status)
+            .collect::<Vec<_>>()
+    };
+    let fresh = || -> Box<dyn Camera> {
+        Box::new(Silent {
+            captures: 0,
+            silent_from: u32::MAX,
+        })
+    };
+    // The switch answers at 0.0, 0.1, 0.2 s; against 0.25 s its reading is stale at 0.5 s.
+    let s = statuses(fresh(), Some(0.25));
+    assert!(matches!(s[4], LoopStatus::Running { .. }), "{s:?}");
+    let stale_switch = |st: &LoopStatus| {
+        matches!(
+            st,
+            LoopStatus::SafeStop {
+                reason: StopReason::Stale {
+                    input: InputKind::DockSwitch,
+                    ..
+                }
+            }
+        )
+    };
+    assert!(s[5..].iter().all(stale_switch), "{s:?}");
+    // Not required: the same silence goes unchecked.
+    let s = statuses(fresh(), None);
+    assert!(s.iter().all(|st| matches!(st, LoopStatus::Running { .. })), "{s:?}");
+    // A frame exposed a second before it was read is stale from the first tick.
+    let s = statuses(Box::new(Buffered), None);
+    assert!(
+        s.iter().all(|st| matches!(
+            st,
+            LoopStatus::SafeStop {
+                reason: StopReason::Stale {
+                    input: InputKind::Camera(0),
+                    ..
+                }
+            }
+        )),
+        "{s:?}"
+    );
 }

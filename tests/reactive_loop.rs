@@ -146,6 +146,7 @@ fn run(seed: u64) -> String {
         camera: Some(0.5),
         odometry: None,
         tether: None,
+        dock_switch: None,
         sensors: Vec::new(),
     });
     let mut log = String::new();
@@ -219,6 +220,7 @@ fn stale_missing_and_bad_inputs_stop_then_resume() {
         camera: Some(0.5),
         odometry: None,
         tether: None,
+        dock_switch: None,
         sensors: Vec::new(),
     });
     assert_eq!(
@@ -303,6 +305,7 @@ fn required_odometry_must_be_fresh() {
         camera: None,
         odometry: Some(0.2),
         tether: None,
+        dock_switch: None,
         sensors: Vec::new(),
     });
     assert_eq!(

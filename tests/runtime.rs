@@ -5,7 +5,7 @@ use marsupial::arbiter::runtime::{RuntimeConfig, RuntimeEvent, StopHandle, run, 
 use marsupial::arbiter::{InputKind, LoopConfig, ReactiveLoop, Staleness, StopReason};
 use marsupial::kinematics::{Differential, DriveLimits, DriveModel};
 use marsupial::perception::RgbImage;
-use marsupial::robot::{Actuator, Camera, Drive, HardwareError, Robot, Sensor};
+use marsupial::robot::{Actuator, Camera, Drive, Exposure, HardwareError, Robot, Sensor};
 use marsupial::schemas::{
     Agent, Behavior, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Outcome, Step,
 };
@@ -25,7 +25,7 @@ impl Camera for GappyCamera {
     fn resolution(&self) -> (usize, usize) {
         (8, 6)
     }
-    fn capture(&mut self, frame: &mut RgbImage) -> Result<(), HardwareError> {
+    fn capture(&mut self, frame: &mut RgbImage) -> Result<Exposure, HardwareError> {
         let start = *self.start.get_or_insert_with(Instant::now);
         std::thread::sleep(Duration::from_secs_f64(1.0 / self.fps));
         let t = start.elapsed().as_secs_f64();
@@ -34,7 +34,7 @@ impl Camera for GappyCamera {
         }
         self.count = self.count.wrapping_add(1);
         frame.as_bytes_mut()[0] = self.count;
-        Ok(())
+        Ok(Exposure::NOW)
     }
 }
 
@@ -75,6 +75,7 @@ fn loop_config() -> LoopConfig {
             camera: Some(0.25),
             odometry: None,
             tether: None,
+            dock_switch: None,
             sensors: Vec::new(),
         },
         frame_sizes: vec![(8, 6)],
@@ -356,4 +357,68 @@ fn a_mission_the_robot_refuses_runs_nothing() {
         matches!(report.events[..], [RuntimeEvent::MissionRefused { .. }]),
         "{report:?}"
     );
+}
+
+/// A driver that hands out frames from a one-second buffer: each is fresh off the queue,
+/// but was exposed a second ago, and the driver says so.
+struct BufferedCamera {
+    inner: GappyCamera,
+    delay: Duration,
+}
+
+impl Camera for BufferedCamera {
+    fn resolution(&self) -> (usize, usize) {
+        self.inner.resolution()
+    }
+    fn capture(&mut self, frame: &mut RgbImage) -> Result<Exposure, HardwareError> {
+        self.inner.capture(frame)?;
+        Ok(Exposure::ago(self.delay))
+    }
+}
+
+#[test]
+fn a_frame_from_a_one_second_buffer_is_stale() {
+    let run_with = |delay: Duration| {
+        let drive = LogDrive::default();
+        let creep = Creep::default();
+        let cam = BufferedCamera {
+            inner: GappyCamera {
+                start: None,
+                fps: 50.0,
+                gap: (1e9, 1e9),
+                count: 0,
+            },
+            delay,
+        };
+        let mut robot = Robot::new(vec![Box::new(cam)], Box::new(drive.clone()));
+        let mut lp = ReactiveLoop::new(Box::new(creep.clone()), loop_config());
+        let cfg = RuntimeConfig {
+            max_duration: Some(Duration::from_millis(600)),
+            ..Default::default()
+        };
+        let report = run(&mut robot, &mut lp, &cfg, &StopHandle::new());
+        let cmds = drive.0.lock().unwrap().clone();
+        (report, cmds, creep.0.lock().unwrap().len())
+    };
+    // Frames arrive at 50 Hz, but each was exposed 1 s before: stale against 0.25 s.
+    let (report, cmds, ticked) = run_with(Duration::from_secs(1));
+    let stale_age = report.events.iter().find_map(|e| match e {
+        RuntimeEvent::SafeStop {
+            reason:
+                StopReason::Stale {
+                    input: InputKind::Camera(0),
+                    age_s,
+                    ..
+                },
+            ..
+        } => Some(*age_s),
+        _ => None,
+    });
+    let age = stale_age.unwrap_or_else(|| panic!("not caught as stale: {:?}", report.events));
+    assert!((1.0..1.1).contains(&age), "the frame's age is its exposure's: {age}");
+    assert_eq!(ticked, 0, "the behavior never ran on a buffered frame");
+    assert!(cmds.iter().all(|c| *c == DriveCommand::Stop), "{cmds:?}");
+    // Control: the same camera reporting its frames as just exposed drives.
+    let (_, cmds, ticked) = run_with(Duration::ZERO);
+    assert!(ticked > 5 && cmds.iter().any(|c| matches!(c, DriveCommand::Twist(_))));
 }

@@ -7,7 +7,7 @@
 
 use marsupial::geometry::{Pose2, Twist, integrate_twist};
 use marsupial::perception::RgbImage;
-use marsupial::robot::{Camera, DockSensor, Drive, HardwareError, Sensor, WheelEncoders, WheelTravel};
+use marsupial::robot::{Camera, DockSensor, Drive, Exposure, HardwareError, Sensor, WheelEncoders, WheelTravel};
 use marsupial::schemas::DriveCommand;
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
@@ -129,7 +129,7 @@ impl Camera for ToyCamera {
         IMAGE
     }
 
-    fn capture(&mut self, frame: &mut RgbImage) -> Result<(), HardwareError> {
+    fn capture(&mut self, frame: &mut RgbImage) -> Result<Exposure, HardwareError> {
         std::thread::sleep(Duration::from_millis(33));
         let (pose, post) = {
             let w = world(&self.0)?;
@@ -154,7 +154,7 @@ impl Camera for ToyCamera {
         if post_nearer {
             paint_post(frame);
         }
-        Ok(())
+        Ok(Exposure::NOW)
     }
 }
 

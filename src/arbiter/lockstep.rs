@@ -137,7 +137,7 @@ impl Lockstep {
         for (i, cam) in cameras.iter_mut().enumerate() {
             if let Some(frame) = self.frames.get_mut(i) {
                 match cam.capture(frame) {
-                    Ok(()) => self.frame_stamps[i] = Some(now),
+                    Ok(exposure) => self.frame_stamps[i] = Some(exposure.stamp(now)),
                     Err(HardwareError::NotReady) => {}
                     Err(e) => self.errors.push((now, "camera", e)),
                 }

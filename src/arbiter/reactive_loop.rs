@@ -26,6 +26,8 @@ pub enum InputKind {
     Tether,
     /// The `[[sensors]]` entry with this index (profile order).
     Sensor(usize),
+    /// The dock switch.
+    DockSwitch,
     /// The loop clock itself.
     Clock,
 }
@@ -37,6 +39,7 @@ impl fmt::Display for InputKind {
             InputKind::Odometry => f.write_str("odometry"),
             InputKind::Tether => f.write_str("tether"),
             InputKind::Sensor(i) => write!(f, "sensor {i}"),
+            InputKind::DockSwitch => f.write_str("dock switch"),
             InputKind::Clock => f.write_str("clock"),
         }
     }
@@ -85,6 +88,22 @@ pub enum StopReason {
     NonFiniteCommand,
 }
 
+impl StopReason {
+    /// The same cause as `other`: the same kind of fault on the same input, whatever the
+    /// measured values (a stale input's age grows every tick; it is still one stop).
+    pub fn same_cause(&self, other: &StopReason) -> bool {
+        use StopReason::*;
+        match (self, other) {
+            (Missing { input: a }, Missing { input: b })
+            | (Stale { input: a, .. }, Stale { input: b, .. })
+            | (NonFinite { input: a }, NonFinite { input: b }) => a == b,
+            (BadFrameSize { camera: a, .. }, BadFrameSize { camera: b, .. }) => a == b,
+            (BadClock { .. }, BadClock { .. }) | (NonFiniteCommand, NonFiniteCommand) => true,
+            _ => false,
+        }
+    }
+}
+
 impl fmt::Display for StopReason {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -113,6 +132,8 @@ pub struct Staleness {
     pub odometry: Option<f64>,
     /// Limit for the tether sensor.
     pub tether: Option<f64>,
+    /// Limit for the dock switch.
+    pub dock_switch: Option<f64>,
     /// Limit per `[[sensors]]` entry (profile order).
     pub sensors: Vec<Option<f64>>,
 }
@@ -355,6 +376,13 @@ impl LoopCore {
                 input: InputKind::Tether,
             });
         }
+        if let Some(d) = inputs.dock_contact
+            && !d.stamp.is_finite()
+        {
+            return Some(StopReason::NonFinite {
+                input: InputKind::DockSwitch,
+            });
+        }
         let checks = [
             (
                 InputKind::Odometry,
@@ -365,6 +393,11 @@ impl LoopCore {
                 InputKind::Tether,
                 self.config.staleness.tether,
                 inputs.tether.map(|t| t.stamp),
+            ),
+            (
+                InputKind::DockSwitch,
+                self.config.staleness.dock_switch,
+                inputs.dock_contact.map(|d| d.stamp),
             ),
         ];
         for (i, limit) in self.config.staleness.sensors.iter().enumerate() {

@@ -287,8 +287,8 @@ fn run_with<B: Behavior + ?Sized>(
                     let mut buf = empty_rx.try_recv().unwrap_or_else(|_| RgbImage::new(w, h));
                     buf.resize(w, h);
                     match cam.capture(&mut buf) {
-                        Ok(()) => {
-                            let stamp = clock();
+                        Ok(exposure) => {
+                            let stamp = exposure.stamp(clock());
                             if let Some((_, old)) = send_latest(&full_tx, &rx_for_drop, (stamp, buf)) {
                                 let _ = recycle.try_send(old);
                             }
@@ -408,7 +408,9 @@ fn run_with<B: Behavior + ?Sized>(
         let mut odometry = None;
         let mut tether = None;
         let mut dock_contact = None;
-        let mut was_stopped = false;
+        // The cause of the safe stop in force, if any: a stop is reported when it starts
+        // and again when its cause changes (a camera that was missing and is now stale).
+        let mut stopped_for: Option<StopReason> = None;
         let mut next = Instant::now();
         loop {
             if stop.is_stopped() || config.max_duration.is_some_and(|d| t0.elapsed() >= d) {
@@ -465,10 +467,10 @@ fn run_with<B: Behavior + ?Sized>(
             report.last_command = Some(command);
             match status {
                 LoopStatus::SafeStop { reason } => {
-                    if !was_stopped {
+                    if !stopped_for.is_some_and(|r| r.same_cause(&reason)) {
                         report.events.push(RuntimeEvent::SafeStop { t: now, reason });
                     }
-                    was_stopped = true;
+                    stopped_for = Some(reason);
                 }
                 LoopStatus::Finished { outcome } => {
                     report.events.push(RuntimeEvent::Finished { t: now, outcome });
@@ -478,10 +480,9 @@ fn run_with<B: Behavior + ?Sized>(
                     }
                 }
                 _ => {
-                    if was_stopped {
+                    if stopped_for.take().is_some() {
                         report.events.push(RuntimeEvent::Resumed { t: now });
                     }
-                    was_stopped = false;
                 }
             }
             while let Ok(e) = event_rx.try_recv() {

@@ -239,6 +239,10 @@ pub struct LoopSpec {
     /// Tether sensing is required; older than this stops the robot, s.
     #[serde(default)]
     pub tether_stale_s: Option<f64>,
+    /// The dock switch is required; a reading older than this stops the robot, s (a
+    /// docking that ends on the switch must not trust a switch that stopped answering).
+    #[serde(default)]
+    pub dock_switch_stale_s: Option<f64>,
 }
 
 pub(crate) fn validate_behavior(b: &BehaviorSpec, v: &mut Validator<'_>) {
@@ -388,6 +392,7 @@ pub(crate) fn validate_loop(l: &LoopSpec, v: &mut Validator<'_>) {
         ("loop.camera_stale_s", l.camera_stale_s),
         ("loop.odometry_stale_s", l.odometry_stale_s),
         ("loop.tether_stale_s", l.tether_stale_s),
+        ("loop.dock_switch_stale_s", l.dock_switch_stale_s),
     ] {
         if let Some(s) = s {
             v.positive(path, s);

@@ -181,6 +181,7 @@ impl Profile {
                 camera: self.loop_.camera_stale_s,
                 odometry: self.loop_.odometry_stale_s,
                 tether: self.loop_.tether_stale_s,
+                dock_switch: self.loop_.dock_switch_stale_s,
                 sensors: self.sensors.iter().map(|s| s.stale_s).collect(),
             },
             frame_sizes: self.cameras.iter().map(|c| (c.width_px, c.height_px)).collect(),

@@ -18,6 +18,7 @@
 
 use crate::perception::RgbImage;
 use crate::schemas::{DriveCommand, Guides, MotorOutput, OdometryReading, Posture, TetherCommand, TetherReading};
+use std::time::Duration;
 use thiserror::Error;
 
 /// A hardware fault or a "nothing new yet".
@@ -44,15 +45,42 @@ pub enum HardwareError {
     },
 }
 
+/// When a captured frame was exposed, as far as its driver knows: how long before
+/// [`Camera::capture`] returned. A driver that buffers frames (a V4L2 queue, a network
+/// camera) knows each buffer's timestamp and reports its age, so the loop stamps the frame
+/// at its exposure and a frame that sat in a buffer is caught as stale; a driver that does
+/// not know returns [`Exposure::NOW`] and the frame is stamped on arrival.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Exposure {
+    /// Age of the frame when `capture` returned.
+    pub age: Duration,
+}
+
+impl Exposure {
+    /// Exposed just now (or the driver cannot tell).
+    pub const NOW: Exposure = Exposure { age: Duration::ZERO };
+
+    /// Exposed `age` before `capture` returned.
+    pub fn ago(age: Duration) -> Self {
+        Self { age }
+    }
+
+    /// The loop-clock stamp of a frame that arrived at `arrival`, seconds.
+    pub fn stamp(&self, arrival: f64) -> f64 {
+        arrival - self.age.as_secs_f64()
+    }
+}
+
 /// A camera delivering RGB frames.
 pub trait Camera: Send {
     /// Frame size (width, height) in pixels; must match the profile.
     fn resolution(&self) -> (usize, usize);
-    /// Captures the next frame into `frame` (already sized to `resolution()`).
+    /// Captures the next frame into `frame` (already sized to `resolution()`) and says
+    /// when it was exposed.
     ///
     /// # Errors
     /// [`HardwareError::NotReady`] when no frame arrived within about one frame period.
-    fn capture(&mut self, frame: &mut RgbImage) -> Result<(), HardwareError>;
+    fn capture(&mut self, frame: &mut RgbImage) -> Result<Exposure, HardwareError>;
 }
 
 /// The base's motors. Receives commands already realised for the profile's drive type

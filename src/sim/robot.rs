@@ -18,7 +18,8 @@ use super::rng::Rng;
 use crate::perception::RgbImage;
 use crate::profile::{RANGE_KIND, RangeParams, SensorSpec};
 use crate::robot::{
-    BodyPosture, Camera, DockGuides, DockSensor, Drive, HardwareError, Lights, Odometer, Robot, Sensor, TetherReel,
+    BodyPosture, Camera, DockGuides, DockSensor, Drive, Exposure, HardwareError, Lights, Odometer, Robot, Sensor,
+    TetherReel,
 };
 use crate::schemas::{DriveCommand, Guides, OdometryReading, Posture, TetherCommand, TetherReading};
 use std::collections::BTreeMap;
@@ -211,7 +212,7 @@ impl Camera for SimCamera {
         })
     }
 
-    fn capture(&mut self, frame: &mut RgbImage) -> Result<(), HardwareError> {
+    fn capture(&mut self, frame: &mut RgbImage) -> Result<Exposure, HardwareError> {
         if self.paced {
             let t = self.sim.with(|s| s.time());
             if self.last.is_some_and(|last| t <= last) {
@@ -222,7 +223,7 @@ impl Camera for SimCamera {
         }
         let i = self.index;
         self.sim.with(|s| s.render(i, frame));
-        Ok(())
+        Ok(Exposure::NOW)
     }
 }
 
