@@ -1,12 +1,19 @@
-//! The perceptual schemas allocate nothing per frame in steady state: segmentation,
-//! labelling, pairing, adaptation and the fallback chain (Bujold), HSV segmentation,
-//! ellipses, blue regions, pair filters and tracking (RAPOSA) all reuse their buffers.
-//! So does the per-tick camera list the simulator and the runtime build. A counting
-//! global allocator (gated to this thread) proves it.
+//! Nothing allocates per frame or per tick in steady state:
+//! * the perceptual schemas in every segmentation mode, imprinted first, with the clock
+//!   running through the fallback chain (adapted → imprinted → table): segmentation,
+//!   labelling, pairing, adaptation (Bujold); HSV segmentation, ellipses, blue regions,
+//!   pair filters and tracking (RAPOSA);
+//! * the per-tick camera list, and the simulator's whole lockstep tick (device reads
+//!   through the hardware traits, rendering, the composed behavior, the command, the
+//!   physics step);
+//! * the composed Bujold and RAPOSA behaviors through their phases.
+//!
+//! A counting global allocator, gated to the test's own thread, proves it. (The threaded
+//! runtime builds the same per-tick lists as the lockstep; its threads are not counted.)
 
 mod common;
 
-use marsupial::perception::RgbImage;
+use marsupial::perception::{ColorMode, RgbImage};
 use marsupial::profile::{Profile, SegmentationMode};
 use marsupial::schemas::{CameraInput, CameraInputs};
 use marsupial::schemas::{PyramidSchema, TwoBlockSchema};
@@ -53,37 +60,66 @@ static A: Counting = Counting;
 
 #[test]
 fn steady_state_schema_does_not_allocate() {
-    for (w, h) in [(640, 480), (256, 240)] {
+    // Every segmentation mode, after imprinting on departure as the robot does: frames
+    // with the fiducial at several sizes, then long spells without it, so the adaptive
+    // model falls back adapted → imprinted → table and recovers while counted.
+    let modes = [
+        SegmentationMode::Adaptive,
+        SegmentationMode::Static,
+        SegmentationMode::Fixed,
+    ];
+    for ((w, h), mode) in [(640, 480), (256, 240)].into_iter().flat_map(|s| modes.map(|m| (s, m))) {
         let mut p = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/bujold.toml")).unwrap();
         p.cameras[0].width_px = w;
         p.cameras[0].height_px = h;
+        p.perception.mode = mode;
         let mut schema = TwoBlockSchema::from_profile(&p, 0).unwrap();
-        // Frames with the fiducial at several sizes, and empty frames (lost → fallbacks).
         let frames: Vec<_> = (0..6).map(|k| common::scene(w, h, 0.1 + 0.08 * k as f64, k)).collect();
         let empty = common::background(w, h);
-        for (k, f) in frames.iter().enumerate() {
-            schema.process(&f.view(), k as f64 * 0.1).unwrap(); // warm-up
+        for _ in 0..schema.imprint_frames_wanted() {
+            schema.imprint_frame(&frames[2].view());
+        }
+        let imprinted = schema.finish_imprint(0.0);
+        assert_eq!(imprinted, mode != SegmentationMode::Fixed, "{mode:?}: imprint");
+        let mut t = 0.0;
+        for f in &frames {
+            t += 0.1;
+            schema.process(&f.view(), t).unwrap(); // warm-up
         }
         reset();
         COUNTING.with(|c| c.set(true));
         let mut found = 0;
-        let mut t = 1.0;
+        // Fixed storage: the test itself must not allocate while counting.
+        let mut modes_seen = [None; 3];
         for round in 0..20 {
             for f in &frames {
                 t += 0.1;
                 found += schema.process(&f.view(), t).unwrap().found as usize;
             }
             if round % 5 == 4 {
-                // Ten seconds without the fiducial: adapted → imprinted/table fallbacks.
+                // Ten seconds without the fiducial: past both fallback timeouts.
                 for _ in 0..100 {
                     t += 0.1;
                     schema.process(&empty.view(), t).unwrap();
+                    let m = schema.model().mode();
+                    modes_seen[m as usize] = Some(m);
                 }
             }
         }
         COUNTING.with(|c| c.set(false));
-        assert_eq!(allocs(), 0, "{w}×{h}: allocations in steady state");
-        assert_eq!(found, 120, "{w}×{h}: every fiducial frame detected");
+        assert_eq!(allocs(), 0, "{w}×{h} {mode:?}: allocations in steady state");
+        assert_eq!(found, 120, "{w}×{h} {mode:?}: every fiducial frame detected");
+        let expected: &[ColorMode] = match mode {
+            SegmentationMode::Adaptive => &[ColorMode::Adapted, ColorMode::Imprinted, ColorMode::Table],
+            SegmentationMode::Static => &[ColorMode::Imprinted],
+            SegmentationMode::Fixed => &[ColorMode::Table],
+        };
+        for m in expected {
+            assert!(
+                modes_seen.contains(&Some(*m)),
+                "{w}×{h} {mode:?}: {m:?} not counted: {modes_seen:?}"
+            );
+        }
     }
     // Control: the counter does see allocations.
     COUNTING.with(|c| c.set(true));
@@ -119,7 +155,9 @@ fn pyramid_frame(w: usize, h: usize, side: usize) -> RgbImage {
 
 #[test]
 fn steady_state_pyramid_schema_does_not_allocate() {
-    // Every segmentation mode: adaptive also samples each pair and moves its bands.
+    // Every segmentation mode, imprinted first: adaptive also samples each pair and moves
+    // its bands, and the clock runs, so spells without the pyramid drop the tracking ball
+    // and walk the fallback chain while counted.
     let modes = [
         SegmentationMode::Fixed,
         SegmentationMode::Static,
@@ -133,26 +171,59 @@ fn steady_state_pyramid_schema_does_not_allocate() {
         let mut schema = PyramidSchema::from_profile(&p, 0).unwrap();
         let frames: Vec<_> = (0..4).map(|k| pyramid_frame(w, h, h / 6 + k * h / 10)).collect();
         let empty = common::background(w, h);
+        // The imprint samples only a pyramid at the imprint distance: the first size that
+        // agrees, then as many frames as the profile wants.
+        let at_distance = (h / 10..h)
+            .map(|side| pyramid_frame(w, h, side))
+            .find(|f| schema.imprint_frame(&f.view()).unwrap())
+            .expect("some size is at the imprint distance");
+        for _ in 1..schema.imprint_frames_wanted() {
+            assert!(schema.imprint_frame(&at_distance.view()).unwrap());
+        }
+        assert_eq!(
+            schema.finish_imprint(0.0),
+            mode != SegmentationMode::Fixed,
+            "{mode:?}: imprint"
+        );
+        let mut t = 0.0;
         for f in &frames {
-            schema.process(&f.view(), 0.0).unwrap(); // warm-up
+            t += 0.1;
+            schema.process(&f.view(), t).unwrap(); // warm-up
         }
         reset();
         COUNTING.with(|c| c.set(true));
         let mut pairs = 0;
+        // Fixed storage: the test itself must not allocate while counting.
+        let mut modes_seen = [None; 3];
         for round in 0..10 {
             for f in &frames {
-                pairs += schema.process(&f.view(), 0.0).unwrap().detection.pair.is_some() as usize;
+                t += 0.1;
+                pairs += schema.process(&f.view(), t).unwrap().detection.pair.is_some() as usize;
             }
             if round % 3 == 2 {
-                // Lost for a while: the tracking ball is dropped, then re-acquired.
-                for _ in 0..10 {
-                    schema.process(&empty.view(), 0.0).unwrap();
+                // Lost for ten seconds: past both fallback timeouts.
+                for _ in 0..100 {
+                    t += 0.1;
+                    schema.process(&empty.view(), t).unwrap();
+                    let m = schema.model().mode();
+                    modes_seen[m as usize] = Some(m);
                 }
             }
         }
         COUNTING.with(|c| c.set(false));
         assert_eq!(allocs(), 0, "{w}×{h} {mode:?}: allocations in steady state");
         assert_eq!(pairs, 40, "{w}×{h} {mode:?}: every pyramid frame paired");
+        let expected: &[ColorMode] = match mode {
+            SegmentationMode::Adaptive => &[ColorMode::Adapted, ColorMode::Imprinted, ColorMode::Table],
+            SegmentationMode::Static => &[ColorMode::Imprinted],
+            SegmentationMode::Fixed => &[ColorMode::Table],
+        };
+        for m in expected {
+            assert!(
+                modes_seen.contains(&Some(*m)),
+                "{w}×{h} {mode:?}: {m:?} not counted: {modes_seen:?}"
+            );
+        }
     }
 }
 
@@ -331,4 +402,47 @@ fn composed_raposa_ticks_do_not_allocate() {
     ] {
         assert!(phases.contains(&phase), "{phase} did not run: {phases:?}");
     }
+}
+
+/// The simulator's path: the per-tick camera and sensor lists, the device reads through
+/// the hardware traits (rendering into the lockstep's frames), the composed behavior, the
+/// command and the physics step allocate nothing per tick once warmed up, through Bujold's
+/// departure (undock, drive out, imprint).
+#[cfg(feature = "sim")]
+#[test]
+fn a_simulated_robots_lockstep_ticks_do_not_allocate() {
+    use marsupial::arbiter::{Lockstep, LoopStatus, ReactiveLoop};
+    use marsupial::behaviors::agent_for;
+    use marsupial::schemas::Mission;
+    use marsupial::sim::campaign;
+    use marsupial::sim::robot::SimDevices;
+    use marsupial::sim::run::docked_robot;
+    use marsupial::sim::scenario::Scenario;
+
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/bujold-table1.toml");
+    let prepared = campaign::prepare(Scenario::load(&scenario).unwrap()).unwrap();
+    let profile = &prepared.loaded.profile;
+    let sim = docked_robot(&prepared, &prepared.runs[0]);
+    let mut robot = sim.robot(&SimDevices::default()).unwrap();
+    let config = profile.loop_config();
+    let mut step = Lockstep::new(&robot, &config);
+    let mut lp = ReactiveLoop::new(agent_for(profile).unwrap(), config);
+    lp.begin(&Mission::Departure).unwrap();
+    let mut tick = |n: usize| {
+        let mut running = 0;
+        for _ in 0..n {
+            let now = sim.with(|s| s.time());
+            let out = step.tick(&mut robot, &mut lp, now);
+            running += matches!(out.status, LoopStatus::Running { .. }) as usize;
+            assert!(sim.advance().is_none(), "the departure runs on");
+        }
+        running
+    };
+    tick(20); // warm-up: buffers sized, the first phase entered
+    reset();
+    COUNTING.with(|c| c.set(true));
+    let running = tick(60);
+    COUNTING.with(|c| c.set(false));
+    assert_eq!(allocs(), 0, "allocations in the simulator's lockstep ticks");
+    assert_eq!(running, 60, "every counted tick ran the behavior");
 }

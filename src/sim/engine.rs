@@ -46,6 +46,9 @@ pub enum PhaseEnd {
     Timeout,
 }
 
+/// Track samples reserved up front: ten minutes at two a second.
+const TRACK_CAPACITY: usize = 1200;
+
 /// A running simulation.
 pub struct Sim {
     profile: Arc<Profile>,
@@ -146,7 +149,9 @@ impl Sim {
             drive_changes: 0,
             last_drive: DriveCommand::Stop,
             entrance: None,
-            track: Vec::new(),
+            // Sized for a ten-minute phase (longer than any campaign's), so the physics
+            // step allocates nothing per tick (`tests/no_alloc.rs`).
+            track: Vec::with_capacity(TRACK_CAPACITY),
             track_every: 0.5,
             next_track: 0.0,
             safe_stops: 0,
