@@ -264,6 +264,9 @@ fn run_with<B: Behavior + ?Sized>(
     let (event_tx, event_rx) = crossbeam::channel::unbounded::<RuntimeEvent>();
     let done = StopHandle::new();
     let mut report = RuntimeReport::default();
+    // Room for the events of a normal run (safe stops, resumptions, faults), so reporting
+    // one does not allocate on the loop's thread (`tests/no_alloc_runtime.rs`).
+    report.events.reserve(64);
     let (cameras, sensing, mut actuation) = robot.split();
     let n_sensors = sensing.sensors.len();
 
