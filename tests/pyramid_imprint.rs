@@ -41,7 +41,7 @@ fn render(p: &Profile, pose: &Pose2, preset: LightingPreset, seed: u64) -> RgbIm
     let light = LightingRun::new(lighting, &mut Rng::new(seed), 10.0);
     // White balance fixed for daylight: dusk's warm light reaches the colours.
     let sensor = SensorParams {
-        white_balance: Illuminant::Daylight.rgb(),
+        white_balance: WhiteBalance::Fixed(Illuminant::Daylight.rgb().map(|c| 1.0 / c)),
         ..SensorParams::default()
     };
     let mut out = RgbImage::default();
