@@ -1,14 +1,58 @@
 //! `marsupial dock`: `--index` replays exactly one run of the campaign (its start, trial,
-//! lighting and segmentation) and names the valid range when out of it; `--out` with
+//! lighting and segmentation, and so its outcome, time, path and every other field of its
+//! `runs.jsonl` line) and names the valid range when out of it; `--out` with
 //! `--frames-every` writes the departure's and the docking's frames.
 
 use marsupial::cli::sim_cmds::{DockOptions, dock};
-use marsupial::sim::campaign;
+use marsupial::sim::campaign::{self, RunRecord};
 use marsupial::sim::scenario::Scenario;
 use std::path::{Path, PathBuf};
 
 fn scenario() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/bujold-yellow.toml")
+    shipped("bujold-yellow")
+}
+
+fn shipped(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenarios/{name}.toml"))
+}
+
+/// Line `index` of the campaign's committed `runs.jsonl` (`tests/golden/NAME.jsonl`, which
+/// `scripts/golden` holds to what `marsupial trials` writes, byte for byte).
+fn campaign_line(name: &str, index: usize) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/golden/{name}.jsonl"));
+    let text = std::fs::read_to_string(&path).unwrap();
+    let line = text.lines().nth(index).unwrap().to_string();
+    let rec: RunRecord = serde_json::from_str(&line).unwrap();
+    assert_eq!(rec.index, index, "{}", path.display());
+    line
+}
+
+/// `dock --index` gives the campaign's own record of that run: the same outcome, time,
+/// path, entrance error, imprint, manoeuvres, command changes, safe stops and track.
+fn assert_replays(name: &str, index: usize, rec: &RunRecord) {
+    let line = campaign_line(name, index);
+    let want: RunRecord = serde_json::from_str(&line).unwrap();
+    let key = |r: &RunRecord| {
+        (
+            r.success,
+            r.outcome.clone(),
+            r.time_s,
+            r.path_m,
+            r.entrance_lateral_m,
+            r.entrance_heading_deg,
+            r.imprinted,
+            r.manoeuvres,
+            r.commands_per_m,
+            r.safe_stops,
+            r.track.len(),
+        )
+    };
+    assert_eq!(key(rec), key(&want), "{name} --index {index}: replay ≠ campaign run");
+    // Every field, byte for byte as `trials` writes it.
+    assert!(
+        serde_json::to_string(rec).unwrap() == line,
+        "{name} --index {index}: the replay's runs.jsonl line differs from the campaign's"
+    );
 }
 
 fn opts(index: Option<usize>, out: Option<PathBuf>, frames_every: Option<u32>) -> DockOptions {
@@ -39,6 +83,9 @@ fn index_replays_that_campaign_run_and_writes_its_frames() {
         (want.start.label.as_str(), want.trial, want.seed)
     );
     assert_eq!(rec.lighting, want.lighting);
+    // Recording frames does not change the run: it is the campaign's run 5 (docked after
+    // 41 s from 1.33 m on the axis).
+    assert_replays("bujold-yellow", 5, &rec);
     let names: Vec<String> = std::fs::read_dir(dir.join("frames"))
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -46,6 +93,26 @@ fn index_replays_that_campaign_run_and_writes_its_frames() {
     assert!(names.iter().any(|n| n.starts_with("depart-")), "{names:?}");
     assert!(names.iter().any(|n| n.starts_with("frame-")), "{names:?}");
     assert!(dir.join("trajectory.csv").exists());
+}
+
+/// Runs that are not short and not all successes: Bujold's Table I run 35 (the README's
+/// example of a failure to watch: target lost after 78 s from 2 m at −60°), and RAPOSA
+/// with a repainted ball, run 36 (fixed bands: stuck on the pyramid after 79 s) and run
+/// 14 (static bands imprinted on departure: docked after a region-II manoeuvre, 73 s).
+#[test]
+fn index_gives_the_campaigns_own_record_of_that_run() {
+    for (name, index, outcome) in [
+        ("bujold-table1", 35, "target_lost"),
+        ("raposa-repaint", 36, "stuck_contact"),
+        ("raposa-repaint", 14, "docked"),
+    ] {
+        let mut o = opts(Some(index), None, None);
+        o.scenario = shipped(name);
+        let rec = dock(&o, &mut Vec::new()).unwrap();
+        assert_eq!(rec.outcome, outcome, "{name} --index {index}");
+        assert!(rec.time_s > 60.0, "{name} --index {index}: {} s", rec.time_s);
+        assert_replays(name, index, &rec);
+    }
 }
 
 #[test]

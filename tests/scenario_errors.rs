@@ -1,8 +1,12 @@
-//! Malformed scenarios fail with the file, field path, line and expectation, like profiles.
+//! Malformed scenarios fail with the file, field path, line and expectation, like profiles,
+//! and no mutant of a shipped scenario makes loading panic.
 
 use marsupial::config::ConfigError;
 use marsupial::sim::scenario::Scenario;
 use std::path::{Path, PathBuf};
+
+#[path = "common/mutate.rs"]
+mod mutate;
 
 fn write(name: &str, body: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("marsupial-scenario-errors-{}", std::process::id()));
@@ -192,4 +196,54 @@ fn shipped_scenarios_are_valid_and_check_accepts_them() {
         }
     }
     assert!(n >= 5);
+}
+
+#[test]
+fn mutated_scenarios_never_panic() {
+    // Every shipped scenario, truncated, with bytes flipped, values swapped for other types
+    // and lines deleted, loaded from a folder beside a copy of the shipped profiles (so
+    // `profile = "../profiles/…"` resolves and the `[profile_patch]` is merged): loading
+    // each (parse, validate, its profile's too) must return, Ok or Err. Loading runs no
+    // campaign.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let work = std::env::temp_dir().join(format!("marsupial-scenario-mutants-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&work);
+    std::fs::create_dir_all(work.join("scenarios")).unwrap();
+    std::fs::create_dir_all(work.join("profiles")).unwrap();
+    for e in std::fs::read_dir(root.join("profiles")).unwrap() {
+        let p = e.unwrap().path();
+        std::fs::copy(&p, work.join("profiles").join(p.file_name().unwrap())).unwrap();
+    }
+    let mut files: Vec<PathBuf> = std::fs::read_dir(root.join("scenarios"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 18, "{files:?}");
+    let mutant = work.join("scenarios/mutant.toml");
+    let mut bad = Vec::new();
+    let mut tried = 0;
+    for (k, file) in files.iter().enumerate() {
+        let src = std::fs::read_to_string(file).unwrap();
+        // The original loads from there.
+        std::fs::write(&mutant, &src).unwrap();
+        Scenario::load(&mutant).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        let mutants = mutate::mutants(&src, 0x5CE7_0000 + k as u64, 30, 11, 3);
+        tried += mutants.len();
+        for what in mutate::panicking(&mutants, |m| {
+            std::fs::write(&mutant, &m.bytes).unwrap();
+            let _ = Scenario::load(&mutant);
+        }) {
+            bad.push(format!("{}: {what}", file.display()));
+        }
+    }
+    let _ = std::fs::remove_dir_all(&work);
+    assert!(tried > 3000, "{tried} mutants");
+    assert!(
+        bad.is_empty(),
+        "{} of {tried} mutants panicked:\n{}",
+        bad.len(),
+        bad.join("\n")
+    );
 }

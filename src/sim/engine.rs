@@ -79,8 +79,12 @@ pub struct Sim {
     /// Drive command changes issued by the behaviors.
     pub drive_changes: u32,
     last_drive: DriveCommand,
-    /// Entrance errors when the robot crossed the entrance (lateral m, heading rad).
+    /// Entrance errors of the robot's first arrival at the entrance since it was placed
+    /// (lateral m, heading rad): the arrival the judge accepted, or the one it refused.
     pub entrance: Option<(f64, f64)>,
+    /// The lateral offset the pouch's walls hold the robot at: its rear's at its latest
+    /// entry (0 when placed inside).
+    pouch_lateral: f64,
     /// True pose samples (t, x, y, θ) every `track_every` s.
     pub track: Vec<[f64; 4]>,
     track_every: f64,
@@ -149,6 +153,7 @@ impl Sim {
             drive_changes: 0,
             last_drive: DriveCommand::Stop,
             entrance: None,
+            pouch_lateral: 0.0,
             // Sized for a ten-minute phase (longer than any campaign's), so the physics
             // step allocates nothing per tick (`tests/no_alloc.rs`).
             track: Vec::with_capacity(TRACK_CAPACITY),
@@ -197,6 +202,7 @@ impl Sim {
         self.path_m = 0.0;
         self.drive_changes = 0;
         self.entrance = None;
+        self.pouch_lateral = 0.0;
         self.track.clear();
         self.next_track = 0.0;
         self.safe_stops = 0;
@@ -340,15 +346,20 @@ impl Sim {
                 Contact::Blocked => {}
                 Contact::Inside => {
                     if !self.inside {
-                        self.entrance =
-                            Some((to.to_world(-length / 2.0, 0.0).1, crate::geometry::wrap_angle(to.theta)));
+                        let arrival = (to.to_world(-length / 2.0, 0.0).1, crate::geometry::wrap_angle(to.theta));
+                        self.pouch_lateral = arrival.0;
+                        // The walls square the robot up at once (below). One that arrived
+                        // corner first has its rear centre still a few millimetres short
+                        // of the entrance, so it is outside again for a moment and
+                        // re-enters squared up: that is not an arrival, and must not
+                        // replace the one the judge accepted in the record.
+                        self.entrance.get_or_insert(arrival);
                     }
                     self.inside = true;
                     // The pouch's walls guide the robot: it keeps its entrance offset
                     // within the clearance and moves only along the axis.
-                    let (lat, _) = self.entrance.unwrap_or((0.0, 0.0));
                     let clearance = (self.world.dock.entrance_half - width / 2.0).max(0.0);
-                    self.pose = Pose2::new(to.x, lat.clamp(-clearance, clearance), 0.0);
+                    self.pose = Pose2::new(to.x, self.pouch_lateral.clamp(-clearance, clearance), 0.0);
                 }
                 Contact::Docked => {
                     self.pose = to;
