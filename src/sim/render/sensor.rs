@@ -484,12 +484,12 @@ mod tests {
         };
         // A grey card filling the view under dusk light comes out grey.
         let grey = expose(&|_| dusk.map(|c| c * 0.3));
-        let px = grey.get(5, 5).unwrap();
+        let px = grey.view().get(5, 5).unwrap();
         assert!(px.iter().all(|&c| (c as i32 - px[1] as i32).abs() <= 1), "{px:?}");
         // Under daylight, a view nine-tenths cyan pulls the balance toward red: the grey
         // card beside it turns reddish.
         let cyan_view = expose(&|i| if i % w < 63 { [0.05, 0.4, 0.45] } else { [0.3; 3] });
-        let card = cyan_view.get(66, 5).unwrap();
+        let card = cyan_view.view().get(66, 5).unwrap();
         assert!(card[0] as i32 > card[2] as i32 + 20, "{card:?}");
     }
 
