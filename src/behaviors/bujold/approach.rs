@@ -72,10 +72,10 @@ impl Approach {
     /// window is full, the blocks are tall enough to trust and the robot is more than
     /// `reposition_lateral_m` off the axis; `None` otherwise.
     fn off_axis(&self, m: &Memory, planning: &FiducialView) -> Option<FiducialView> {
-        if !m.alpha_window.is_full() || planning.height_px < m.tuning.reliable_height_px {
+        if planning.height_px < m.tuning.reliable_height_px {
             return None;
         }
-        let alpha = m.alpha_window.median()?;
+        let alpha = m.alpha_window.full_median()?;
         ((planning.distance * alpha.sin()).abs() > self.params.reposition_lateral_m).then(|| planning.with_alpha(alpha))
     }
 }
