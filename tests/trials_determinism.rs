@@ -5,29 +5,17 @@
 //! parallel with `--jobs 2`. (`tests/sim_scripted.rs`
 //! checks the same with a scripted driver that has no perception and no imprint.)
 
+mod common;
+
 use marsupial::cli::sim_cmds::{TrialsOptions, trials};
 use marsupial::sim::campaign::{self, RunRecord};
-use std::path::{Path, PathBuf};
-
-/// A scenario file on a shipped profile (absolute path), written to a temp dir.
-fn scenario(dir: &Path, name: &str, profile: &str, rest: &str) -> PathBuf {
-    std::fs::create_dir_all(dir).unwrap();
-    let profile = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles").join(profile);
-    let path = dir.join(format!("{name}.toml"));
-    std::fs::write(
-        &path,
-        format!("name = \"{name}\"\nprofile = \"{}\"\n{rest}", profile.display()),
-    )
-    .unwrap();
-    path
-}
 
 /// Runs the campaign through the CLI's `trials` with `--jobs 1` and `--jobs 2` and checks
 /// the two `runs.jsonl` (and `summary.json`) are identical; returns the records.
 fn same_runs_whatever_the_jobs(name: &str, profile: &str, rest: &str) -> Vec<RunRecord> {
     let dir = std::env::temp_dir().join(format!("marsupial-jobs-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let s = scenario(&dir, name, profile, rest);
+    let s = common::scenario_file(&dir, name, profile, rest);
     let run = |jobs: usize| {
         let out = dir.join(format!("jobs{jobs}"));
         let opts = TrialsOptions {
