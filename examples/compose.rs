@@ -27,6 +27,8 @@
 //! `cargo run --example compose -- 0.4 -0.6 90`. It exits with status 0 only when the robot
 //! docked without touching the post.
 
+#[path = "common/red_beacon.rs"]
+mod red_beacon;
 #[path = "common/toy_world.rs"]
 mod toy_world;
 
@@ -35,53 +37,27 @@ use marsupial::arbiter::{Blackboard, ReactiveLoop};
 use marsupial::behaviors::registry::{LeafArgs, Registry};
 use marsupial::behaviors::{Composed, SharedMemory, common};
 use marsupial::geometry::Pose2;
-use marsupial::perception::{ColorRange, HsvRange, Labeler, Mask, Segmenter};
 use marsupial::profile::Profile;
 use marsupial::robot::Robot;
 use marsupial::schemas::{
     Behavior, DriveCommand, FailureReason, Feedback, Inputs, Mission, MissionError, MotionVector, MotorOutput, Outcome,
     Step,
 };
+use red_beacon::RedBeacon;
 use serde::Deserialize;
 use std::path::Path;
 use std::time::Duration;
 use toy_world::{Post, ToyBumper, ToyCamera, ToyDockSwitch, ToyDrive, ToyEncoders, ToyRange, World};
 
-/// The profile: the toy robot, its two extra sensors, and its behavior as a tree.
-const PROFILE: &str = r#"
+/// The profile: the toy robot's hardware (`examples/common/toy_robot.toml`, shared with
+/// `custom_robot`), its two extra sensors, and its behavior as a tree.
+const PROFILE: &str = concat!(
+    r#"
 name = "toy-composed"
 description = "A differential-drive toy that docks at a red beacon, round a post"
-
-[drive]
-kind = "differential"
-track_m = 0.30
-max_speed_mps = 0.25
-max_turn_rate_dps = 60.0
-
-[body]
-length_m = 0.35
-width_m = 0.30
-height_m = 0.20
-
-[[cameras]]
-name = "front"
-model = "pinhole"
-width_px = 160
-height_px = 120
-hfov_deg = 60.0
-fps = 30.0
-
-[dock]
-entrance_width_m = 0.40
-depth_m = 0.10
-approach_radius_m = 3.0
-approach_half_angle_deg = 90.0
-
-[fiducial.markers]
-count = 1
-side_m = 0.10
-color = "red"
-
+"#,
+    include_str!("common/toy_robot.toml"),
+    r#"
 [[sensors]]
 name = "front_ranges"
 kind = "range"                 # the crate's kind: avoid_obstacles reads it
@@ -142,15 +118,12 @@ kind = "leaf"
 schema = "avoid_obstacles"     # the crate's schema, on the range finder
 params = { sphere_m = 0.6, safety_m = 0.25, gain_mps = 0.2, cap = 2.0, swirl = 0.7 }
 
-[loop]
-rate_hz = 20.0
-camera_stale_s = 0.3
-
 [success]
 lateral_tolerance_m = 0.1
 heading_tolerance_deg = 20.0
 timeout_s = 40.0
-"#;
+"#
+);
 
 // ---------------------------------------------------------------------------------------
 // The robot's shared memory: its perception, run once per tick.
@@ -167,12 +140,10 @@ struct Beacon {
     pixels: f64,
 }
 
-/// The memory every leaf shares: the red-beacon finder and what it last saw.
+/// The memory every leaf shares: the red-beacon finder (`examples/common/red_beacon.rs`)
+/// and what it last saw.
 struct ToyMemory {
-    red: [ColorRange; 1],
-    segmenter: Segmenter,
-    mask: [Mask; 1],
-    labeler: Labeler,
+    finder: RedBeacon,
     focal_px: f64,
     beacon: Beacon,
     /// When the beacon was last seen, s.
@@ -184,23 +155,12 @@ struct ToyMemory {
 }
 
 impl ToyMemory {
-    /// Blobs smaller than this are noise, px.
-    const MIN_PIXELS: u64 = 10;
-
     /// Buffers for `profile`'s first camera, allocated once.
     fn new(profile: &Profile) -> Self {
         let cam = &profile.cameras[0];
-        let (w, h) = (cam.width_px, cam.height_px);
-        let hfov = cam.hfov_deg.unwrap_or(60.0);
+        let (w, hfov) = (cam.width_px, cam.hfov_deg.unwrap_or(60.0));
         Self {
-            red: [ColorRange::Hsv(HsvRange {
-                h: [340.0, 20.0],
-                s: [0.5, 1.0],
-                v: [0.4, 1.0],
-            })],
-            segmenter: Segmenter::new(),
-            mask: [Mask::new(w, h)],
-            labeler: Labeler::new(w, h),
+            finder: RedBeacon::new(w, cam.height_px),
             focal_px: w as f64 / 2.0 / (hfov / 2.0).to_radians().tan(),
             beacon: Beacon::default(),
             last_seen: f64::NEG_INFINITY,
@@ -217,21 +177,11 @@ impl SharedMemory for ToyMemory {
             self.heading = odo.value.pose.theta;
         }
         let Some(cam) = inputs.camera(0) else { return };
-        // A frame of the wrong size is an error, not a beacon: nothing seen.
-        if self.segmenter.segment(&cam.image, &self.red, &mut self.mask).is_err() {
-            return;
-        }
-        let Ok(blobs) = self.labeler.label(&self.mask[0]) else {
-            return;
-        };
-        if let Some(blob) = blobs.iter().max_by_key(|b| b.count)
-            && blob.count > Self::MIN_PIXELS
-        {
-            let offset = blob.centroid().0 - cam.image.width() as f64 / 2.0;
+        if let Some(seen) = self.finder.find(&cam.image) {
             self.beacon = Beacon {
                 found: true,
-                bearing: (-offset / self.focal_px).atan(),
-                pixels: blob.count as f64,
+                bearing: (-seen.offset_px / self.focal_px).atan(),
+                pixels: seen.pixels as f64,
             };
             self.last_seen = inputs.now;
             self.last_direction = self.heading + self.beacon.bearing;

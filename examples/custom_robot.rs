@@ -2,15 +2,16 @@
 //!
 //! This is the starting point for a new platform. It shows the three things you write:
 //!
-//! 1. **A profile** (here inline; normally `profiles/<robot>.toml`) describing the drive,
-//!    cameras, body, dock and loop timing. `marsupial check` validates it.
+//! 1. **A profile** (here `examples/common/toy_robot.toml` plus a few lines inline;
+//!    normally `profiles/<robot>.toml`) describing the drive, cameras, body, dock and loop
+//!    timing. `marsupial check` validates it.
 //! 2. **The hardware traits** from [`marsupial::robot`]: a [`Camera`], a [`Drive`], and
 //!    optionally [`WheelEncoders`], a [`DockSensor`], a tether reel, arm, lights …
 //!    Here they talk to a tiny toy world (a red beacon on a floor,
 //!    `examples/common/toy_world.rs`); on your robot they talk to your drivers.
 //! 3. **Behaviors**: a perceptual schema (find the red beacon with the crate's perception:
-//!    HSV segmentation and connected components, from plain parameters), a motor schema (steer at
-//!    it), paired with an activation condition, under a priority arbiter with a
+//!    HSV segmentation and connected components, from plain parameters,
+//!    `examples/common/red_beacon.rs`), a motor schema (steer at it), paired with an activation condition, under a priority arbiter with a
 //!    "docked" check on top.
 //!
 //! Then [`run`] drives the reactive loop on threads: one per camera, one for the slow
@@ -19,6 +20,8 @@
 //!
 //! Run it with `cargo run --example custom_robot`.
 
+#[path = "common/red_beacon.rs"]
+mod red_beacon;
 #[path = "common/toy_world.rs"]
 #[allow(dead_code)] // the post, range finder and bumper are the compose example's
 mod toy_world;
@@ -26,67 +29,39 @@ mod toy_world;
 use marsupial::arbiter::runtime::{RuntimeConfig, StopHandle, run};
 use marsupial::arbiter::{Priority, ReactiveLoop};
 use marsupial::geometry::Pose2;
-use marsupial::perception::{ColorRange, HsvRange, Labeler, Mask, Segmenter};
 use marsupial::profile::Profile;
 use marsupial::robot::Robot;
 use marsupial::schemas::{
     Behavior, DriveCommand, Feedback, Inputs, MotorOutput, MotorSchema, Outcome, Percept, PerceptualSchema,
     SchemaBehavior, Step,
 };
+use red_beacon::RedBeacon;
 use std::path::Path;
 use std::time::Duration;
 use toy_world::{ToyCamera, ToyDockSwitch, ToyDrive, ToyEncoders, World};
 
-/// 1. The profile. Every field is checked; try misspelling one.
-const PROFILE: &str = r#"
+/// Step 1, the profile: the toy robot's hardware (`examples/common/toy_robot.toml`,
+/// shared with the `compose` example), then this example's name, behavior settings and
+/// success criteria. Every field is checked; try misspelling one.
+const PROFILE: &str = concat!(
+    r#"
 name = "toy"
 description = "A differential-drive toy that docks at a red beacon"
-
-[drive]
-kind = "differential"
-track_m = 0.30
-max_speed_mps = 0.25
-max_turn_rate_dps = 60.0
-
-[body]
-length_m = 0.35
-width_m = 0.30
-height_m = 0.20
-
-[[cameras]]
-name = "front"
-model = "pinhole"
-width_px = 160
-height_px = 120
-hfov_deg = 60.0
-fps = 30.0
-
-[dock]
-entrance_width_m = 0.40
-depth_m = 0.10
-approach_radius_m = 3.0
-approach_half_angle_deg = 90.0
-
-[fiducial.markers]
-count = 1
-side_m = 0.10
-color = "red"
-
+"#,
+    include_str!("common/toy_robot.toml"),
+    r#"
 [behavior]
 approach = "none"
 max_retries = 0
 search_timeout_s = 20.0
 phase_timeout_s = 20.0
 
-[loop]
-rate_hz = 20.0
-camera_stale_s = 0.3
-
 [success]
 lateral_tolerance_m = 0.1
 heading_tolerance_deg = 20.0
 timeout_s = 30.0
-"#;
+"#
+);
 
 // ---------------------------------------------------------------------------------------
 // 2. Hardware: the toy world's devices (examples/common/toy_world.rs) stand in for your
@@ -117,61 +92,28 @@ impl Percept for Beacon {
     }
 }
 
-/// Perceptual schema: the crate's perception with plain parameters, no profile needed.
-/// Red is a box in HSV (hue wrapping through 0°); the [`Segmenter`] writes the red pixels
-/// into a [`Mask`], the [`Labeler`] finds its 8-connected blobs, and the largest blob is
-/// the beacon. Every buffer is allocated once, for the camera's resolution.
-struct FindRed {
-    red: [ColorRange; 1],
-    segmenter: Segmenter,
-    mask: [Mask; 1],
-    labeler: Labeler,
-}
-
-impl FindRed {
-    /// Blobs smaller than this are noise, px.
-    const MIN_PIXELS: u64 = 10;
-
-    fn new(width: usize, height: usize) -> Self {
-        Self {
-            red: [ColorRange::Hsv(HsvRange {
-                h: [340.0, 20.0],
-                s: [0.5, 1.0],
-                v: [0.4, 1.0],
-            })],
-            segmenter: Segmenter::new(),
-            mask: [Mask::new(width, height)],
-            labeler: Labeler::new(width, height),
-        }
-    }
-}
+/// Perceptual schema: the crate's perception with plain parameters
+/// (`examples/common/red_beacon.rs`), wrapped as this loop's percept.
+struct FindRed(RedBeacon);
 
 impl PerceptualSchema for FindRed {
     type Percept = Beacon;
     fn perceive(&mut self, inputs: &Inputs<'_>) -> Beacon {
-        let mut beacon = Beacon {
-            stamp: inputs.now,
-            found: false,
-            offset_px: 0.0,
-            pixels: 0,
-        };
         let Some(cam) = inputs.camera(0) else {
-            return beacon;
+            return Beacon {
+                stamp: inputs.now,
+                found: false,
+                offset_px: 0.0,
+                pixels: 0,
+            };
         };
-        beacon.stamp = cam.stamp;
-        // A frame of the wrong size is an error, not a beacon: report nothing seen.
-        if self.segmenter.segment(&cam.image, &self.red, &mut self.mask).is_err() {
-            return beacon;
+        let seen = self.0.find(&cam.image);
+        Beacon {
+            stamp: cam.stamp,
+            found: seen.is_some(),
+            offset_px: seen.map_or(0.0, |s| s.offset_px),
+            pixels: seen.map_or(0, |s| s.pixels as usize),
         }
-        let Ok(blobs) = self.labeler.label(&self.mask[0]) else {
-            return beacon;
-        };
-        if let Some(blob) = blobs.iter().max_by_key(|b| b.count) {
-            beacon.found = blob.count > Self::MIN_PIXELS;
-            beacon.offset_px = blob.centroid().0 - cam.image.width() as f64 / 2.0;
-            beacon.pixels = blob.count as usize;
-        }
-        beacon
     }
 }
 
@@ -234,7 +176,12 @@ fn main() {
     robot.encoders = Some(Box::new(ToyEncoders(world.clone())));
     robot.dock_sensor = Some(Box::new(ToyDockSwitch(world.clone())));
 
-    let approach = SchemaBehavior::new("approach", FindRed::new(160, 120), SteerAtBeacon, |b: &Beacon| b.found);
+    let approach = SchemaBehavior::new(
+        "approach",
+        FindRed(RedBeacon::new(160, 120)),
+        SteerAtBeacon,
+        |b: &Beacon| b.found,
+    );
     let root = Priority::new(
         "root",
         vec![Box::new(DockedCheck), Box::new(approach), Box::new(Search)],

@@ -3,10 +3,12 @@
 //! to either side. Each must dock within the profile's tolerance (±2 cm, ±5°), measured
 //! from the robot's true pose as it reached the entrance, not from the judge's record.
 
+mod common;
+
 use marsupial::arbiter::Blackboard;
+use marsupial::behaviors::BuildError;
 use marsupial::behaviors::bujold::{self, Memory};
 use marsupial::behaviors::registry::Registry;
-use marsupial::behaviors::{BuildError, common};
 use marsupial::geometry::Pose2;
 use marsupial::profile::{Profile, SensorSpec};
 use marsupial::robot::{HardwareError, Sensor};
@@ -54,7 +56,7 @@ impl Sensor for Probe {
 fn bujold_agent(profile: &Profile) -> Result<Box<dyn Agent>, BuildError> {
     let mut registry: Registry<Blackboard<Memory>> = Registry::new();
     registry.register_sensor_kind(PROBE, |_| Ok(()));
-    common::register(&mut registry);
+    marsupial::behaviors::common::register(&mut registry);
     bujold::register(&mut registry);
     Ok(Box::new(bujold::agent_with(profile, &registry)?))
 }
@@ -106,14 +108,7 @@ fn run_probed(mut loaded: marsupial::sim::scenario::Loaded) -> Campaign {
 /// `profile` line is `rest`.
 fn run_bujold(name: &str, rest: &str) -> Campaign {
     let dir = std::env::temp_dir().join(format!("marsupial-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let profile = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/bujold.toml");
-    let s = dir.join("s.toml");
-    std::fs::write(
-        &s,
-        format!("name = \"{name}\"\nprofile = \"{}\"\n{rest}", profile.display()),
-    )
-    .unwrap();
+    let s = common::scenario_file(&dir, name, "bujold.toml", rest);
     run_probed(Scenario::load(&s).unwrap())
 }
 

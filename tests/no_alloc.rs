@@ -58,6 +58,23 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static A: Counting = Counting;
 
+/// The colour modes a segmentation mode must have passed through while allocations were
+/// counted: the adaptive model's whole fallback chain, a static model's imprint, a fixed
+/// one's table.
+fn assert_fallbacks_counted(mode: SegmentationMode, seen: &[Option<ColorMode>; 3], label: &str) {
+    let expected: &[ColorMode] = match mode {
+        SegmentationMode::Adaptive => &[ColorMode::Adapted, ColorMode::Imprinted, ColorMode::Table],
+        SegmentationMode::Static => &[ColorMode::Imprinted],
+        SegmentationMode::Fixed => &[ColorMode::Table],
+    };
+    for m in expected {
+        assert!(
+            seen.contains(&Some(*m)),
+            "{label} {mode:?}: {m:?} not counted: {seen:?}"
+        );
+    }
+}
+
 #[test]
 fn steady_state_schema_does_not_allocate() {
     // Every segmentation mode, after imprinting on departure as the robot does: frames
@@ -109,17 +126,7 @@ fn steady_state_schema_does_not_allocate() {
         COUNTING.with(|c| c.set(false));
         assert_eq!(allocs(), 0, "{w}×{h} {mode:?}: allocations in steady state");
         assert_eq!(found, 120, "{w}×{h} {mode:?}: every fiducial frame detected");
-        let expected: &[ColorMode] = match mode {
-            SegmentationMode::Adaptive => &[ColorMode::Adapted, ColorMode::Imprinted, ColorMode::Table],
-            SegmentationMode::Static => &[ColorMode::Imprinted],
-            SegmentationMode::Fixed => &[ColorMode::Table],
-        };
-        for m in expected {
-            assert!(
-                modes_seen.contains(&Some(*m)),
-                "{w}×{h} {mode:?}: {m:?} not counted: {modes_seen:?}"
-            );
-        }
+        assert_fallbacks_counted(mode, &modes_seen, &format!("{w}×{h}"));
     }
     // Control: the counter does see allocations.
     COUNTING.with(|c| c.set(true));
@@ -213,17 +220,7 @@ fn steady_state_pyramid_schema_does_not_allocate() {
         COUNTING.with(|c| c.set(false));
         assert_eq!(allocs(), 0, "{w}×{h} {mode:?}: allocations in steady state");
         assert_eq!(pairs, 40, "{w}×{h} {mode:?}: every pyramid frame paired");
-        let expected: &[ColorMode] = match mode {
-            SegmentationMode::Adaptive => &[ColorMode::Adapted, ColorMode::Imprinted, ColorMode::Table],
-            SegmentationMode::Static => &[ColorMode::Imprinted],
-            SegmentationMode::Fixed => &[ColorMode::Table],
-        };
-        for m in expected {
-            assert!(
-                modes_seen.contains(&Some(*m)),
-                "{w}×{h} {mode:?}: {m:?} not counted: {modes_seen:?}"
-            );
-        }
+        assert_fallbacks_counted(mode, &modes_seen, &format!("{w}×{h}"));
     }
 }
 

@@ -228,3 +228,70 @@ fn the_avoid_profile_builds() {
     let p = Profile::parse(&avoid_shipped(), Path::new("bujold-avoid.toml")).unwrap();
     assert!(agent_for(&p).is_ok());
 }
+
+/// The toy robot of the examples with `[[actuators]]` entries `actuators` (TOML) and a
+/// one-leaf tree whose leaf, `test.grip`, needs a `gripper`.
+fn gripper_profile(actuators: &str) -> Profile {
+    let src = format!(
+        "name = \"gripper\"\n{}{actuators}\n\
+         [behavior]\napproach = \"none\"\nmax_retries = 0\nsearch_timeout_s = 20.0\nphase_timeout_s = 20.0\n\
+         [behavior.tree]\nroot = \"seek\"\ndocking = \"grip\"\n\
+         [behavior.tree.nodes.seek]\nkind = \"sequencer\"\nstates = [\"grip\"]\n\
+         [behavior.tree.nodes.grip]\nkind = \"leaf\"\nschema = \"test.grip\"\n\
+         [success]\nlateral_tolerance_m = 0.1\nheading_tolerance_deg = 20.0\ntimeout_s = 30.0\n",
+        include_str!("../examples/common/toy_robot.toml")
+    );
+    Profile::parse(&src, Path::new("gripper.toml")).expect("the profile loads")
+}
+
+/// A registry that knows the `gripper` actuator kind (params: `force_n` > 0) and a leaf
+/// that finds it, reporting the index it found into `found`.
+fn gripper_registry(
+    found: std::sync::Arc<std::sync::Mutex<Option<usize>>>,
+) -> marsupial::behaviors::registry::Registry<()> {
+    use marsupial::behaviors::registry::{LeafArgs, Registry};
+    use marsupial::schemas::{Behavior, Inputs, Step};
+    struct Grip;
+    impl Behavior for Grip {
+        fn name(&self) -> &str {
+            "grip"
+        }
+        fn tick(&mut self, _: &Inputs<'_>) -> Option<Step> {
+            None
+        }
+    }
+    let mut r = Registry::new();
+    r.register_actuator_kind("gripper", |p| match p.get("force_n").and_then(toml::Value::as_float) {
+        Some(f) if f > 0.0 => Ok(()),
+        _ => Err("params.force_n: expected a force > 0 N".into()),
+    })
+    .register("test.grip", move |_: &(), a: &LeafArgs<'_>| {
+        *found.lock().unwrap() = Some(a.actuator("gripper")?);
+        Ok(Box::new(Grip))
+    });
+    r
+}
+
+#[test]
+fn a_registered_actuator_kind_is_checked_and_found_by_its_leaf() {
+    let found = std::sync::Arc::default();
+    let registry = gripper_registry(std::sync::Arc::clone(&found));
+    let ok = "[[actuators]]\nname = \"beacon\"\nkind = \"gripper\"\nparams = { force_n = 5.0 }\n\
+              [[actuators]]\nname = \"claw\"\nkind = \"gripper\"\nparams = { force_n = 20.0 }\n";
+    assert!(registry.build(&gripper_profile(ok), &()).is_ok());
+    assert_eq!(*found.lock().unwrap(), Some(0), "the first entry of the kind");
+    // Params the kind refuses, at their entry.
+    let weak = ok.replace("force_n = 20.0", "force_n = 0.0");
+    let e = registry.build(&gripper_profile(&weak), &()).err().unwrap();
+    let (_, _, msg) = problem_at(&e, "actuators[1].params");
+    assert!(msg.contains("force_n"), "{msg}");
+    // A kind nobody registered, named with the registered ones.
+    let unknown = ok.replace("kind = \"gripper\"\nparams = { force_n = 5.0 }", "kind = \"winch\"");
+    let e = registry.build(&gripper_profile(&unknown), &()).err().unwrap();
+    let (_, _, msg) = problem_at(&e, "actuators[0].kind");
+    assert!(msg.contains("`winch`") && msg.contains("gripper"), "{msg}");
+    // No gripper at all: the leaf that needs one says so.
+    let e = registry.build(&gripper_profile(""), &()).err().unwrap();
+    let (_, _, msg) = problem_at(&e, "behavior.tree.nodes.grip.schema");
+    assert!(msg.contains("[[actuators]]") && msg.contains("gripper"), "{msg}");
+}

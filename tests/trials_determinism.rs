@@ -5,29 +5,17 @@
 //! parallel with `--jobs 2`. (`tests/sim_scripted.rs`
 //! checks the same with a scripted driver that has no perception and no imprint.)
 
+mod common;
+
 use marsupial::cli::sim_cmds::{TrialsOptions, trials};
 use marsupial::sim::campaign::{self, RunRecord};
-use std::path::{Path, PathBuf};
-
-/// A scenario file on a shipped profile (absolute path), written to a temp dir.
-fn scenario(dir: &Path, name: &str, profile: &str, rest: &str) -> PathBuf {
-    std::fs::create_dir_all(dir).unwrap();
-    let profile = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles").join(profile);
-    let path = dir.join(format!("{name}.toml"));
-    std::fs::write(
-        &path,
-        format!("name = \"{name}\"\nprofile = \"{}\"\n{rest}", profile.display()),
-    )
-    .unwrap();
-    path
-}
 
 /// Runs the campaign through the CLI's `trials` with `--jobs 1` and `--jobs 2` and checks
 /// the two `runs.jsonl` (and `summary.json`) are identical; returns the records.
 fn same_runs_whatever_the_jobs(name: &str, profile: &str, rest: &str) -> Vec<RunRecord> {
     let dir = std::env::temp_dir().join(format!("marsupial-jobs-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let s = scenario(&dir, name, profile, rest);
+    let s = common::scenario_file(&dir, name, profile, rest);
     let run = |jobs: usize| {
         let out = dir.join(format!("jobs{jobs}"));
         let opts = TrialsOptions {
@@ -55,6 +43,23 @@ fn same_runs_whatever_the_jobs(name: &str, profile: &str, rest: &str) -> Vec<Run
     records
 }
 
+/// What both campaigns must be: four real runs (each departed and imprinted, then docked
+/// or failed on what it saw, in adaptive segmentation), at least one docked, and four
+/// distinct seeds, so the runs are not copies of one another.
+fn assert_four_real_runs(records: &[RunRecord]) {
+    assert_eq!(records.len(), 4);
+    for r in records {
+        assert_eq!(r.imprinted, Some(true), "run {}: {}", r.index, r.outcome);
+        assert_eq!(r.segmentation, "adaptive");
+        assert!(r.path_m > 0.3, "run {}: drove {:.2} m", r.index, r.path_m);
+    }
+    assert!(records.iter().any(|r| r.success), "no run docked");
+    let mut seeds: Vec<u64> = records.iter().map(|r| r.seed).collect();
+    seeds.sort_unstable();
+    seeds.dedup();
+    assert_eq!(seeds.len(), 4);
+}
+
 #[test]
 fn a_bujold_campaign_with_imprint_and_adaptive_segmentation_is_the_same_on_1_or_2_jobs() {
     let records = same_runs_whatever_the_jobs(
@@ -65,19 +70,7 @@ fn a_bujold_campaign_with_imprint_and_adaptive_segmentation_is_the_same_on_1_or_
          [axes]\nlighting = [\"clouds\"]\nsegmentation = [\"adaptive\"]\n\
          [imprint]\nenabled = true\n",
     );
-    assert_eq!(records.len(), 4);
-    for r in &records {
-        // A real run: departed and imprinted, then docked (or failed) on what it saw.
-        assert_eq!(r.imprinted, Some(true), "run {}: {}", r.index, r.outcome);
-        assert_eq!(r.segmentation, "adaptive");
-        assert!(r.path_m > 0.3, "run {}: drove {:.2} m", r.index, r.path_m);
-    }
-    assert!(records.iter().any(|r| r.success), "no run docked");
-    // Four runs, four seeds: the runs are not copies of one another.
-    let mut seeds: Vec<u64> = records.iter().map(|r| r.seed).collect();
-    seeds.sort_unstable();
-    seeds.dedup();
-    assert_eq!(seeds.len(), 4);
+    assert_four_real_runs(&records);
 }
 
 #[test]
@@ -91,15 +84,5 @@ fn a_raposa_campaign_with_imprint_and_adaptive_bands_is_the_same_on_1_or_2_jobs(
          [sensor]\nwhite_balance_for = \"daylight\"\n\
          [imprint]\nenabled = true\n",
     );
-    assert_eq!(records.len(), 4);
-    for r in &records {
-        assert_eq!(r.imprinted, Some(true), "run {}: {}", r.index, r.outcome);
-        assert_eq!(r.segmentation, "adaptive");
-        assert!(r.path_m > 0.3, "run {}: drove {:.2} m", r.index, r.path_m);
-    }
-    assert!(records.iter().any(|r| r.success), "no run docked");
-    let mut seeds: Vec<u64> = records.iter().map(|r| r.seed).collect();
-    seeds.sort_unstable();
-    seeds.dedup();
-    assert_eq!(seeds.len(), 4);
+    assert_four_real_runs(&records);
 }

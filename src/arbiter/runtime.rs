@@ -247,6 +247,30 @@ pub fn run_missions<B: Agent + ?Sized>(
     report
 }
 
+/// The safe-stop events of a run, from each tick's loop status: a stop is reported when it
+/// starts and again when its cause changes (a camera that was missing and is now stale),
+/// not on every tick it lasts; a resumption when the loop runs again.
+#[derive(Debug, Default)]
+struct StopEvents {
+    /// The cause of the safe stop in force, if any.
+    stopped_for: Option<StopReason>,
+}
+
+impl StopEvents {
+    /// The event this tick's `status` (not `Finished`, which the caller reports) adds.
+    fn observe(&mut self, now: f64, status: &LoopStatus) -> Option<RuntimeEvent> {
+        match *status {
+            LoopStatus::SafeStop { reason } => {
+                let new = !self.stopped_for.is_some_and(|r| r.same_cause(&reason));
+                self.stopped_for = Some(reason);
+                new.then_some(RuntimeEvent::SafeStop { t: now, reason })
+            }
+            LoopStatus::Finished { .. } => None,
+            _ => self.stopped_for.take().map(|_| RuntimeEvent::Resumed { t: now }),
+        }
+    }
+}
+
 /// The loop, with `next_mission` asked after each successful finish whether to go on
 /// (it starts the next mission on the loop and returns true).
 fn run_with<B: Behavior + ?Sized>(
@@ -411,9 +435,7 @@ fn run_with<B: Behavior + ?Sized>(
         let mut odometry = None;
         let mut tether = None;
         let mut dock_contact = None;
-        // The cause of the safe stop in force, if any: a stop is reported when it starts
-        // and again when its cause changes (a camera that was missing and is now stale).
-        let mut stopped_for: Option<StopReason> = None;
+        let mut stops = StopEvents::default();
         let mut next = Instant::now();
         loop {
             if stop.is_stopped() || config.max_duration.is_some_and(|d| t0.elapsed() >= d) {
@@ -468,25 +490,14 @@ fn run_with<B: Behavior + ?Sized>(
             report.ticks += 1;
             let _ = cmd_tx.send(command);
             report.last_command = Some(command);
-            match status {
-                LoopStatus::SafeStop { reason } => {
-                    if !stopped_for.is_some_and(|r| r.same_cause(&reason)) {
-                        report.events.push(RuntimeEvent::SafeStop { t: now, reason });
-                    }
-                    stopped_for = Some(reason);
+            if let LoopStatus::Finished { outcome } = status {
+                report.events.push(RuntimeEvent::Finished { t: now, outcome });
+                report.outcome = Some(outcome);
+                if !(outcome.is_success() && next_mission(lp, now)) {
+                    break;
                 }
-                LoopStatus::Finished { outcome } => {
-                    report.events.push(RuntimeEvent::Finished { t: now, outcome });
-                    report.outcome = Some(outcome);
-                    if !(outcome.is_success() && next_mission(lp, now)) {
-                        break;
-                    }
-                }
-                _ => {
-                    if stopped_for.take().is_some() {
-                        report.events.push(RuntimeEvent::Resumed { t: now });
-                    }
-                }
+            } else if let Some(e) = stops.observe(now, &status) {
+                report.events.push(e);
             }
             while let Ok(e) = event_rx.try_recv() {
                 report.events.push(e);
@@ -508,4 +519,54 @@ fn run_with<B: Behavior + ?Sized>(
     }
     report.elapsed_s = t0.elapsed().as_secs_f64();
     report
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::arbiter::InputKind;
+
+    #[test]
+    fn a_stop_is_reported_when_it_starts_and_when_its_cause_changes() {
+        let stop = |reason| LoopStatus::SafeStop { reason };
+        let stale = |age_s| StopReason::Stale {
+            input: InputKind::Camera(0),
+            age_s,
+            limit_s: 0.25,
+        };
+        let missing = StopReason::Missing {
+            input: InputKind::Camera(0),
+        };
+        let mut e = StopEvents::default();
+        let events: Vec<_> = [
+            (0.0, stop(missing)),
+            (0.1, stop(missing)),
+            (0.2, stop(stale(1.0))),
+            (0.3, stop(stale(1.1))),
+            (0.4, LoopStatus::Idle),
+            (0.5, LoopStatus::Idle),
+            (0.6, stop(stale(0.3))),
+        ]
+        .iter()
+        .filter_map(|(t, s)| e.observe(*t, s))
+        .collect();
+        assert_eq!(
+            events,
+            vec![
+                RuntimeEvent::SafeStop {
+                    t: 0.0,
+                    reason: missing
+                },
+                RuntimeEvent::SafeStop {
+                    t: 0.2,
+                    reason: stale(1.0)
+                },
+                RuntimeEvent::Resumed { t: 0.4 },
+                RuntimeEvent::SafeStop {
+                    t: 0.6,
+                    reason: stale(0.3)
+                },
+            ]
+        );
+    }
 }

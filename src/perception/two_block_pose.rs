@@ -136,6 +136,13 @@ impl FiducialView {
         )
     }
 
+    /// The block ratio's sin α, before it is clipped to ±1 and turned into
+    /// [`FiducialView::alpha`]: |sin α| ≥ 1 means the ratio saturated (the flap is seen
+    /// edge-on, or one block bloomed).
+    pub fn sin_alpha(&self, g: &TwoBlockGeometry) -> f64 {
+        ratio_sin_alpha(self.distance, self.asym, g.size.0)
+    }
+
     /// The same view with viewing angle `alpha` (rad) and the heading that follows from
     /// it and the bearing: what a filter or a robust summary of α hands to the planners.
     pub fn with_alpha(self, alpha: f64) -> Self {
@@ -165,7 +172,7 @@ impl FiducialView {
         };
         let (l, r) = (solid(p.left_px, p.left_centroid), solid(p.right_px, p.right_centroid));
         let asym = (l - r) / (l + r) * g.image_right_sign * -g.drive_dir;
-        let alpha = (2.0 * distance * asym / w)
+        let alpha = ratio_sin_alpha(distance, asym, w)
             .clamp(-1.0, 1.0)
             .asin()
             .clamp(-80f64.to_radians(), 80f64.to_radians());
@@ -181,4 +188,11 @@ impl FiducialView {
             height_px: h_img,
         })
     }
+}
+
+/// sin α from the pixel asymmetry (L − R)/(L + R) of a flap `width_m` wide seen from
+/// `distance` m: off the axis the near block is nearer than the far one by about
+/// (w/2)·sin α and looks larger by perspective, so sin α ≈ 2·d·asym/w.
+fn ratio_sin_alpha(distance: f64, asym: f64, width_m: f64) -> f64 {
+    2.0 * distance * asym / width_m
 }

@@ -106,7 +106,7 @@ impl AvoidObstacles {
         if largest <= 0.0 {
             return None;
         }
-        let norm = sum.x.hypot(sum.y);
+        let norm = sum.norm();
         // Returns all round cancel: no way out is better than another; push nowhere.
         Some(if norm < 1e-12 {
             MotionVector::ZERO

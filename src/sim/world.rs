@@ -37,6 +37,23 @@ pub struct ClutterSpec {
     pub facing_deg: f64,
 }
 
+impl ClutterSpec {
+    /// Size along axis `i` (0: x or width, 1: y or height, 2: z), m; 0.1 m when the
+    /// scenario gives none.
+    fn size(&self, i: usize) -> f64 {
+        self.size_m.get(i).copied().unwrap_or(0.1)
+    }
+
+    /// A box's lowest and highest corners (x, y, z), m.
+    fn box_bounds(&self) -> ([f64; 3], [f64; 3]) {
+        let (sx, sy, sz) = (self.size(0), self.size(1), self.size(2));
+        (
+            [self.x_m - sx / 2.0, self.y_m - sy / 2.0, self.z_m],
+            [self.x_m + sx / 2.0, self.y_m + sy / 2.0, self.z_m + sz],
+        )
+    }
+}
+
 /// Kinds of clutter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -334,15 +351,12 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
         .iter()
         .filter(|c| c.kind == ClutterKind::Box && c.z_m < profile.body.height_m)
         .map(|c| {
-            let (sx, sy) = (
-                c.size_m.first().copied().unwrap_or(0.1),
-                c.size_m.get(1).copied().unwrap_or(0.1),
-            );
+            let (lo, hi) = c.box_bounds();
             Footprint {
-                x0: c.x_m - sx / 2.0,
-                y0: c.y_m - sy / 2.0,
-                x1: c.x_m + sx / 2.0,
-                y1: c.y_m + sy / 2.0,
+                x0: lo[0],
+                y0: lo[1],
+                x1: hi[0],
+                y1: hi[1],
             }
         })
         .collect();
@@ -466,15 +480,14 @@ fn build_central_module(
 }
 
 fn add_clutter(prims: &mut Vec<Prim>, c: &ClutterSpec, profile: &Profile) {
-    let size = |i: usize, d: f64| c.size_m.get(i).copied().unwrap_or(d);
     let colour = c.color.map(paint).unwrap_or(albedo([200, 200, 200], 0.8));
     let u = yaw(y_axis(), c.facing_deg);
     match c.kind {
         ClutterKind::Box => {
-            let (sx, sy, sz) = (size(0, 0.1), size(1, 0.1), size(2, 0.1));
+            let (lo, hi) = c.box_bounds();
             prims.extend(boxed(
-                Point3::new(c.x_m - sx / 2.0, c.y_m - sy / 2.0, c.z_m),
-                Point3::new(c.x_m + sx / 2.0, c.y_m + sy / 2.0, c.z_m + sz),
+                Point3::new(lo[0], lo[1], lo[2]),
+                Point3::new(hi[0], hi[1], hi[2]),
                 Material::Solid(colour),
                 Tag::Clutter,
             ));
@@ -482,10 +495,10 @@ fn add_clutter(prims: &mut Vec<Prim>, c: &ClutterSpec, profile: &Profile) {
         ClutterKind::Panel => {
             let mut p = Prim::new(
                 Shape::Rect {
-                    centre: Point3::new(c.x_m, c.y_m, c.z_m.max(size(1, 0.1) / 2.0)),
+                    centre: Point3::new(c.x_m, c.y_m, c.z_m.max(c.size(1) / 2.0)),
                     u,
                     v: z_axis(),
-                    half: [size(0, 0.1) / 2.0, size(1, 0.1) / 2.0],
+                    half: [c.size(0) / 2.0, c.size(1) / 2.0],
                 },
                 Material::Solid(colour),
                 Tag::Clutter,

@@ -6,7 +6,7 @@ use marsupial::perception::{RgbImage, SctRange};
 use marsupial::profile::Profile;
 #[cfg(feature = "sim")]
 use marsupial::sim::render::SensorParams;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// A profile shipped in `profiles/`, by name.
 pub fn shipped_profile(name: &str) -> Profile {
@@ -144,4 +144,19 @@ pub fn weighted_centroid(
         }
     }
     (n > 0.0).then(|| [sx / n, sy / n])
+}
+
+/// Writes a scenario named `name` on the shipped profile `profile` (a file name in
+/// `profiles/`, referenced by absolute path) into `dir`, its text after the `profile` line
+/// being `rest`; returns its path.
+pub fn scenario_file(dir: &Path, name: &str, profile: &str, rest: &str) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let profile = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles").join(profile);
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(
+        &path,
+        format!("name = \"{name}\"\nprofile = \"{}\"\n{rest}", profile.display()),
+    )
+    .unwrap();
+    path
 }

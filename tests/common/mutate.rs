@@ -5,20 +5,16 @@
 //! same inputs and a failure names one that can be replayed.
 #![allow(dead_code)]
 
-/// splitmix64: small, fast and good enough to pick positions.
-pub struct Rng(u64);
+/// The crate's seeded generator ([`marsupial::sim::rng::Rng`]), picking positions.
+pub struct Rng(marsupial::sim::rng::Rng);
 
 impl Rng {
     pub fn new(seed: u64) -> Self {
-        Self(seed)
+        Self(marsupial::sim::rng::Rng::new(seed))
     }
 
     pub fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
 
     /// Uniform in 0..n (n > 0).

@@ -20,7 +20,7 @@ use super::memory::raised;
 use super::params::{ApproachOutput, ApproachParams};
 use crate::arbiter::Blackboard;
 use crate::perception::two_block_pose::FiducialView;
-use crate::schemas::{Behavior, DriveCommand, Inputs, MotorOutput, Step};
+use crate::schemas::{Behavior, DriveCommand, Inputs, MotionVector, MotorOutput, Step};
 
 /// See the module docs.
 pub struct Approach {
@@ -62,9 +62,15 @@ impl Approach {
 
     /// This tick's proposal for a view.
     fn propose(&self, m: &Memory, v: &FiducialView) -> MotorOutput {
-        match (self.params.output, m.approach.vector(v)) {
-            (ApproachOutput::Vector, Some(vec)) => MotorOutput::drive(DriveCommand::Vector(vec)).with_aux(raised()),
-            _ => m.approach.act(v),
+        // The field's vector only when the leaf proposes vectors: a steering approach
+        // does not compute it every tick to throw it away.
+        let vector = match self.params.output {
+            ApproachOutput::Vector => m.approach.vector(v),
+            ApproachOutput::Steer => None,
+        };
+        match vector {
+            Some(vec) => vector_output(vec),
+            None => m.approach.act(v),
         }
     }
 
@@ -72,10 +78,10 @@ impl Approach {
     /// window is full, the blocks are tall enough to trust and the robot is more than
     /// `reposition_lateral_m` off the axis; `None` otherwise.
     fn off_axis(&self, m: &Memory, planning: &FiducialView) -> Option<FiducialView> {
-        if !m.alpha_window.is_full() || planning.height_px < m.tuning.reliable_height_px {
+        if planning.height_px < m.tuning.reliable_height_px {
             return None;
         }
-        let alpha = m.alpha_window.median()?;
+        let alpha = m.alpha_window.full_median()?;
         ((planning.distance * alpha.sin()).abs() > self.params.reposition_lateral_m).then(|| planning.with_alpha(alpha))
     }
 }
@@ -117,10 +123,7 @@ impl Behavior for Approach {
                     ApproachOutput::Steer => None,
                 };
                 let hold = match remembered {
-                    Some(vec) => Step::running(
-                        MotorOutput::drive(DriveCommand::Vector(vec)).with_aux(raised()),
-                        m.feedback("approach"),
-                    ),
+                    Some(vec) => Step::running(vector_output(vec), m.feedback("approach")),
                     None => m.hold("approach"),
                 };
                 if lost { hold.with_event("lost") } else { hold }
@@ -128,4 +131,9 @@ impl Behavior for Approach {
         };
         Some(step)
     }
+}
+
+/// A motion vector proposed raised (as the approach drives).
+fn vector_output(vec: MotionVector) -> MotorOutput {
+    MotorOutput::drive(DriveCommand::Vector(vec)).with_aux(raised())
 }

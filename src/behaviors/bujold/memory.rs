@@ -262,9 +262,10 @@ impl Memory {
             }
             // The final decision uses the filtered estimate (repositioning the median of
             // `alpha_window`); steering uses it scaled by its trust.
-            self.planning = Some(v.with_alpha(a));
+            let planning = v.with_alpha(a);
+            self.planning = Some(planning);
             // dock → odometry: odo = T ⊕ here, so T = odo ⊕ here⁻¹.
-            let here = v.with_alpha(a).dock_pose();
+            let here = planning.dock_pose();
             self.dock_in_odometry = Some(self.odo.compose(&here.relative(&Pose2::default())));
             *v = v.with_alpha(a * trust);
         }

@@ -44,6 +44,12 @@ impl MedianWindow {
         self.len == self.capacity
     }
 
+    /// Median of a full window (`None` until `capacity` samples are held): the estimate
+    /// a decision may act on.
+    pub fn full_median(&self) -> Option<f64> {
+        if self.is_full() { self.median() } else { None }
+    }
+
     /// Median of the samples held (`None` when empty); an even count averages the middle two.
     pub fn median(&self) -> Option<f64> {
         if self.len == 0 {
@@ -72,6 +78,7 @@ mod tests {
         w.push(3.0);
         w.push(1.0);
         assert_eq!(w.median(), Some(2.0));
+        assert_eq!(w.full_median(), None, "not full yet");
         // A steady 0.1 rad with a third of the frames pushed to 0.5 by a flash.
         w.clear();
         for k in 0..16 {
@@ -79,6 +86,7 @@ mod tests {
         }
         assert!(w.is_full());
         assert_eq!(w.median(), Some(0.1));
+        assert_eq!(w.full_median(), Some(0.1));
         // A full window of new values replaces the old ones entirely.
         for _ in 0..16 {
             w.push(-0.2);

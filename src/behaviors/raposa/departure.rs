@@ -1,13 +1,12 @@
 //! The departure (seed 001's robot leaves the pyramid to explore; the imprint is seed
 //! 004's method, seed 001's future work): `raposa.depart` drives straight out, body
 //! forward, until the camera is the profile's `perception.pyramid.imprint_distance_m` from
-//! the ball (event `stopped`; for a two-block flap `perception.imprint.at_distance_m` from
-//! the flap), `raposa.imprint` stands still with the target straight
-//! behind and imprints its colours (the common leaf
-//! [`crate::behaviors::common::docking::Imprint`], skipping the first frame after
-//! stopping, which may still be blurred; its outcome is the departure's). The perception
-//! does not run meanwhile (the departure mission turns it off); only the imprint reads
-//! frames.
+//! the ball (for a two-block flap, `perception.imprint.at_distance_m` from the flap; event
+//! `stopped`). Then `raposa.imprint`, the common leaf
+//! [`crate::behaviors::common::docking::Imprint`], stands still with the target straight
+//! behind and imprints its colours, skipping the first frame after stopping (it may still
+//! be blurred); its outcome is the departure's. The perception does not run meanwhile
+//! (the departure mission turns it off); only the imprint reads frames.
 
 use super::memory::Memory;
 use crate::arbiter::Blackboard;

@@ -162,14 +162,6 @@ impl Source {
             Source::TwoBlock(c) => c.schema.finish_imprint(now),
         }
     }
-
-    /// The pyramid schema, to retune its bands live (`None` for a two-block source).
-    pub fn pyramid_mut(&mut self) -> Option<&mut PyramidSchema> {
-        match self {
-            Source::Pyramid(s) => Some(&mut **s),
-            Source::TwoBlock(_) => None,
-        }
-    }
 }
 
 /// Bujold's two-block perceptual schema, reporting RAPOSA's cues (see the module docs).
@@ -242,19 +234,14 @@ impl TwoBlockCues {
         } else {
             self.alpha_window.clear();
         }
-        let alpha = self
-            .alpha_window
-            .is_full()
-            .then(|| self.alpha_window.median())
-            .flatten();
-        let sin_alpha = 2.0 * v.distance * v.asym / self.geometry.size.0;
+        let alpha = self.alpha_window.full_median();
         let row = (p.left_centroid[1] + p.right_centroid[1]) / 2.0 - p.image_size.1 as f64 / 2.0;
         tracing::trace!(target: "marsupial::behavior", now = p.stamp, d = v.distance, height_px = v.height_px, raw_alpha_deg = v.alpha.to_degrees(), alpha_deg = alpha.map(f64::to_degrees), bearing_deg = v.bearing.to_degrees(), left_px = p.left_px, right_px = p.right_px, left_bbox = ?p.left_bbox, right_bbox = ?p.right_bbox, mode = %p.mode, "two-block cues");
         Some(PyramidView {
             blue_distance_m: None,
             ball_distance_m: v.distance,
             alpha,
-            alpha_saturated: alpha.is_some() && sin_alpha.abs() >= 1.0,
+            alpha_saturated: alpha.is_some() && v.sin_alpha(&self.geometry).abs() >= 1.0,
             bearing: v.bearing,
             dev_px: [-self.geometry.fx * v.bearing.tan(), row],
             area_px: p.total_px,
