@@ -117,8 +117,9 @@ fn default_terrain() -> Vec<Terrain> {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum WhiteBalanceSpec {
-    /// The camera's own grey-world estimate, every frame (the default; fooled by coloured
-    /// light and by frames one colour fills, as a real camera's is).
+    /// The camera's own grey-world estimate over near-neutral pixels, settling with
+    /// `white_balance_tau_s` (the default; fooled by coloured light and by views one
+    /// colour fills, as a real camera's is).
     GreyWorld,
     /// Balanced for each run's true illuminant: a perfect balance no real camera has.
     Perfect,
@@ -148,6 +149,9 @@ pub struct SensorSpec {
     pub auto_exposure: bool,
     /// White balance.
     pub white_balance: WhiteBalanceSpec,
+    /// Time constant of the grey-world balance, s (0 follows each frame's estimate at
+    /// once).
+    pub white_balance_tau_s: f64,
     /// Auto-exposure's highlight protection: the largest fraction of pixels it lets clip
     /// (0–1; 1 meters the mean alone and lets a sunlit target burn out).
     pub highlight_clip_frac: f64,
@@ -162,6 +166,7 @@ impl Default for SensorSpec {
             max_integration: f64::from(d.max_integration),
             auto_exposure: true,
             white_balance: WhiteBalanceSpec::GreyWorld,
+            white_balance_tau_s: f64::from(d.white_balance_tau_s),
             highlight_clip_frac: 0.01,
         }
     }
@@ -388,6 +393,7 @@ impl Validate for Scenario {
         v.positive("sensor.full_well_e", self.sensor.full_well_e);
         v.non_negative("sensor.read_noise_e", self.sensor.read_noise_e);
         v.positive("sensor.max_integration", self.sensor.max_integration);
+        v.non_negative("sensor.white_balance_tau_s", self.sensor.white_balance_tau_s);
         v.range("sensor.highlight_clip_frac", self.sensor.highlight_clip_frac, 0.0, 1.0);
         v.non_negative("motion.latency_s", self.motion.latency_s);
         v.positive("motion.accel_mps2", self.motion.accel_mps2);
@@ -545,6 +551,7 @@ impl Scenario {
             max_integration: self.sensor.max_integration as f32,
             auto_exposure: self.sensor.auto_exposure,
             white_balance,
+            white_balance_tau_s: self.sensor.white_balance_tau_s as f32,
             highlight_clip: self.sensor.highlight_clip_frac as f32,
             ..SensorParams::default()
         }

@@ -9,16 +9,21 @@
 //! the exposure that puts a unit radiance at full scale) and then raises the gain, so a dim
 //! scene brightened to the same output is noisier than a bright one, as on a real camera.
 //!
-//! White balance is the camera's own estimate by default: grey-world (each channel's mean
-//! over the frame made equal to green's), which a coloured illuminant or a frame filled by
-//! one colour fools, as it fools a real camera. A scenario can instead balance for a named
-//! illuminant (`Fixed`), including each run's true one (the perfect balance of earlier
-//! versions).
+//! White balance is the camera's own estimate by default: grey-world over the near-neutral
+//! pixels, as a camera's auto white balance gathers its statistics. Each channel's mean
+//! over the pixels that are neither dark, clipped, nor strongly coloured (more than a
+//! factor of two from grey in red/green or blue/green under the balance in force) is made
+//! equal to green's. A coloured illuminant, or a view filled by one colour, still fools it,
+//! as it fools a real camera; a small saturated object (a beacon, a fiducial) does not. A
+//! scenario can instead balance for a named illuminant (`Fixed`), including each run's
+//! true one (the perfect balance of earlier versions).
 //!
-//! Auto-exposure and auto white balance move only halfway toward what this frame needs, in
-//! log terms, so a sudden light change over- or under-exposes the next few frames. Noise
-//! comes from a per-row offset into a seeded table of normal deviates, scaled per output
-//! level.
+//! Auto-exposure moves halfway toward what this frame needs each frame, in log terms, so a
+//! sudden light change over- or under-exposes the next few frames. The white balance
+//! follows its estimate with a time constant in seconds (a camera's AWB settles over a
+//! second or two, far slower than its exposure), so a flashing beacon does not swing it
+//! frame by frame. Noise comes from a per-row offset into a seeded table of normal
+//! deviates, scaled per output level.
 
 use crate::perception::RgbImage;
 use crate::sim::rng::{NoiseTable, splitmix64};
@@ -29,7 +34,8 @@ use crate::sim::scene::srgb_to_linear;
 pub enum WhiteBalance {
     /// Per-channel multipliers fixed in advance (`[1, 1, 1]` is none).
     Fixed([f32; 3]),
-    /// Estimated every frame by grey-world: each channel's mean scaled to green's.
+    /// Estimated by grey-world over the near-neutral pixels, followed with a time
+    /// constant (module docs).
     GreyWorld,
 }
 
@@ -57,12 +63,19 @@ pub struct SensorParams {
     /// clip in any channel (1 = plain mean metering, which burns out a bright target in
     /// front of a dark body).
     pub highlight_clip: f32,
+    /// Time constant of the auto white balance, s: it moves 1 − e^(−Δt/τ) of the way (in
+    /// log terms) toward each frame's estimate.
+    pub white_balance_tau_s: f32,
+    /// Time between frames, s (the simulator renders every camera every loop tick, so it
+    /// sets this from the profile's loop rate).
+    pub frame_interval_s: f32,
 }
 
 impl Default for SensorParams {
     /// A small, cheap colour sensor: 2,100 e⁻ full well and 12 e⁻ read noise, which at
     /// unity gain give 1.5 linear 8-bit units of read noise and 0.35·√signal of shot noise
-    /// (the model's earlier defaults, now added in quadrature), grey-world white balance.
+    /// (the model's earlier defaults, now added in quadrature), grey-world white balance
+    /// settling with a 1 s time constant, 10 frames a second.
     fn default() -> Self {
         Self {
             full_well_e: 2100.0,
@@ -74,6 +87,8 @@ impl Default for SensorParams {
             max_integration: 4.0,
             white_balance: WhiteBalance::GreyWorld,
             highlight_clip: 0.01,
+            white_balance_tau_s: 1.0,
+            frame_interval_s: 0.1,
         }
     }
 }
@@ -232,7 +247,7 @@ impl Sensor {
         out.resize(width, height);
         let balance = match params.white_balance {
             WhiteBalance::Fixed(m) => m,
-            WhiteBalance::GreyWorld => self.grey_world(radiance),
+            WhiteBalance::GreyWorld => self.grey_world(radiance, params),
         };
         if params.auto_exposure {
             self.meter(radiance, params, balance);
@@ -325,25 +340,66 @@ impl Sensor {
     }
 }
 
+/// Grey-world gate: a sample counts toward the balance when, under the balance in force,
+/// its red/green and blue/green both lie within this factor of grey. Wide enough for any
+/// illuminant the scenarios use seen through a neutral balance (tungsten's blue/green is
+/// 0.56), narrow enough to leave out saturated paint and beacons.
+const NEUTRAL_GATE: f32 = 2.0;
+
+/// Fewer gated samples than this fraction of the subsample, and grey-world uses them all
+/// (a view with almost nothing near grey, where the gate has nothing to go on).
+const MIN_NEUTRAL_FRACTION: f32 = 0.02;
+
 impl Sensor {
-    /// Grey-world white balance: each channel's mean over a subsample of the frame made
-    /// equal to green's, moved halfway (in log terms) from the last frame's, like the
-    /// exposure. A frame too dark to say anything keeps the last balance.
-    fn grey_world(&mut self, radiance: &[[f32; 3]]) -> [f32; 3] {
-        let mut sum = [0.0f32; 3];
+    /// Grey-world white balance over the near-neutral, unclipped, not-dark pixels of a
+    /// subsample ([`NEUTRAL_GATE`]), followed with the time constant
+    /// `params.white_balance_tau_s`. The first frame takes its estimate at once; a frame
+    /// too dark to say anything keeps the last balance.
+    fn grey_world(&mut self, radiance: &[[f32; 3]], params: &SensorParams) -> [f32; 3] {
+        let last = self.balance.unwrap_or([1.0; 3]);
+        // Linear radiance at which a balanced channel clips at the current exposure, and
+        // below which a pixel is in the noise (a thousandth of that).
+        let k = (self.exposure * params.gain).max(1e-6);
+        let (clip, dark) = (1.0 / k, 1e-3 / k);
+        let (lo, hi) = (1.0 / NEUTRAL_GATE, NEUTRAL_GATE);
+        let mut all = [0.0f32; 3];
+        let mut neutral = [0.0f32; 3];
+        let (mut n_all, mut n_neutral) = (0u32, 0u32);
         for px in radiance.iter().step_by(7) {
+            let p = px.map(|v| v.max(0.0));
             for c in 0..3 {
-                sum[c] += px[c].max(0.0);
+                all[c] += p[c];
+            }
+            n_all += 1;
+            let q = [0, 1, 2].map(|c| p[c] * last[c]);
+            let (r, g, b) = (q[0], q[1], q[2]);
+            if g > dark && r.max(g).max(b) < clip && (lo * g..=hi * g).contains(&r) && (lo * g..=hi * g).contains(&b) {
+                for c in 0..3 {
+                    neutral[c] += p[c];
+                }
+                n_neutral += 1;
             }
         }
-        let last = self.balance.unwrap_or([1.0; 3]);
+        let sum = if n_neutral as f32 >= MIN_NEUTRAL_FRACTION * n_all as f32 {
+            neutral
+        } else {
+            all
+        };
         if sum.iter().any(|&s| !(s > 1e-6)) {
             return *self.balance.get_or_insert(last);
         }
         let want = [sum[1] / sum[0], 1.0, sum[1] / sum[2]].map(|m| m.clamp(0.25, 4.0));
         let now = match self.balance {
             None => want,
-            Some(b) => [0, 1, 2].map(|c| b[c] * (want[c] / b[c]).sqrt()),
+            Some(b) => {
+                let tau = params.white_balance_tau_s.max(0.0);
+                let step = if tau > 0.0 {
+                    1.0 - (-params.frame_interval_s.max(0.0) / tau).exp()
+                } else {
+                    1.0
+                };
+                [0, 1, 2].map(|c| b[c] * (want[c] / b[c]).powf(step))
+            }
         };
         self.balance = Some(now);
         now
@@ -464,33 +520,80 @@ mod tests {
         assert!(sd_dim > 1.8 * sd_bright, "dim {sd_dim:.2} vs bright {sd_bright:.2}");
     }
 
+    /// Exposes `frames` frames of `scene(frame, pixel)` (70 × 10) through grey-world
+    /// with `params`, returning the last output.
+    fn grey_world_frames(params: &SensorParams, frames: u64, scene: &dyn Fn(u64, usize) -> [f32; 3]) -> RgbImage {
+        let params = SensorParams {
+            white_balance: WhiteBalance::GreyWorld,
+            ..*params
+        };
+        let mut sensor = Sensor::new(1);
+        let mut out = RgbImage::default();
+        for frame in 0..frames {
+            let mut r: Vec<[f32; 3]> = (0..70 * 10).map(|i| scene(frame, i)).collect();
+            sensor.expose(&mut r, 70, &params, frame, &mut out);
+        }
+        out
+    }
+
     #[test]
     fn grey_world_balances_a_grey_scene_and_is_fooled_by_a_coloured_one() {
         let params = SensorParams::noiseless();
-        let params = SensorParams {
-            white_balance: WhiteBalance::GreyWorld,
-            ..params
-        };
         let dusk = [1.0f32, 0.72, 0.48];
-        let (w, h) = (70, 10);
-        let expose = |scene: &dyn Fn(usize) -> [f32; 3]| {
-            let mut sensor = Sensor::new(1);
-            let mut out = RgbImage::default();
-            for frame in 0..20 {
-                let mut r: Vec<[f32; 3]> = (0..w * h).map(scene).collect();
-                sensor.expose(&mut r, w, &params, frame, &mut out);
-            }
-            out
-        };
-        // A grey card filling the view under dusk light comes out grey.
-        let grey = expose(&|_| dusk.map(|c| c * 0.3));
-        let px = grey.view().get(5, 5).unwrap();
-        assert!(px.iter().all(|&c| (c as i32 - px[1] as i32).abs() <= 1), "{px:?}");
-        // Under daylight, a view nine-tenths cyan pulls the balance toward red: the grey
-        // card beside it turns reddish.
-        let cyan_view = expose(&|i| if i % w < 63 { [0.05, 0.4, 0.45] } else { [0.3; 3] });
-        let card = cyan_view.view().get(66, 5).unwrap();
+        let tungsten = [1.0f32, 0.68, 0.38];
+        // A grey card filling the view under dusk or tungsten light comes out grey.
+        for light in [dusk, tungsten] {
+            let grey = grey_world_frames(&params, 60, &|_, _| light.map(|c| c * 0.3));
+            let px = grey.view().get(5, 5).unwrap();
+            assert!(px.iter().all(|&c| (c as i32 - px[1] as i32).abs() <= 1), "{px:?}");
+        }
+        // Under daylight, a view nine-tenths a greenish-blue surface (near enough to grey
+        // to pass the gate, as a lawn or a painted wall does) pulls the balance toward
+        // red: the grey card beside it turns reddish.
+        let wall = grey_world_frames(&params, 60, &|_, i| {
+            if i % 70 < 63 { [0.2, 0.3, 0.35] } else { [0.3; 3] }
+        });
+        let card = wall.view().get(66, 5).unwrap();
         assert!(card[0] as i32 > card[2] as i32 + 20, "{card:?}");
+    }
+
+    #[test]
+    fn saturated_colour_does_not_move_the_balance() {
+        // A fifth of the view a saturated orange (a beacon, a painted block) beside grey:
+        // the gate leaves it out, and the grey stays grey. Plain grey-world over every
+        // pixel would have turned the grey card blue.
+        let params = SensorParams::noiseless();
+        let out = grey_world_frames(&params, 60, &|_, i| {
+            if i % 70 < 14 { [0.9, 0.25, 0.02] } else { [0.3; 3] }
+        });
+        let px = out.view().get(40, 5).unwrap();
+        assert!(px.iter().all(|&c| (c as i32 - px[1] as i32).abs() <= 1), "{px:?}");
+    }
+
+    #[test]
+    fn the_balance_settles_with_its_time_constant() {
+        // The light turns from daylight to dusk after the first frame. With τ = 1 s at
+        // 10 frames a second the balance has moved 1 − e^(−1) ≈ 63 % (in log terms) of
+        // the way after 1 s, and all of it after 6 s; with τ = 0 at once.
+        let params = SensorParams::noiseless();
+        let dusk = [1.0f32, 0.72, 0.48];
+        let scene = |frame: u64, _| if frame == 0 { [0.3; 3] } else { dusk.map(|c| c * 0.3) };
+        let blue_over_green = |frames: u64, tau: f32| {
+            let p = SensorParams {
+                white_balance_tau_s: tau,
+                frame_interval_s: 0.1,
+                ..params
+            };
+            let out = grey_world_frames(&p, frames, &scene);
+            let px = out.view().get(5, 5).unwrap();
+            srgb_to_linear(px[2] as f32 / 255.0) / srgb_to_linear(px[1] as f32 / 255.0)
+        };
+        // Uncorrected, blue/green is 0.48/0.72 = 0.667; corrected, 1.
+        let moved = |ratio: f32| ratio.ln() / (0.48f32 / 0.72).ln();
+        let after_1s = 1.0 - moved(blue_over_green(11, 1.0));
+        assert!((after_1s - 0.632).abs() < 0.05, "moved {after_1s:.3} of the way in 1 s");
+        assert!((blue_over_green(61, 1.0) - 1.0).abs() < 0.02);
+        assert!((blue_over_green(2, 0.0) - 1.0).abs() < 0.02);
     }
 
     fn srgb_level(lin: f32) -> f64 {
