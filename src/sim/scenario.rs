@@ -121,6 +121,12 @@ pub enum WhiteBalanceSpec {
     /// `white_balance_tau_s` (the default; fooled by coloured light and by views one
     /// colour fills, as a real camera's is).
     GreyWorld,
+    /// A camera's indoor/outdoor white-balance switch, set for the run's setting as seed
+    /// 004's operators set Bujold's camera ("moving the white balance switch on the camera"
+    /// between lab and outdoor light, §VI-B): balanced for the room's illuminant under a
+    /// lighting without sun, for daylight under one with sun. Nothing corrects dusk's or
+    /// dawn's colour, or a flasher's.
+    Switch,
     /// Balanced for each run's true illuminant: a perfect balance no real camera has.
     Perfect,
     /// Balanced once for daylight, whatever the light.
@@ -538,6 +544,8 @@ impl Scenario {
         let fixed = |i: I| WhiteBalance::Fixed(i.rgb().map(|c| 1.0 / c));
         let white_balance = match self.sensor.white_balance {
             WhiteBalanceSpec::GreyWorld => WhiteBalance::GreyWorld,
+            WhiteBalanceSpec::Switch if lighting.sun > 0.0 => fixed(I::Daylight),
+            WhiteBalanceSpec::Switch => fixed(lighting.illuminant),
             WhiteBalanceSpec::Perfect => fixed(lighting.illuminant),
             WhiteBalanceSpec::Daylight => fixed(I::Daylight),
             WhiteBalanceSpec::Dusk => fixed(I::Dusk),
