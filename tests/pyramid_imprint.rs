@@ -12,7 +12,7 @@ use marsupial::profile::{Profile, SegmentationMode};
 use marsupial::schemas::PyramidSchema;
 use marsupial::sim::camera::camera_pose;
 use marsupial::sim::lighting::{Illuminant, LightingPreset, LightingRun, LightingSpec};
-use marsupial::sim::render::{Renderer, SensorParams};
+use marsupial::sim::render::{Renderer, SensorParams, WhiteBalance};
 use marsupial::sim::rng::Rng;
 use marsupial::sim::world;
 use std::path::Path;

@@ -385,7 +385,7 @@ impl Sensor {
         } else {
             all
         };
-        if sum.iter().any(|&s| !(s > 1e-6)) {
+        if !sum.iter().all(|&s| s > 1e-6) {
             return *self.balance.get_or_insert(last);
         }
         let want = [sum[1] / sum[0], 1.0, sum[1] / sum[2]].map(|m| m.clamp(0.25, 4.0));
