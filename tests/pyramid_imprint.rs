@@ -12,7 +12,7 @@ use marsupial::profile::{Profile, SegmentationMode};
 use marsupial::schemas::PyramidSchema;
 use marsupial::sim::camera::camera_pose;
 use marsupial::sim::lighting::{Illuminant, LightingPreset, LightingRun, LightingSpec};
-use marsupial::sim::render::{Renderer, SensorParams};
+use marsupial::sim::render::{Renderer, SensorParams, WhiteBalance};
 use marsupial::sim::rng::Rng;
 use marsupial::sim::world;
 use std::path::Path;
@@ -41,7 +41,7 @@ fn render(p: &Profile, pose: &Pose2, preset: LightingPreset, seed: u64) -> RgbIm
     let light = LightingRun::new(lighting, &mut Rng::new(seed), 10.0);
     // White balance fixed for daylight: dusk's warm light reaches the colours.
     let sensor = SensorParams {
-        white_balance: Illuminant::Daylight.rgb(),
+        white_balance: WhiteBalance::Fixed(Illuminant::Daylight.rgb().map(|c| 1.0 / c)),
         ..SensorParams::default()
     };
     let mut out = RgbImage::default();

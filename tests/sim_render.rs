@@ -264,11 +264,9 @@ fn clipped_after_settling(highlight_clip: f32) -> f64 {
     let mut r = Renderer::new(CameraModel::from_spec(cam), cam.width_px, cam.height_px, 1);
     let mut out = RgbImage::default();
     let sensor = SensorParams {
-        read_noise: 0.0,
-        shot_noise: 0.0,
         auto_exposure: true,
         highlight_clip,
-        ..SensorParams::default()
+        ..SensorParams::noiseless()
     };
     let pose = camera_pose(&Pose2::new(0.6, 0.0, 0.0), &cam.mount);
     for k in 0..20 {

@@ -81,7 +81,7 @@ fn a_raposa_campaign_with_imprint_and_adaptive_bands_is_the_same_on_1_or_2_jobs(
         "seed = 2014\ntrials = 2\ntimeout_s = 60.0\n\
          [starts]\ngrid = \"paper16\"\nselect = [5, 9]\nposition_jitter_m = 0.02\nheading_jitter_deg = 3.0\n\
          [axes]\nlighting = [\"clouds\"]\nsegmentation = [\"adaptive\"]\n\
-         [sensor]\nwhite_balance_for = \"daylight\"\n\
+         [sensor]\nwhite_balance = \"daylight\"\n\
          [imprint]\nenabled = true\n",
     );
     assert_four_real_runs(&records);

@@ -343,9 +343,18 @@ fn run_with<B: Behavior + ?Sized>(
         let (odo_tx, odo_rx) = bounded::<Stamped<OdometryReading>>(1);
         let (teth_tx, teth_rx) = bounded::<Stamped<TetherReading>>(1);
         let (dock_tx, dock_rx) = bounded::<Stamped<bool>>(1);
-        let (values_tx, values_rx) = bounded::<(usize, f64, Vec<f64>)>(4 * n_sensors.max(1));
-        let (values_back_tx, values_back_rx) = bounded::<Vec<f64>>(4 * n_sensors.max(1));
+        let pool = 4 * n_sensors.max(1);
+        let (values_tx, values_rx) = bounded::<(usize, f64, Vec<f64>)>(pool);
+        let (values_back_tx, values_back_rx) = bounded::<Vec<f64>>(pool);
+        // The buffer pool is filled up front and used in turn (the channel is FIFO), so
+        // every buffer has grown to its sensor's size within the first readings; a reading
+        // the loop has no room for gives its buffer back to the pool instead of dropping
+        // it. Steady state then allocates nothing, even after the loop falls behind.
+        for _ in 0..pool {
+            let _ = values_back_tx.try_send(Vec::new());
+        }
         {
+            let values_back_tx = values_back_tx.clone();
             let mut sensing = sensing;
             let done = done.clone();
             let events = event_tx.clone();
@@ -381,9 +390,14 @@ fn run_with<B: Behavior + ?Sized>(
                         buf.clear();
                         match sensor.read(&mut buf) {
                             Ok(()) => {
-                                let _ = values_tx.try_send((i, t, buf));
+                                if let Err(full) = values_tx.try_send((i, t, buf)) {
+                                    let _ = values_back_tx.try_send(full.into_inner().2);
+                                }
                             }
-                            Err(e) => fault(t, "sensor", e),
+                            Err(e) => {
+                                let _ = values_back_tx.try_send(buf);
+                                fault(t, "sensor", e);
+                            }
                         }
                     }
                     next += sensor_period;

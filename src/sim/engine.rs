@@ -96,16 +96,19 @@ pub struct Sim {
 }
 
 impl Sim {
-    /// A simulation of `profile` in `world`.
+    /// A simulation of `profile` in `world`. The sensor's frame interval is set to the
+    /// loop tick, since every camera renders once a tick.
     pub fn new(
         profile: Arc<Profile>,
         world: Arc<World>,
         light: LightingRun,
-        sensor: SensorParams,
+        mut sensor: SensorParams,
         motion: Motion,
         dt: f64,
         seed: u64,
     ) -> Self {
+        // Every camera renders once a loop tick: that is the sensor's frame interval.
+        sensor.frame_interval_s = (1.0 / profile.loop_.rate_hz) as f32;
         let renderers = profile
             .cameras
             .iter()
@@ -184,10 +187,14 @@ impl Sim {
         &mut self.light
     }
 
-    /// Replaces the lighting programme (e.g. after imprinting under another light).
+    /// Replaces the lighting programme (e.g. after imprinting under another light). The
+    /// sensor's frame interval stays the loop tick.
     pub fn set_lighting(&mut self, light: LightingRun, sensor: SensorParams) {
         self.light = light;
-        self.sensor = sensor;
+        self.sensor = SensorParams {
+            frame_interval_s: self.sensor.frame_interval_s,
+            ..sensor
+        };
     }
 
     /// Puts the robot at `pose` (a proctor placing it): stops the motors, restarts

@@ -8,7 +8,7 @@
 
 use super::lighting::{Lighting, LightingPreset, LightingSpec};
 use super::motion::{SlipSpec, Terrain};
-use super::render::SensorParams;
+use super::render::{SensorParams, WhiteBalance};
 use super::world::ClutterSpec;
 use crate::config::{self, ConfigError, Validate, Validator};
 use crate::geometry::Pose2;
@@ -113,18 +113,51 @@ fn default_terrain() -> Vec<Terrain> {
     vec![Terrain::LabFloor]
 }
 
-/// `[sensor]`.
+/// `[sensor].white_balance`: how the simulated camera balances white.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WhiteBalanceSpec {
+    /// The camera's own grey-world estimate over near-neutral pixels, settling with
+    /// `white_balance_tau_s` (the default; fooled by coloured light and by views one
+    /// colour fills, as a real camera's is).
+    GreyWorld,
+    /// A camera's indoor/outdoor white-balance switch, set for the run's setting as seed
+    /// 004's operators set Bujold's camera ("moving the white balance switch on the camera"
+    /// between lab and outdoor light, §VI-B): balanced for the room's illuminant under a
+    /// lighting without sun, for daylight under one with sun. Nothing corrects dusk's or
+    /// dawn's colour, or a flasher's.
+    Switch,
+    /// Balanced for each run's true illuminant: a perfect balance no real camera has.
+    Perfect,
+    /// Balanced once for daylight, whatever the light.
+    Daylight,
+    /// Balanced once for dusk.
+    Dusk,
+    /// Balanced once for tungsten.
+    Tungsten,
+    /// Balanced once for fluorescent light.
+    Fluorescent,
+    /// Balanced once for dawn.
+    Dawn,
+}
+
+/// `[sensor]`: the simulated camera's sensor (see [`super::render::SensorParams`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorSpec {
-    /// Read noise SD, 8-bit units.
-    pub read_noise: f64,
-    /// Shot noise scale.
-    pub shot_noise: f64,
+    /// Full well at unity gain, electrons.
+    pub full_well_e: f64,
+    /// Read noise SD, electrons.
+    pub read_noise_e: f64,
+    /// Longest integration, as an exposure multiplier; beyond it the gain rises.
+    pub max_integration: f64,
     /// Auto-exposure on.
     pub auto_exposure: bool,
-    /// White balance for this illuminant (`None`: balanced for each run's illuminant).
-    pub white_balance_for: Option<super::lighting::Illuminant>,
+    /// White balance.
+    pub white_balance: WhiteBalanceSpec,
+    /// Time constant of the grey-world balance, s (0 follows each frame's estimate at
+    /// once).
+    pub white_balance_tau_s: f64,
     /// Auto-exposure's highlight protection: the largest fraction of pixels it lets clip
     /// (0–1; 1 meters the mean alone and lets a sunlit target burn out).
     pub highlight_clip_frac: f64,
@@ -132,11 +165,14 @@ pub struct SensorSpec {
 
 impl Default for SensorSpec {
     fn default() -> Self {
+        let d = SensorParams::default();
         Self {
-            read_noise: 1.5,
-            shot_noise: 0.35,
+            full_well_e: f64::from(d.full_well_e),
+            read_noise_e: f64::from(d.read_noise_e),
+            max_integration: f64::from(d.max_integration),
             auto_exposure: true,
-            white_balance_for: None,
+            white_balance: WhiteBalanceSpec::GreyWorld,
+            white_balance_tau_s: f64::from(d.white_balance_tau_s),
             highlight_clip_frac: 0.01,
         }
     }
@@ -360,8 +396,10 @@ impl Validate for Scenario {
         for (name, l) in &self.lighting {
             l.validate_at(&format!("lighting.{name}"), v);
         }
-        v.non_negative("sensor.read_noise", self.sensor.read_noise);
-        v.non_negative("sensor.shot_noise", self.sensor.shot_noise);
+        v.positive("sensor.full_well_e", self.sensor.full_well_e);
+        v.non_negative("sensor.read_noise_e", self.sensor.read_noise_e);
+        v.positive("sensor.max_integration", self.sensor.max_integration);
+        v.non_negative("sensor.white_balance_tau_s", self.sensor.white_balance_tau_s);
         v.range("sensor.highlight_clip_frac", self.sensor.highlight_clip_frac, 0.0, 1.0);
         v.non_negative("motion.latency_s", self.motion.latency_s);
         v.positive("motion.accel_mps2", self.motion.accel_mps2);
@@ -502,12 +540,26 @@ impl Scenario {
 
     /// Sensor parameters for a run under `lighting`.
     pub fn sensor_params(&self, lighting: &Lighting) -> SensorParams {
-        let illum = self.sensor.white_balance_for.unwrap_or(lighting.illuminant).rgb();
+        use super::lighting::Illuminant as I;
+        let fixed = |i: I| WhiteBalance::Fixed(i.rgb().map(|c| 1.0 / c));
+        let white_balance = match self.sensor.white_balance {
+            WhiteBalanceSpec::GreyWorld => WhiteBalance::GreyWorld,
+            WhiteBalanceSpec::Switch if lighting.sun > 0.0 => fixed(I::Daylight),
+            WhiteBalanceSpec::Switch => fixed(lighting.illuminant),
+            WhiteBalanceSpec::Perfect => fixed(lighting.illuminant),
+            WhiteBalanceSpec::Daylight => fixed(I::Daylight),
+            WhiteBalanceSpec::Dusk => fixed(I::Dusk),
+            WhiteBalanceSpec::Tungsten => fixed(I::Tungsten),
+            WhiteBalanceSpec::Fluorescent => fixed(I::Fluorescent),
+            WhiteBalanceSpec::Dawn => fixed(I::Dawn),
+        };
         SensorParams {
-            read_noise: self.sensor.read_noise as f32,
-            shot_noise: self.sensor.shot_noise as f32,
+            full_well_e: self.sensor.full_well_e as f32,
+            read_noise_e: self.sensor.read_noise_e as f32,
+            max_integration: self.sensor.max_integration as f32,
             auto_exposure: self.sensor.auto_exposure,
-            white_balance: illum.map(|c| 1.0 / c),
+            white_balance,
+            white_balance_tau_s: self.sensor.white_balance_tau_s as f32,
             highlight_clip: self.sensor.highlight_clip_frac as f32,
             ..SensorParams::default()
         }

@@ -17,13 +17,7 @@ pub fn shipped_profile(name: &str) -> Profile {
 /// values a test reads.
 #[cfg(feature = "sim")]
 pub fn quiet_sensor() -> SensorParams {
-    SensorParams {
-        read_noise: 0.0,
-        shot_noise: 0.0,
-        auto_exposure: false,
-        exposure: 1.0,
-        ..SensorParams::default()
-    }
+    SensorParams::noiseless()
 }
 
 pub const CYAN: [u8; 3] = [20, 190, 210];

@@ -20,7 +20,7 @@ mod rays;
 mod sensor;
 mod texture;
 
-pub use sensor::SensorParams;
+pub use sensor::{SensorParams, WhiteBalance};
 
 use super::lighting::LightState;
 use super::scene::{Prim, Scene, Shape};

@@ -1,48 +1,126 @@
 //! The camera sensor: white balance, exposure, shot and read noise, clipping and sRGB
 //! gamma, from linear scene radiance to 8-bit RGB.
 //!
-//! Auto-exposure moves only halfway toward the level this frame needs, in log terms, so a
-//! sudden light change over- or under-exposes the next few frames. Noise comes from a
-//! per-row offset into a seeded table of normal deviates, scaled per output level.
+//! The noise is physical, in electrons. A pixel at output level L (linear, 1 = full scale)
+//! collected e = L·FW/g electrons, where FW is the full well at unity gain and g the
+//! analogue gain; its noise is the shot noise √e and the read noise r added in quadrature,
+//! √(e + r²) electrons, which the gain carries to the output as √(e + r²)·g/FW. Exposure is
+//! integration time first: auto-exposure lengthens it up to `max_integration` (relative to
+//! the exposure that puts a unit radiance at full scale) and then raises the gain, so a dim
+//! scene brightened to the same output is noisier than a bright one, as on a real camera.
+//!
+//! White balance is the camera's own estimate by default: grey-world over the near-neutral
+//! pixels, as a camera's auto white balance gathers its statistics. Each channel's mean
+//! over the pixels that are neither dark, clipped, nor strongly coloured (more than a
+//! factor of two from grey in red/green or blue/green under the balance in force) is made
+//! equal to green's. A coloured illuminant, or a view filled by one colour, still fools it,
+//! as it fools a real camera; a small saturated object (a beacon, a fiducial) does not. A
+//! scenario can instead balance for a named illuminant (`Fixed`), including each run's
+//! true one (the perfect balance of earlier versions).
+//!
+//! Auto-exposure moves halfway toward what this frame needs each frame, in log terms, so a
+//! sudden light change over- or under-exposes the next few frames. The white balance
+//! follows its estimate with a time constant in seconds (a camera's AWB settles over a
+//! second or two, far slower than its exposure), so a flashing beacon does not swing it
+//! frame by frame. Noise comes from a per-row offset into a seeded table of normal
+//! deviates, scaled per output level.
 
 use crate::perception::RgbImage;
 use crate::sim::rng::{NoiseTable, splitmix64};
 use crate::sim::scene::srgb_to_linear;
 
+/// How the camera balances white.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum WhiteBalance {
+    /// Per-channel multipliers fixed in advance (`[1, 1, 1]` is none).
+    Fixed([f32; 3]),
+    /// Estimated by grey-world over the near-neutral pixels, followed with a time
+    /// constant (module docs).
+    GreyWorld,
+}
+
 /// Sensor settings (from the scenario).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SensorParams {
-    /// Read noise SD, in 8-bit linear units.
-    pub read_noise: f32,
-    /// Shot-noise scale: SD = shot·√(signal) in 8-bit linear units.
-    pub shot_noise: f32,
+    /// Full well at unity gain: electrons that bring a pixel to full scale.
+    pub full_well_e: f32,
+    /// Read noise SD, electrons.
+    pub read_noise_e: f32,
     /// Fixed exposure multiplier when auto-exposure is off.
     pub exposure: f32,
     /// Follow the scene brightness.
     pub auto_exposure: bool,
     /// Mean linear level auto-exposure aims for (0–1).
     pub target_level: f32,
-    /// Analogue gain.
+    /// Base analogue gain.
     pub gain: f32,
-    /// Per-channel white-balance multipliers (1, 1, 1 is neutral).
-    pub white_balance: [f32; 3],
+    /// The longest integration, as an exposure multiplier: beyond it auto-exposure (or a
+    /// fixed exposure) raises the analogue gain instead, and the noise with it.
+    pub max_integration: f32,
+    /// White balance.
+    pub white_balance: WhiteBalance,
     /// Highlight protection of auto-exposure: the largest fraction of pixels allowed to
     /// clip in any channel (1 = plain mean metering, which burns out a bright target in
     /// front of a dark body).
     pub highlight_clip: f32,
+    /// Time constant of the auto white balance, s: it moves 1 − e^(−Δt/τ) of the way (in
+    /// log terms) toward each frame's estimate.
+    pub white_balance_tau_s: f32,
+    /// Time between frames, s (the simulator renders every camera every loop tick, so it
+    /// sets this from the profile's loop rate).
+    pub frame_interval_s: f32,
 }
 
 impl Default for SensorParams {
+    /// A small, cheap colour sensor: 2,100 e⁻ full well and 12 e⁻ read noise, which at
+    /// unity gain give 1.5 linear 8-bit units of read noise and 0.35·√signal of shot noise
+    /// (the model's earlier defaults, now added in quadrature), grey-world white balance
+    /// settling with a 1 s time constant, 10 frames a second.
     fn default() -> Self {
         Self {
-            read_noise: 1.5,
-            shot_noise: 0.35,
+            full_well_e: 2100.0,
+            read_noise_e: 12.0,
             exposure: 1.0,
             auto_exposure: true,
             target_level: 0.18,
             gain: 1.0,
-            white_balance: [1.0; 3],
+            max_integration: 4.0,
+            white_balance: WhiteBalance::GreyWorld,
             highlight_clip: 0.01,
+            white_balance_tau_s: 1.0,
+            frame_interval_s: 0.1,
+        }
+    }
+}
+
+impl SensorParams {
+    /// The analogue gain an exposure multiplier `k` needs: 1 × the base gain while the
+    /// integration time can supply it, more beyond.
+    pub fn analogue_gain(&self, k: f32) -> f32 {
+        self.gain.max(1e-6) * (k / self.max_integration.max(1e-6)).max(1.0)
+    }
+
+    /// Noise SD in linear 8-bit units (0–255) of a pixel at output linear level `lin`
+    /// (0–1) under analogue gain `g`: √(e + r²)·g/FW with e = lin·FW/g (module docs).
+    /// An infinite full well means no shot noise (and, with no read noise, a noiseless
+    /// sensor, [`SensorParams::noiseless`]).
+    pub fn noise_sd_lin255(&self, lin: f32, g: f32) -> f32 {
+        let fw = self.full_well_e.max(1e-6);
+        // In output units: shot variance e·(g/FW)² = lin·g/FW, read variance (r·g/FW)².
+        let read = self.read_noise_e * g / fw;
+        (lin.max(0.0) * g / fw + read * read).sqrt() * 255.0
+    }
+
+    /// A sensor without noise, auto-exposure or white balance (exposure 1): renders whose
+    /// pixel values a test reads.
+    pub fn noiseless() -> Self {
+        Self {
+            full_well_e: f32::INFINITY,
+            read_noise_e: 0.0,
+            auto_exposure: false,
+            exposure: 1.0,
+            white_balance: WhiteBalance::Fixed([1.0; 3]),
+            ..Self::default()
         }
     }
 }
@@ -101,6 +179,9 @@ pub(super) struct Sensor {
     /// Per value of a row: its table index, then its table entry.
     row_code: Vec<i32>,
     exposure: f32,
+    /// Grey-world white balance in force (multipliers, green = 1); `None` before the first
+    /// frame.
+    balance: Option<[f32; 3]>,
     /// Histogram of sampled pixels' brightest channel, by [`octave_bin`].
     highlights: [u32; HIGHLIGHT_BINS],
 }
@@ -137,6 +218,7 @@ impl Sensor {
             row_gain: Vec::new(),
             row_code: Vec::new(),
             exposure: 1.0,
+            balance: None,
             highlights: [0; HIGHLIGHT_BINS],
         }
     }
@@ -163,21 +245,24 @@ impl Sensor {
     ) {
         let height = radiance.len() / width.max(1);
         out.resize(width, height);
+        let balance = match params.white_balance {
+            WhiteBalance::Fixed(m) => m,
+            WhiteBalance::GreyWorld => self.grey_world(radiance, params),
+        };
         if params.auto_exposure {
-            self.meter(radiance, params);
+            self.meter(radiance, params, balance);
         } else {
             self.exposure = params.exposure;
         }
         let k = self.exposure * params.gain;
-        let wb = [0, 1, 2].map(|c| params.white_balance[c] * k * LUT_MAX);
-        // Noise SD per output level: read noise (amplified when the scene is dark and the
-        // camera's gain is up) plus shot noise ∝ √signal, both taken through the slope of
-        // the sRGB curve at that level.
-        let read = params.read_noise * k.max(1.0).sqrt();
-        // This frame's noise SD per output byte, in output levels × [`SD_ONE`].
+        let g = params.analogue_gain(self.exposure);
+        let wb = [0, 1, 2].map(|c| balance[c] * k * LUT_MAX);
+        // This frame's noise SD per output byte, in output levels × [`SD_ONE`]: the
+        // electrons' noise at that level under this frame's gain, through the slope of the
+        // sRGB curve there.
         let mut sd_out = [0i32; 256];
         for ((sd, lin), slope) in sd_out.iter_mut().zip(&self.level_lin).zip(&self.level_slope) {
-            let sd_lin = read + params.shot_noise * (lin * 255.0).sqrt();
+            let sd_lin = params.noise_sd_lin255(*lin, g);
             // An SD past the whole output range means nothing more; the cap also bounds
             // the fixed-point products below whatever noise a scenario asks for.
             *sd = (sd_lin * slope.min(8.0) * SD_ONE as f32)
@@ -227,11 +312,10 @@ impl Sensor {
     /// brightest white-balanced channel. The exposure aims the mean at the target unless
     /// that would clip more than `highlight_clip` of the pixels, then it protects the
     /// highlights. It adapts partly toward the aim each frame (camera lag).
-    fn meter(&mut self, radiance: &[[f32; 3]], params: &SensorParams) {
+    fn meter(&mut self, radiance: &[[f32; 3]], params: &SensorParams, wbn: [f32; 3]) {
         let mut sum = 0.0f32;
         let mut n = 0u32;
         self.highlights.fill(0);
-        let wbn = params.white_balance;
         for px in radiance.iter().step_by(7) {
             sum += px[1];
             n += 1;
@@ -253,6 +337,72 @@ impl Sensor {
         }
         self.exposure *= (want / self.exposure).powf(0.5);
         self.exposure = self.exposure.clamp(1e-3, 1e3);
+    }
+}
+
+/// Grey-world gate: a sample counts toward the balance when, under the balance in force,
+/// its red/green and blue/green both lie within this factor of grey. Wide enough for any
+/// illuminant the scenarios use seen through a neutral balance (tungsten's blue/green is
+/// 0.56), narrow enough to leave out saturated paint and beacons.
+const NEUTRAL_GATE: f32 = 2.0;
+
+/// Fewer gated samples than this fraction of the subsample, and grey-world uses them all
+/// (a view with almost nothing near grey, where the gate has nothing to go on).
+const MIN_NEUTRAL_FRACTION: f32 = 0.02;
+
+impl Sensor {
+    /// Grey-world white balance over the near-neutral, unclipped, not-dark pixels of a
+    /// subsample ([`NEUTRAL_GATE`]), followed with the time constant
+    /// `params.white_balance_tau_s`. The first frame takes its estimate at once; a frame
+    /// too dark to say anything keeps the last balance.
+    fn grey_world(&mut self, radiance: &[[f32; 3]], params: &SensorParams) -> [f32; 3] {
+        let last = self.balance.unwrap_or([1.0; 3]);
+        // Linear radiance at which a balanced channel clips at the current exposure, and
+        // below which a pixel is in the noise (a thousandth of that).
+        let k = (self.exposure * params.gain).max(1e-6);
+        let (clip, dark) = (1.0 / k, 1e-3 / k);
+        let (lo, hi) = (1.0 / NEUTRAL_GATE, NEUTRAL_GATE);
+        let mut all = [0.0f32; 3];
+        let mut neutral = [0.0f32; 3];
+        let (mut n_all, mut n_neutral) = (0u32, 0u32);
+        for px in radiance.iter().step_by(7) {
+            let p = px.map(|v| v.max(0.0));
+            for c in 0..3 {
+                all[c] += p[c];
+            }
+            n_all += 1;
+            let q = [0, 1, 2].map(|c| p[c] * last[c]);
+            let (r, g, b) = (q[0], q[1], q[2]);
+            if g > dark && r.max(g).max(b) < clip && (lo * g..=hi * g).contains(&r) && (lo * g..=hi * g).contains(&b) {
+                for c in 0..3 {
+                    neutral[c] += p[c];
+                }
+                n_neutral += 1;
+            }
+        }
+        let sum = if n_neutral as f32 >= MIN_NEUTRAL_FRACTION * n_all as f32 {
+            neutral
+        } else {
+            all
+        };
+        if !sum.iter().all(|&s| s > 1e-6) {
+            return *self.balance.get_or_insert(last);
+        }
+        let want = [sum[1] / sum[0], 1.0, sum[1] / sum[2]].map(|m| m.clamp(0.25, 4.0));
+        let now = match self.balance {
+            None => want,
+            Some(b) => {
+                let tau = params.white_balance_tau_s.max(0.0);
+                let step = if tau > 0.0 {
+                    1.0 - (-params.frame_interval_s.max(0.0) / tau).exp()
+                } else {
+                    1.0
+                };
+                [0, 1, 2].map(|c| b[c] * (want[c] / b[c]).powf(step))
+            }
+        };
+        self.balance = Some(now);
+        now
     }
 }
 
@@ -279,9 +429,9 @@ mod tests {
         (mean, var.sqrt())
     }
 
-    /// The noise model, written out directly: SD in linear 8-bit units (read + shot·√signal)
-    /// times the sRGB curve's slope in output levels per linear unit.
-    fn expected_sd(lin: f64, read: f64, shot: f64) -> f64 {
+    /// Output levels (0–255) per linear 8-bit unit at linear level `lin`: the slope of
+    /// the sRGB encoding (IEC 61966-2-1), to carry an output SD back to linear units.
+    fn srgb_slope(lin: f64) -> f64 {
         let to_srgb = |l: f64| {
             if l <= 0.003_130_8 {
                 12.92 * l
@@ -289,44 +439,161 @@ mod tests {
                 1.055 * l.powf(1.0 / 2.4) - 0.055
             }
         };
-        let dl = 1e-4;
-        let slope = (to_srgb(lin + dl) - to_srgb(lin)) / dl; // output (0–1) per linear (0–1)
-        (read + shot * (lin * 255.0).sqrt()) * slope
+        let dl = 1e-5;
+        (to_srgb(lin + dl) - to_srgb(lin - dl)) / (2.0 * dl)
     }
 
     #[test]
-    fn sensor_noise_has_the_specified_sd_at_every_level() {
+    fn the_photon_transfer_curve_gives_back_the_full_well_and_read_noise() {
+        // A photon-transfer measurement, as one characterises a real sensor: flat fields
+        // at several levels, the variance against the mean in linear units. Shot noise is
+        // Poisson in electrons, so var = (255·g/FW)·mean + (255·g·r/FW)²: the slope gives
+        // the full well, the intercept the read noise. Read and shot noise adding as SDs
+        // (not variances) would bend the line and miss both.
         let params = SensorParams {
             auto_exposure: false,
+            white_balance: WhiteBalance::Fixed([1.0; 3]),
             ..SensorParams::default()
         };
-        for lin in [0.05f32, 0.18, 0.4, 0.7] {
-            let (mean, sd) = flat_field_stats(lin, &params);
-            let want = expected_sd(lin as f64, 1.5, 0.35);
-            let level = srgb_level(lin);
-            assert!(
-                (mean - level).abs() < 0.6,
-                "lin {lin}: mean {mean:.2} vs level {level:.2}"
-            );
-            assert!(
-                (sd - want).abs() < 0.1 * want,
-                "lin {lin}: SD {sd:.2} levels, model {want:.2}"
-            );
-        }
-        // No noise asked, none given.
-        let quiet = SensorParams {
-            read_noise: 0.0,
-            shot_noise: 0.0,
-            ..params
-        };
-        assert_eq!(flat_field_stats(0.18, &quiet).1, 0.0);
-        // Absurd noise saturates the output instead of overflowing.
+        let points: Vec<(f64, f64)> = [0.05f32, 0.1, 0.18, 0.3, 0.45, 0.6]
+            .iter()
+            .map(|&lin| {
+                let (mean, sd) = flat_field_stats(lin, &params);
+                let level = srgb_level(lin);
+                assert!((mean - level).abs() < 0.6, "lin {lin}: mean {mean:.2} vs {level:.2}");
+                // Output levels → linear 8-bit units; the 1/12 level² of rounding removed.
+                let var_out = (sd * sd - 1.0 / 12.0).max(0.0);
+                let slope = srgb_slope(lin as f64) * 255.0 / 255.0;
+                (lin as f64 * 255.0, var_out / (slope * slope))
+            })
+            .collect();
+        let n = points.len() as f64;
+        let (mx, my) = points.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+        let sxy: f64 = points.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+        let sxx: f64 = points.iter().map(|(x, _)| (x - mx).powi(2)).sum();
+        let (a, b) = (sxy / sxx, my - sxy / sxx * mx);
+        let full_well = 255.0 / a;
+        let read = b.max(0.0).sqrt() * full_well / 255.0;
+        assert!(
+            (full_well / 2100.0 - 1.0).abs() < 0.1,
+            "full well {full_well:.0} e⁻ (2100)"
+        );
+        assert!((read / 12.0 - 1.0).abs() < 0.25, "read noise {read:.1} e⁻ (12)");
+        // No noise asked, none given; absurd noise saturates the output, never overflows.
+        assert_eq!(flat_field_stats(0.18, &SensorParams::noiseless()).1, 0.0);
         let loud = SensorParams {
-            read_noise: 1e9,
+            read_noise_e: 1e12,
             ..params
         };
         let (mean, sd) = flat_field_stats(0.18, &loud);
         assert!(sd > 100.0 && (0.0..=255.0).contains(&mean), "{mean} {sd}");
+    }
+
+    #[test]
+    fn a_dim_scene_brightened_by_auto_exposure_is_noisier() {
+        // The same output level from a bright field and from one 16× dimmer: the dim one
+        // integrates to the limit (4×) and then needs 4× gain, so it collected a quarter
+        // of the electrons: twice the shot noise, four times the read noise (output units).
+        let params = SensorParams {
+            white_balance: WhiteBalance::Fixed([1.0; 3]),
+            ..SensorParams::default()
+        };
+        let settled = |radiance: f32| {
+            let mut sensor = Sensor::new(9);
+            let mut out = RgbImage::default();
+            let (w, h) = (64, 64);
+            for frame in 0..30 {
+                let mut r = vec![[radiance; 3]; w * h];
+                sensor.expose(&mut r, w, &params, frame, &mut out);
+            }
+            let v: Vec<f64> = out.as_bytes().iter().map(|&b| b as f64).collect();
+            let mean = v.iter().sum::<f64>() / v.len() as f64;
+            let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / v.len() as f64).sqrt();
+            (mean, sd)
+        };
+        let (m_bright, sd_bright) = settled(0.18);
+        let (m_dim, sd_dim) = settled(0.18 / 16.0);
+        assert!(
+            (m_bright - m_dim).abs() < 2.0,
+            "same output: {m_bright:.1} vs {m_dim:.1}"
+        );
+        assert!(sd_dim > 1.8 * sd_bright, "dim {sd_dim:.2} vs bright {sd_bright:.2}");
+    }
+
+    /// Exposes `frames` frames of `scene(frame, pixel)` (70 × 10) through grey-world
+    /// with `params`, returning the last output.
+    fn grey_world_frames(params: &SensorParams, frames: u64, scene: &dyn Fn(u64, usize) -> [f32; 3]) -> RgbImage {
+        let params = SensorParams {
+            white_balance: WhiteBalance::GreyWorld,
+            ..*params
+        };
+        let mut sensor = Sensor::new(1);
+        let mut out = RgbImage::default();
+        for frame in 0..frames {
+            let mut r: Vec<[f32; 3]> = (0..70 * 10).map(|i| scene(frame, i)).collect();
+            sensor.expose(&mut r, 70, &params, frame, &mut out);
+        }
+        out
+    }
+
+    #[test]
+    fn grey_world_balances_a_grey_scene_and_is_fooled_by_a_coloured_one() {
+        let params = SensorParams::noiseless();
+        let dusk = [1.0f32, 0.72, 0.48];
+        let tungsten = [1.0f32, 0.68, 0.38];
+        // A grey card filling the view under dusk or tungsten light comes out grey.
+        for light in [dusk, tungsten] {
+            let grey = grey_world_frames(&params, 60, &|_, _| light.map(|c| c * 0.3));
+            let px = grey.view().get(5, 5).unwrap();
+            assert!(px.iter().all(|&c| (c as i32 - px[1] as i32).abs() <= 1), "{px:?}");
+        }
+        // Under daylight, a view nine-tenths a greenish-blue surface (near enough to grey
+        // to pass the gate, as a lawn or a painted wall does) pulls the balance toward
+        // red: the grey card beside it turns reddish.
+        let wall = grey_world_frames(&params, 60, &|_, i| {
+            if i % 70 < 63 { [0.2, 0.3, 0.35] } else { [0.3; 3] }
+        });
+        let card = wall.view().get(66, 5).unwrap();
+        assert!(card[0] as i32 > card[2] as i32 + 20, "{card:?}");
+    }
+
+    #[test]
+    fn saturated_colour_does_not_move_the_balance() {
+        // A fifth of the view a saturated orange (a beacon, a painted block) beside grey:
+        // the gate leaves it out, and the grey stays grey. Plain grey-world over every
+        // pixel would have turned the grey card blue.
+        let params = SensorParams::noiseless();
+        let out = grey_world_frames(&params, 60, &|_, i| {
+            if i % 70 < 14 { [0.9, 0.25, 0.02] } else { [0.3; 3] }
+        });
+        let px = out.view().get(40, 5).unwrap();
+        assert!(px.iter().all(|&c| (c as i32 - px[1] as i32).abs() <= 1), "{px:?}");
+    }
+
+    #[test]
+    fn the_balance_settles_with_its_time_constant() {
+        // The light turns from daylight to dusk after the first frame. With τ = 1 s at
+        // 10 frames a second the balance has moved 1 − e^(−1) ≈ 63 % (in log terms) of
+        // the way after 1 s, and all of it after 6 s; with τ = 0 at once.
+        let params = SensorParams::noiseless();
+        let dusk = [1.0f32, 0.72, 0.48];
+        let scene = |frame: u64, _| if frame == 0 { [0.3; 3] } else { dusk.map(|c| c * 0.3) };
+        let blue_over_green = |frames: u64, tau: f32| {
+            let p = SensorParams {
+                white_balance_tau_s: tau,
+                frame_interval_s: 0.1,
+                ..params
+            };
+            let out = grey_world_frames(&p, frames, &scene);
+            let px = out.view().get(5, 5).unwrap();
+            srgb_to_linear(px[2] as f32 / 255.0) / srgb_to_linear(px[1] as f32 / 255.0)
+        };
+        // Uncorrected, blue/green is 0.48/0.72 = 0.667; corrected, 1.
+        let moved = |ratio: f32| ratio.ln() / (0.48f32 / 0.72).ln();
+        let after_1s = 1.0 - moved(blue_over_green(11, 1.0));
+        assert!((after_1s - 0.632).abs() < 0.05, "moved {after_1s:.3} of the way in 1 s");
+        assert!((blue_over_green(61, 1.0) - 1.0).abs() < 0.02);
+        assert!((blue_over_green(2, 0.0) - 1.0).abs() < 0.02);
     }
 
     fn srgb_level(lin: f32) -> f64 {
