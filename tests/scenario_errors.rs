@@ -38,7 +38,14 @@ fn malformed_scenarios_are_reported_precisely() {
             "[starts]\n",
             "starts",
             Some(3),
-            "expected a `grid` or at least one entry in `points`",
+            "expected a `grid`, at least one entry in `points`, or `random`",
+        ),
+        (
+            "bad_random_starts.toml",
+            "[starts]\nrandom = { count = 0, distance_m = [2.0, 1.0], angle_deg = [-60.0, 60.0] }\n",
+            "starts.random.count",
+            Some(4),
+            "expected 1 to 10000 starts, got 0",
         ),
         (
             "bad_grid.toml",

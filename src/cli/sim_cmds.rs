@@ -180,6 +180,13 @@ pub struct TrialsOptions {
     /// Skip runs already in DIR/runs.jsonl.
     #[arg(long, requires = "out")]
     pub resume: bool,
+    /// Print success binned by a drawn lighting parameter, `PARAM` or `PARAM:N` (N bins,
+    /// default 5; repeatable), for a scenario whose lighting axis names a
+    /// `[lighting_random.NAME]`. Parameters: intensity, outdoor, ambient, sun,
+    /// sun_elevation_deg, sun_azimuth_deg, glare, beacons, beacon_power,
+    /// beacon_distance_m, shadows, shadow_speed_mps, shadow_strength, clouds.
+    #[arg(long, value_name = "PARAM[:N]")]
+    pub bin: Vec<String>,
     /// Progress bar on stderr (set by the binary when stderr is a terminal).
     #[arg(skip)]
     pub progress: bool,
@@ -254,7 +261,20 @@ pub fn print_table(s: &Summary, out: &mut dyn Write) -> std::io::Result<()> {
 /// # Errors
 /// [`SimError`].
 pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimError> {
+    let bins = opts
+        .bin
+        .iter()
+        .map(|b| crate::sim::bins::parse_bin_arg(b))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(SimError::InvalidArgument)?;
     let loaded = Scenario::load(&opts.scenario)?;
+    let sc = &loaded.scenario;
+    if !bins.is_empty() && !sc.axes.lighting.iter().any(|l| sc.lighting_random.contains_key(l)) {
+        return Err(SimError::InvalidArgument(format!(
+            "--bin: no lighting on {}'s lighting axis is drawn; name a [lighting_random.NAME] there",
+            opts.scenario.display()
+        )));
+    }
     let prepared = campaign::prepare(loaded)?;
     let started = std::time::Instant::now();
     let (records, summary) = campaign::run_campaign(
@@ -286,6 +306,10 @@ pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimE
         let _ = print_table(&summary, out);
         if let Some(c) = &comparison {
             let _ = writeln!(out, "\n{c}");
+        }
+        for (param, n) in &bins {
+            let table = crate::sim::bins::bin_by(&records, param, *n).map_err(SimError::InvalidArgument)?;
+            let _ = writeln!(out, "\n{table}");
         }
         let _ = writeln!(
             out,

@@ -8,6 +8,7 @@
 //! instant, same placement error and the same imprint, as in the paper's paired protocol.
 
 use super::SimError;
+use super::lighting_random::LightingDraw;
 use super::robot::SimDevices;
 pub use super::run::{Recording, run_one};
 use super::scenario::{Loaded, RunSpec};
@@ -70,6 +71,10 @@ pub struct RunRecord {
     /// Alignment manoeuvres started (RAPOSA's region-II iterations).
     #[serde(default)]
     pub manoeuvres: u32,
+    /// The run's lighting draw, when its lighting is a `[lighting_random.NAME]`
+    /// distribution (absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lighting_draw: Option<LightingDraw>,
     /// True path, [x, y] in mm every 0.5 s.
     pub track: Vec<[i32; 2]>,
 }

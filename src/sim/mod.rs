@@ -4,6 +4,7 @@
 pub mod camera;
 pub mod krawler;
 pub mod lighting;
+pub mod lighting_random;
 pub mod render;
 pub mod rng;
 pub mod scene;
@@ -17,6 +18,9 @@ pub enum SimError {
     /// The simulator cannot (yet) build what the profile describes.
     #[error("not supported by the simulator: {0}")]
     Unsupported(String),
+    /// A command-line argument that cannot be used (e.g. an unknown `--bin` parameter).
+    #[error("{0}")]
+    InvalidArgument(String),
     /// A start pose the robot cannot be placed at.
     #[error("{0}")]
     InvalidStart(String),
@@ -35,6 +39,7 @@ pub enum SimError {
         source: std::io::Error,
     },
 }
+pub mod bins;
 pub mod campaign;
 pub mod dock;
 pub mod engine;

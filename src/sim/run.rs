@@ -12,6 +12,7 @@ use super::SimError;
 use super::campaign::{AgentFactory, Prepared, RunRecord};
 use super::engine::{PhaseEnd, Sim};
 use super::lighting::LightingRun;
+use super::lighting_random::LightingDraw;
 use super::motion::Motion;
 use super::render::SensorParams;
 use super::rng::Rng;
@@ -142,12 +143,13 @@ impl Rig {
 
 /// The simulated world of run `spec`: its lighting (drawn from `pair`, the stream paired
 /// runs share), sensor, terrain and seed, with the run's profile (its segmentation mode).
-/// Returns the run's lighting and sensor too (the departure may run under others).
-fn simulation(p: &Prepared, spec: &RunSpec, pair: &mut Rng) -> (Sim, LightingRun, SensorParams) {
+/// Returns the run's lighting and sensor too (the departure may run under others), and
+/// the lighting's draw when the run's lighting is a distribution.
+fn simulation(p: &Prepared, spec: &RunSpec, pair: &mut Rng) -> (Sim, LightingRun, SensorParams, Option<LightingDraw>) {
     let sc: &Scenario = &p.loaded.scenario;
     let mut profile = p.loaded.profile.clone();
     profile.perception.mode = spec.segmentation;
-    let lighting = sc.lighting_named(&spec.lighting);
+    let (lighting, draw) = sc.lighting_for_run(&spec.lighting, spec.pair_seed);
     let run_light = LightingRun::new(lighting.clone(), pair, sc.timeout_s + 120.0);
     let sensor = sc.sensor_params(&lighting);
     let motion = Motion::new(
@@ -167,7 +169,7 @@ fn simulation(p: &Prepared, spec: &RunSpec, pair: &mut Rng) -> (Sim, LightingRun
         sc.dt_s,
         spec.seed,
     );
-    (sim, run_light, sensor)
+    (sim, run_light, sensor, draw)
 }
 
 /// Puts the robot where a departure starts: in the dock, or, for an open dock (a target
@@ -187,7 +189,7 @@ fn place_docked(s: &mut Sim) {
 /// The simulated robot of run `spec` (its lighting, sensor, terrain and seed), docked and
 /// ready to depart: to drive it with the threaded runtime or your own loop.
 pub fn docked_robot(p: &Prepared, spec: &RunSpec) -> SimRobot {
-    let (mut sim, _, _) = simulation(p, spec, &mut Rng::new(spec.pair_seed));
+    let (mut sim, _, _, _) = simulation(p, spec, &mut Rng::new(spec.pair_seed));
     place_docked(&mut sim);
     SimRobot::new(sim)
 }
@@ -208,7 +210,7 @@ pub fn run_one(
     profile.perception.mode = spec.segmentation;
     let agent = make_agent(&profile).map_err(|e| SimError::Unsupported(e.to_string()))?;
     let mut pair = Rng::new(spec.pair_seed);
-    let (sim, run_light, sensor) = simulation(p, spec, &mut pair);
+    let (sim, run_light, sensor, draw) = simulation(p, spec, &mut pair);
     let (length, width) = (profile.body.length_m, profile.body.width_m);
     let config = profile.loop_config();
     let sim = SimRobot::new(sim);
@@ -273,7 +275,9 @@ pub fn run_one(
         .map_err(|e| SimError::Unsupported(e.to_string()))?;
     let end = rig.run("docking", sc.timeout_s, rec);
     let manoeuvres = rig.lp.root().stats().manoeuvres;
-    Ok(rig.sim.with(|sim| record(spec, sim, end, imprinted, manoeuvres)))
+    let mut record = rig.sim.with(|sim| record(spec, sim, end, imprinted, manoeuvres));
+    record.lighting_draw = draw;
+    Ok(record)
 }
 
 /// The run's `runs.jsonl` line, from the simulator's ground truth.
@@ -320,6 +324,7 @@ fn record(spec: &RunSpec, sim: &Sim, end: PhaseEnd, imprinted: Option<bool>, man
         safe_stops: sim.safe_stops,
         imprinted,
         manoeuvres,
+        lighting_draw: None,
         track: sim
             .track
             .iter()

@@ -7,8 +7,10 @@
 //! relative to the scenario file.
 
 use super::lighting::{Lighting, LightingPreset, LightingSpec};
+use super::lighting_random::{LightingDistribution, LightingDraw};
 use super::motion::{SlipSpec, Terrain};
 use super::render::{SensorParams, WhiteBalance};
+use super::rng::Rng;
 use super::world::ClutterSpec;
 use crate::config::{self, ConfigError, Validate, Validator};
 use crate::geometry::Pose2;
@@ -66,12 +68,30 @@ pub struct StartsSpec {
     /// Explicit starts (instead of, or after, the grid).
     #[serde(default)]
     pub points: Vec<StartPoint>,
+    /// Random starts (after the grid and the points).
+    #[serde(default)]
+    pub random: Option<RandomStarts>,
     /// SD of the placement error, m.
     #[serde(default)]
     pub position_jitter_m: f64,
     /// SD of the heading placement error, degrees.
     #[serde(default)]
     pub heading_jitter_deg: f64,
+}
+
+/// `[starts.random]`: `count` starts drawn uniformly in distance and angle over an
+/// annular sector of the approach zone, from the scenario's seed (so every run of the
+/// campaign, and `dock --index`, sees the same ones), each facing the dock like a grid
+/// start. Labelled `r1`, `r2`, ….
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RandomStarts {
+    /// How many.
+    pub count: usize,
+    /// Distance from the dock entrance, m: [low, high].
+    pub distance_m: [f64; 2],
+    /// Angle off the dock axis, degrees: [low, high].
+    pub angle_deg: [f64; 2],
 }
 
 fn default_corner() -> f64 {
@@ -287,6 +307,10 @@ pub struct Scenario {
     /// Named lighting programmes.
     #[serde(default)]
     pub lighting: BTreeMap<String, LightingSpec>,
+    /// Named lighting distributions: each run on one draws its own programme
+    /// ([`LightingDistribution`]).
+    #[serde(default)]
+    pub lighting_random: BTreeMap<String, LightingDistribution>,
     /// Sensor.
     #[serde(default)]
     pub sensor: SensorSpec,
@@ -348,9 +372,29 @@ impl Validate for Scenario {
             format!("expected a physics step in (0, 0.05] s, got {}", self.dt_s)
         });
         let s = &self.starts;
-        v.require(s.grid.is_some() || !s.points.is_empty(), "starts", || {
-            "expected a `grid` or at least one entry in `points`".into()
-        });
+        v.require(
+            s.grid.is_some() || !s.points.is_empty() || s.random.is_some(),
+            "starts",
+            || "expected a `grid`, at least one entry in `points`, or `random`".into(),
+        );
+        if let Some(r) = &s.random {
+            v.require((1..=10_000).contains(&r.count), "starts.random.count", || {
+                format!("expected 1 to 10000 starts, got {}", r.count)
+            });
+            for (f, b, lo, hi) in [
+                ("distance_m", r.distance_m, 0.0, 1000.0),
+                ("angle_deg", r.angle_deg, -180.0, 180.0),
+            ] {
+                v.require(
+                    b.iter().all(|x| x.is_finite()) && b[0] <= b[1] && b[0] >= lo && b[1] <= hi,
+                    &format!("starts.random.{f}"),
+                    || format!("expected [low, high] with {lo} ≤ low ≤ high ≤ {hi}, got {b:?}"),
+                );
+            }
+            v.require(r.distance_m[0] > 0.0, "starts.random.distance_m", || {
+                "expected a positive lower distance".into()
+            });
+        }
         if let Some(sel) = &s.select {
             v.require(s.grid.is_some(), "starts.select", || "`select` needs a `grid`".into());
             for (i, p) in sel.iter().enumerate() {
@@ -381,9 +425,22 @@ impl Validate for Scenario {
             v.require(n >= 1, field, || "expected at least one value".into());
         }
         for (i, name) in self.axes.lighting.iter().enumerate() {
-            v.require(self.lighting.contains_key(name) || preset_named(name).is_some(), &format!("axes.lighting[{i}]"), || {
-                format!("unknown lighting `{name}`: expected a preset (lab, flashers, noon, dusk, clouds, dawn) or a [lighting.{name}] table")
+            let known = self.lighting.contains_key(name)
+                || self.lighting_random.contains_key(name)
+                || preset_named(name).is_some();
+            v.require(known, &format!("axes.lighting[{i}]"), || {
+                format!("unknown lighting `{name}`: expected a preset (lab, flashers, noon, dusk, clouds, dawn), a [lighting.{name}] table or a [lighting_random.{name}] table")
             });
+        }
+        for name in self.lighting_random.keys() {
+            v.require(
+                !self.lighting.contains_key(name) && preset_named(name).is_none(),
+                &format!("lighting_random.{name}"),
+                || format!("`{name}` is already a lighting programme or preset: give the distribution its own name"),
+            );
+        }
+        for (name, d) in &self.lighting_random {
+            d.validate_at(&format!("lighting_random.{name}"), v);
         }
         if let Some(name) = &self.imprint.lighting {
             v.require(
@@ -526,7 +583,21 @@ impl Scenario {
         })
     }
 
-    /// The resolved lighting programme called `name`.
+    /// The lighting of a run on axis value `name` with pair seed `pair_seed`: a fixed
+    /// programme, or, for a `[lighting_random.NAME]`, the programme this run draws (seeded
+    /// by the pair seed alone, so paired runs and `dock --index` see the same light) and
+    /// the draw's record.
+    pub fn lighting_for_run(&self, name: &str, pair_seed: u64) -> (Lighting, Option<LightingDraw>) {
+        match self.lighting_random.get(name) {
+            Some(d) => {
+                let draw = d.draw(&mut Rng::named(pair_seed, "lighting_random"));
+                (draw.spec.resolve(), Some(draw))
+            }
+            None => (self.lighting_named(name), None),
+        }
+    }
+
+    /// The resolved lighting programme called `name` (a preset or a `[lighting.NAME]`).
     pub fn lighting_named(&self, name: &str) -> Lighting {
         match self.lighting.get(name) {
             Some(spec) => spec.resolve(),
@@ -636,6 +707,16 @@ impl Scenario {
             };
             let label = p.label.clone().unwrap_or_else(|| format!("p{}", i + 1));
             out.push(make(label, x, y, p.heading_deg, polar));
+        }
+        if let Some(r) = &self.starts.random {
+            let mut rng = Rng::named(self.seed, "random_starts");
+            for i in 0..r.count {
+                let d = rng.range(r.distance_m[0], r.distance_m[1].max(r.distance_m[0]));
+                let a = rng
+                    .range(r.angle_deg[0], r.angle_deg[1].max(r.angle_deg[0]))
+                    .to_radians();
+                out.push(make(format!("r{}", i + 1), d * a.cos(), d * a.sin(), None, true));
+            }
         }
         out
     }
