@@ -141,6 +141,17 @@ impl<'a> Validator<'a> {
         });
     }
 
+    /// `bounds` must be an interval [low, high] of finite numbers with low ≤ high, within
+    /// [lo, hi] (a range a scenario draws from).
+    pub fn interval(&mut self, path: &str, bounds: [f64; 2], lo: f64, hi: f64) {
+        let [a, b] = bounds;
+        self.require(
+            a.is_finite() && b.is_finite() && a <= b && a >= lo && b <= hi,
+            path,
+            || format!("expected [low, high] with {lo} ≤ low ≤ high ≤ {hi}, got {bounds:?}"),
+        );
+    }
+
     /// `value` must lie in (0, 1] (a rate, factor or fraction where 0 would switch
     /// the thing off).
     pub fn fraction(&mut self, path: &str, value: f64) {

@@ -156,18 +156,7 @@ impl LightingDistribution {
     /// the lists, naming the field under `base` (e.g. `lighting_random.mixed`).
     pub(crate) fn validate_at(&self, base: &str, v: &mut Validator<'_>) {
         let p = |f: &str| format!("{base}.{f}");
-        let mut range = |f: &str, r: [f64; 2], lo: f64, hi: f64| {
-            let path = p(f);
-            v.require(r.iter().all(|x| x.is_finite()), &path, || {
-                format!("expected finite bounds, got {r:?}")
-            });
-            v.require(r[0] <= r[1], &path, || {
-                format!("expected [low, high] with low ≤ high, got {r:?}")
-            });
-            v.require(r[0] >= lo && r[1] <= hi, &path, || {
-                format!("expected bounds within [{lo}, {hi}], got {r:?}")
-            });
-        };
+        let mut range = |f: &str, r: [f64; 2], lo: f64, hi: f64| v.interval(&p(f), r, lo, hi);
         range("intensity", self.intensity, 1e-3, 100.0);
         range("ambient", self.ambient, 0.0, 100.0);
         range("sun", self.sun, 0.0, 100.0);
@@ -191,8 +180,9 @@ impl LightingDistribution {
                 format!("expected [low, high] with low ≤ high ≤ {MAX_COUNT}, got {c:?}")
             });
         }
-        v.fraction(&p("outdoor_probability"), self.outdoor_probability);
-        v.fraction(&p("cloud_probability"), self.cloud_probability);
+        // Probabilities: 0 (never outdoors, never cloudy) is as valid as 1.
+        v.range(&p("outdoor_probability"), self.outdoor_probability, 0.0, 1.0);
+        v.range(&p("cloud_probability"), self.cloud_probability, 0.0, 1.0);
         v.require(!self.illuminants.is_empty(), &p("illuminants"), || {
             "expected at least one illuminant".into()
         });
@@ -330,6 +320,13 @@ mod tests {
     #[test]
     fn the_defaults_are_valid_and_bad_bounds_are_named() {
         assert!(validate(&LightingDistribution::default()).is_empty());
+        // Probabilities of 0 and 1 are valid: an indoor-only or always-cloudy distribution.
+        let edges = LightingDistribution {
+            outdoor_probability: 0.0,
+            cloud_probability: 1.0,
+            ..LightingDistribution::default()
+        };
+        assert!(validate(&edges).is_empty(), "{:?}", validate(&edges));
         let bad = LightingDistribution {
             beacon_power: [-1.0, 2.0],
             intensity: [3.0, 1.0],

@@ -381,16 +381,8 @@ impl Validate for Scenario {
             v.require((1..=10_000).contains(&r.count), "starts.random.count", || {
                 format!("expected 1 to 10000 starts, got {}", r.count)
             });
-            for (f, b, lo, hi) in [
-                ("distance_m", r.distance_m, 0.0, 1000.0),
-                ("angle_deg", r.angle_deg, -180.0, 180.0),
-            ] {
-                v.require(
-                    b.iter().all(|x| x.is_finite()) && b[0] <= b[1] && b[0] >= lo && b[1] <= hi,
-                    &format!("starts.random.{f}"),
-                    || format!("expected [low, high] with {lo} ≤ low ≤ high ≤ {hi}, got {b:?}"),
-                );
-            }
+            v.interval("starts.random.distance_m", r.distance_m, 0.0, 1000.0);
+            v.interval("starts.random.angle_deg", r.angle_deg, -180.0, 180.0);
             v.require(r.distance_m[0] > 0.0, "starts.random.distance_m", || {
                 "expected a positive lower distance".into()
             });
@@ -616,8 +608,7 @@ impl Scenario {
         let white_balance = match self.sensor.white_balance {
             WhiteBalanceSpec::GreyWorld => WhiteBalance::GreyWorld,
             WhiteBalanceSpec::Switch if lighting.sun > 0.0 => fixed(I::Daylight),
-            WhiteBalanceSpec::Switch => fixed(lighting.illuminant),
-            WhiteBalanceSpec::Perfect => fixed(lighting.illuminant),
+            WhiteBalanceSpec::Switch | WhiteBalanceSpec::Perfect => fixed(lighting.illuminant),
             WhiteBalanceSpec::Daylight => fixed(I::Daylight),
             WhiteBalanceSpec::Dusk => fixed(I::Dusk),
             WhiteBalanceSpec::Tungsten => fixed(I::Tungsten),
