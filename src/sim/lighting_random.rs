@@ -257,7 +257,6 @@ impl LightingDistribution {
             mean_interval_s: uni(rng, self.cloud_interval_s),
             depth: uni(rng, self.cloud_depth),
         };
-        let max = |it: &mut dyn Iterator<Item = f64>| it.fold(0.0f64, f64::max);
         let params: BTreeMap<String, f64> = [
             ("intensity", intensity),
             ("outdoor", f64::from(u8::from(outdoor))),
@@ -267,7 +266,7 @@ impl LightingDistribution {
             ("sun_azimuth_deg", azimuth),
             ("glare", glare),
             ("beacons", f64::from(n_beacons)),
-            ("beacon_power", max(&mut flashers.iter().map(|f| f.power))),
+            ("beacon_power", flashers.iter().map(|f| f.power).fold(0.0, f64::max)),
             (
                 "beacon_distance_m",
                 flashers
@@ -277,8 +276,11 @@ impl LightingDistribution {
                     .unwrap_or(0.0),
             ),
             ("shadows", f64::from(n_shadows)),
-            ("shadow_speed_mps", max(&mut speeds.iter().copied())),
-            ("shadow_strength", max(&mut shadows.iter().map(|s| s.strength))),
+            ("shadow_speed_mps", speeds.iter().copied().fold(0.0, f64::max)),
+            (
+                "shadow_strength",
+                shadows.iter().map(|s| s.strength).fold(0.0, f64::max),
+            ),
             ("clouds", f64::from(u8::from(cloudy))),
         ]
         .into_iter()
