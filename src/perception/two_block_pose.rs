@@ -3,10 +3,10 @@
 //! * Range from the blocks' apparent height: d = f·h / H_img.
 //! * Bearing of the pair from the optical axis: atan(offset / f).
 //! * Viewing angle α (the robot's position angle off the dock axis): the nearer block looks
-//!   bigger. Each block's width and height scale with 1/distance and the block centres sit
-//!   ±w/4 from the middle, so the signed pixel-count (area) asymmetry is
-//!   (L − R)/(L + R) ≈ (w/2)·sin α / d, giving sin α ≈ 2·d·asym / w: the paper's ratio cue
-//!   (seed 004 §V) made metric. It is weak at
+//!   bigger. It is nearer (perspective) and seen less obliquely (foreshortening), and with
+//!   the block centres ±w/4 from the middle the signed pixel-count (area) asymmetry is
+//!   (L − R)/(L + R) ≈ 3·w·sin α / (4·d), giving sin α ≈ 4·d·asym / (3·w): the paper's
+//!   ratio cue (seed 004 §V) made metric. It is weak at
 //!   2 m (a 60° view changes the counts by 2 %) and strong near the gate, where the final
 //!   alignment is decided. (The fiducial's foreshortened aspect looks like a stronger cue
 //!   far away, but segmentation erodes the blocks' outer edges by a pixel, which biases it
@@ -72,7 +72,7 @@ impl TwoBlockGeometry {
 /// A forward camera with f = 100 px sees a 0.2 × 0.1 m fiducial whose blocks are 20 px
 /// tall, so it is 100·0.1/20 = 0.5 m away. The blocks sit symmetrically about the image
 /// centre (no bearing), but the image-left block has 500 px against 400: the asymmetry is
-/// −100/900 for this mount, and sin α = 2·0.5·(−1/9)/0.2 = −5/9.
+/// −100/900 for this mount, and sin α = 4·0.5·(−1/9)/(3·0.2) = −10/27.
 ///
 /// ```
 /// use marsupial::perception::{ColorMode, FiducialView, TwoBlockGeometry, TwoBlockPercept};
@@ -92,12 +92,12 @@ impl TwoBlockGeometry {
 /// let v = FiducialView::from_percept(&p, &g).unwrap();
 /// assert!((v.distance - 0.5).abs() < 1e-12);
 /// assert!((v.asym + 1.0 / 9.0).abs() < 1e-12);
-/// assert!((v.alpha - (-5f64 / 9.0).asin()).abs() < 1e-12);
+/// assert!((v.alpha - (-10f64 / 27.0).asin()).abs() < 1e-12);
 /// assert_eq!((v.bearing, v.height_px), (0.0, 20.0));
 /// // Facing the fiducial, the heading is α itself, and the pose follows.
 /// assert!((v.heading - v.alpha).abs() < 1e-12);
 /// let pose = v.dock_pose();
-/// assert!((pose.y - 0.5 * (-5.0 / 9.0)).abs() < 1e-12 && pose.x > 0.0);
+/// assert!((pose.y - 0.5 * (-10.0 / 27.0)).abs() < 1e-12 && pose.x > 0.0);
 /// // A filtered α replaces the estimate and the heading with it.
 /// assert_eq!(v.with_alpha(0.1).heading, 0.1);
 /// // Nothing found, nothing estimated.
@@ -191,8 +191,14 @@ impl FiducialView {
 }
 
 /// sin α from the pixel asymmetry (L − R)/(L + R) of a flap `width_m` wide seen from
-/// `distance` m: off the axis the near block is nearer than the far one by about
-/// (w/2)·sin α and looks larger by perspective, so sin α ≈ 2·d·asym/w.
+/// `distance` m. A patch at lateral position y on the flap subtends a solid angle
+/// ∝ cos β/r², with r its distance and β the angle between its line of sight and the
+/// flap's normal; to first order in y/d both give 1 + 3·y·sin α/d (perspective 2, the
+/// line of sight's foreshortening 1). Averaged over each block (mean |y| = w/4) the
+/// asymmetry is 3·w·sin α/(4·d), so sin α ≈ 4·d·asym/(3·w). (Earlier versions kept only
+/// the perspective term, sin α ≈ 2·d·asym/w, which overstated α by half: rendered flaps
+/// put it at 1.43–1.48× the true sin α from 0.38 m to 0.8 m,
+/// `tests/two_block_pose_render.rs`.)
 fn ratio_sin_alpha(distance: f64, asym: f64, width_m: f64) -> f64 {
-    2.0 * distance * asym / width_m
+    4.0 * distance * asym / (3.0 * width_m)
 }

@@ -81,6 +81,16 @@ pub struct RatioSteeringGains {
     pub dock_total_px: u32,
     /// Largest horizontal offset of the pair from the image centre to back in, px.
     pub centre_tolerance_px: f64,
+    /// Where the aim point sits on the dock axis, as a fraction f of the robot's distance
+    /// along it (0.5, the default: halfway in). Heading at it, the robot's lateral offset
+    /// shrinks as (x/x₀)^(1/(1−f)) while it closes from x₀ to x: halfway gives a square
+    /// law, two thirds a cube.
+    #[serde(default = "default_aim_fraction")]
+    pub aim_fraction: f64,
+}
+
+fn default_aim_fraction() -> f64 {
+    0.5
 }
 
 /// Gains of the potential-field docking schema (ALGORITHMS §1.3).
@@ -278,6 +288,7 @@ pub(crate) fn validate_behavior(b: &BehaviorSpec, v: &mut Validator<'_>) {
                     "expected a count ≥ 1".into()
                 });
                 v.positive("behavior.ratio_steering.centre_tolerance_px", g.centre_tolerance_px);
+                v.range("behavior.ratio_steering.aim_fraction", g.aim_fraction, 0.0, 0.9);
             }
         },
         ApproachKind::PotentialField => match &b.potential_field {

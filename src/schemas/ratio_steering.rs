@@ -42,6 +42,7 @@ pub const MAX_AIM_RAD: f64 = 25.0 * std::f64::consts::PI / 180.0;
 ///     turn_rate: 0.5,
 ///     speed: 0.06,
 ///     dock_total_px: 9000.0,
+///     aim_fraction: 0.5,
 ///     tick_s: 0.1,
 ///     restricted: true,
 /// };
@@ -65,7 +66,7 @@ pub const MAX_AIM_RAD: f64 = 25.0 * std::f64::consts::PI / 180.0;
 /// assert!(omega < 0.0);
 ///
 /// // 40° off the axis the aim point wants the fiducial off centre: centred is an error.
-/// assert!(RatioSteering::aim_angle(&view(40f64.to_radians(), 0.0)) > 0.1);
+/// assert!(s.aim_angle(&view(40f64.to_radians(), 0.0)) > 0.1);
 /// assert!(s.error(&view(40f64.to_radians(), 0.0)) > s.dead_band);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -84,6 +85,9 @@ pub struct RatioSteering {
     pub speed: f64,
     /// Summed pixel count at the dock.
     pub dock_total_px: f64,
+    /// The aim point's place on the dock axis, as a fraction of the robot's distance
+    /// along it (0.5: halfway in; see [`RatioSteering::aim_angle`]).
+    pub aim_fraction: f64,
     /// Loop period, s.
     pub tick_s: f64,
     /// Turn OR drive (true), or both at once.
@@ -92,13 +96,15 @@ pub struct RatioSteering {
 
 impl RatioSteering {
     /// The aim-point angle δ (rad): how far the motion direction should point away from the
-    /// fiducial so that it heads at the point on the axis halfway in. Capped at
-    /// [`MAX_AIM_RAD`] so the fiducial stays well inside the image; larger offsets are the
-    /// repositioning manoeuvre's job.
-    pub fn aim_angle(view: &FiducialView) -> f64 {
+    /// fiducial so that it heads at the point on the axis `aim_fraction` of the way in
+    /// from the dock (halfway for 0.5). Heading at it, the lateral offset shrinks as
+    /// (x/x₀)^(1/(1−f)) with the distance x along the axis. Capped at [`MAX_AIM_RAD`] so
+    /// the fiducial stays well inside the image; larger offsets are the repositioning
+    /// manoeuvre's job.
+    pub fn aim_angle(&self, view: &FiducialView) -> f64 {
         let (d, a) = (view.distance, view.alpha);
         let (px, py) = (d * a.cos(), d * a.sin());
-        let aim = 0.5 * px;
+        let aim = self.aim_fraction * px;
         let to_dock = (-py).atan2(-px);
         let to_aim = (-py).atan2(aim - px);
         crate::geometry::wrap_angle(to_aim - to_dock).clamp(-MAX_AIM_RAD, MAX_AIM_RAD)
@@ -108,7 +114,7 @@ impl RatioSteering {
     /// mount in `geometry`.
     pub fn error(&self, view: &FiducialView) -> f64 {
         let g = &self.geometry;
-        let desired = g.fx * Self::aim_angle(view).tan() * g.image_right_sign * g.drive_dir;
+        let desired = g.fx * self.aim_angle(view).tan() * g.image_right_sign * g.drive_dir;
         let e = (view.offset_px - desired) / (self.image_width / 2.0);
         e * -g.drive_dir * g.image_right_sign
     }
@@ -171,6 +177,7 @@ mod tests {
             turn_rate: 0.5,
             speed: 0.06,
             dock_total_px: 9000.0,
+            aim_fraction: 0.5,
             tick_s: 0.1,
             restricted: true,
         }
@@ -215,14 +222,44 @@ mod tests {
         assert!(omega < 0.0);
     }
 
+    /// A point heading at the aim point closes on the axis as (x/x₀)^(1/(1−f)): the
+    /// square law halfway in, the cube law at two thirds.
+    #[test]
+    fn the_aim_fraction_sets_how_fast_the_robot_closes_on_the_axis() {
+        for (f, power) in [(0.5, 2.0), (2.0 / 3.0, 3.0)] {
+            let s = RatioSteering {
+                aim_fraction: f,
+                ..schema()
+            };
+            let (mut x, mut y) = (2.0f64, 0.1f64);
+            while x > 0.5 {
+                let v = FiducialView {
+                    distance: x.hypot(y),
+                    alpha: y.atan2(x),
+                    ..view(0.0, 0.0)
+                };
+                // Motion toward the dock, turned by the aim angle toward the axis.
+                let dir = (-y).atan2(-x) + s.aim_angle(&v);
+                let step = 1e-3;
+                x += step * dir.cos();
+                y += step * dir.sin();
+            }
+            let expected = 0.1 * (x / 2.0).powf(power);
+            assert!(
+                (y - expected).abs() < 0.15 * expected,
+                "f {f}: y {y:.5} against {expected:.5}"
+            );
+        }
+    }
+
     #[test]
     fn off_axis_the_fiducial_is_held_off_centre_toward_the_axis() {
         // At α = +40°, the aim point asks for the fiducial on the image's left: centred is wrong.
         let s = schema();
-        assert!(RatioSteering::aim_angle(&view(40.0, 0.0)) > 0.1);
+        assert!(s.aim_angle(&view(40.0, 0.0)) > 0.1);
         let e_centred = s.error(&view(40.0, 0.0));
         assert!(e_centred > s.dead_band, "{e_centred}");
-        let desired = -182.8 * RatioSteering::aim_angle(&view(40.0, 0.0)).tan();
+        let desired = -182.8 * s.aim_angle(&view(40.0, 0.0)).tan();
         assert!(s.error(&view(40.0, desired)).abs() < 1e-9);
         // Symmetric on the other side.
         assert!((s.error(&view(-40.0, 0.0)) + e_centred).abs() < 1e-9);

@@ -394,6 +394,9 @@ impl Sim {
                 self.next_track += self.track_every;
             }
         }
+        // The true pose each tick, for comparing a replayed run's estimates with the truth
+        // (`RUST_LOG=marsupial::sim=trace marsupial dock --index N`).
+        tracing::trace!(target: "marsupial::sim", t = self.t, x = self.pose.x, y = self.pose.y, theta_deg = self.pose.theta.to_degrees(), "truth");
         self.docked.then_some(PhaseEnd::Docked)
     }
 }

@@ -122,6 +122,7 @@ impl Behavior for Decide {
             self.tol_heading,
             self.params.tolerance_fraction,
         );
+        tracing::debug!(target: "marsupial::behavior", now = m.now, back_in = d.back_in, alpha_deg = d.alpha.to_degrees(), heading_deg = d.heading.to_degrees(), distance = d.distance, lateral_m = d.lateral_at_entrance, "at-dock decision");
         if d.back_in {
             m.samples_distance = d.distance;
             return Some(Step::event(

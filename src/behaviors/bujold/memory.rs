@@ -189,6 +189,7 @@ impl Memory {
             turn_rate: g.turn_rate_dps.to_radians(),
             speed: g.drive_speed_mps,
             dock_total_px: g.dock_total_px as f64,
+            aim_fraction: g.aim_fraction,
             tick_s: 1.0 / profile.loop_.rate_hz,
             restricted: profile.drive.kind == crate::profile::DriveKind::TurnOrDrive,
         };

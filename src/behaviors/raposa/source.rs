@@ -18,7 +18,7 @@
 //! | `bearing` | the pair's bearing in the robot frame |
 //! | `ball_distance_m` (d = f·h/g − m·cos α with a pair) | camera to flap, d = f·h/H from the blocks' mean height |
 //! | `area_px` and A₁ (the ball's area at 1 m) for v = K_lin·√(A₁/A) | both blocks' pixels, and A₁ = f²·w·h, the flap's area at 1 m |
-//! | `alpha` from the quadratic in K = c·h/g (pairs only) | the block-ratio viewing angle sin α ≈ 2·d·(L − R)/((L + R)·w): the median of the last `alpha_window_frames` frames whose blocks are at least `reliable_height_px` tall (`[behavior.bujold]`, as Bujold's repositioning decides), reported once that many were seen in a row; until then `None`, as a lone ellipse gives, and the selector chooses state 1 or 3 |
+//! | `alpha` from the quadratic in K = c·h/g (pairs only) | the block-ratio viewing angle sin α ≈ 4·d·(L − R)/(3·(L + R)·w): the median of the last `alpha_window_frames` frames whose blocks are at least `reliable_height_px` tall (`[behavior.bujold]`, as Bujold's repositioning decides), reported once that many were seen in a row; until then `None`, as a lone ellipse gives, and the selector chooses state 1 or 3 |
 //! | `alpha_saturated` (K past the quadratic's peak, 73°) | the ratio's sin α clipped at 1 |
 //!
 //! With no equivalent:
