@@ -5,6 +5,9 @@
 //! the bands, keeps the pair from other poses and falls back to the table when the
 //! pyramid is gone; a failed departure imprint is recorded as failed.
 
+mod common;
+
+use common::pose_seeing_origin;
 use marsupial::geometry::Pose2;
 use marsupial::perception::camera_model::CameraModel;
 use marsupial::perception::{ColorMode, RgbImage};
@@ -19,14 +22,6 @@ use std::path::Path;
 
 fn load(rel: &str) -> Profile {
     Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap()
-}
-
-/// Robot pose with its camera at distance `d` from the ball, at angle `alpha_deg` around
-/// the pyramid axis, looking at the ball.
-fn pose_at(p: &Profile, d: f64, alpha_deg: f64) -> Pose2 {
-    let a = alpha_deg.to_radians();
-    let x = p.cameras[0].mount.x_m;
-    Pose2::new(d * a.cos() - x * a.cos(), d * a.sin() - x * a.sin(), a)
 }
 
 fn render(p: &Profile, pose: &Pose2, preset: LightingPreset, seed: u64) -> RgbImage {
@@ -76,13 +71,13 @@ fn imprint_learns_a_repainted_ball() {
         // Under lab light the orange bands do not see the red ball from the departure
         // pose (dusk's warm light and the fixed white balance push it back to orange) …
         if preset == LightingPreset::Lab {
-            let depart = render(&red, &pose_at(&red, d, 0.0), preset, 3);
+            let depart = render(&red, &pose_seeing_origin(&red, d, 0.0, 0.0), preset, 3);
             assert!(s.process(&depart.view(), 0.0).unwrap().view.is_none());
         }
         // … the imprint does, and from the grid's starts too.
         let frames = s.imprint_frames_wanted();
         for k in 0..frames {
-            let im = render(&red, &pose_at(&red, d, 0.0), preset, 10 + k as u64);
+            let im = render(&red, &pose_seeing_origin(&red, d, 0.0, 0.0), preset, 10 + k as u64);
             assert!(s.imprint_frame(&im.view()).unwrap(), "{preset:?} frame {k}");
         }
         assert!(s.finish_imprint(1.0));
@@ -92,7 +87,7 @@ fn imprint_learns_a_repainted_ball() {
             assert!(o.h[0] > o.h[1] || o.h[0] < 8.0, "band around red: {o:?}");
         }
         for (dist, a) in [(1.0, 0.0), (1.33, 0.0), (1.5, 30.0), (2.0, -20.0)] {
-            let im = render(&red, &pose_at(&red, dist, a), preset, 99);
+            let im = render(&red, &pose_seeing_origin(&red, dist, a, 0.0), preset, 99);
             let pc = s.process(&im.view(), 2.0).unwrap();
             assert!(pc.detection.pair.is_some(), "{preset:?} {dist} m {a}°");
         }
@@ -106,7 +101,7 @@ fn imprint_refuses_a_pyramid_off_the_departure_pose() {
     let d = s.imprint_distance();
     // Twice as far and 40° off: the geometry check rejects every frame.
     for (dist, a) in [(2.0 * d, 0.0), (d, 40.0)] {
-        let im = render(&p, &pose_at(&p, dist, a), LightingPreset::Lab, 5);
+        let im = render(&p, &pose_seeing_origin(&p, dist, a, 0.0), LightingPreset::Lab, 5);
         assert!(!s.imprint_frame(&im.view()).unwrap(), "{dist} m {a}°");
     }
     assert!(!s.finish_imprint(1.0));
@@ -118,7 +113,12 @@ fn fixed_mode_never_imprints_or_adapts() {
     let p = load("profiles/raposa.toml");
     let mut s = schema(&p, SegmentationMode::Fixed);
     let table = s.bands();
-    let im = render(&p, &pose_at(&p, s.imprint_distance(), 0.0), LightingPreset::Lab, 5);
+    let im = render(
+        &p,
+        &pose_seeing_origin(&p, s.imprint_distance(), 0.0, 0.0),
+        LightingPreset::Lab,
+        5,
+    );
     assert!(s.imprint_frame(&im.view()).unwrap());
     assert!(!s.finish_imprint(1.0));
     for t in 0..5 {
@@ -131,7 +131,7 @@ fn fixed_mode_never_imprints_or_adapts() {
 fn adaptation_follows_the_target_and_falls_back_when_lost() {
     let p = load("profiles/raposa.toml");
     let mut s = schema(&p, SegmentationMode::Adaptive);
-    let near = render(&p, &pose_at(&p, 1.0, 10.0), LightingPreset::Lab, 5);
+    let near = render(&p, &pose_seeing_origin(&p, 1.0, 10.0, 0.0), LightingPreset::Lab, 5);
     assert!(s.process(&near.view(), 0.0).unwrap().detection.pair.is_some());
     assert_eq!(s.model().mode(), ColorMode::Adapted);
     let adapted = s.bands();
@@ -143,7 +143,7 @@ fn adaptation_follows_the_target_and_falls_back_when_lost() {
     assert!(adapted[0].h[0] < 30.0 && adapted[0].h[1] > 30.0);
     // From other poses under the same light the adapted bands still find the pair.
     for (dist, a) in [(1.5, -20.0), (0.7, 0.0), (2.0, 30.0)] {
-        let im = render(&p, &pose_at(&p, dist, a), LightingPreset::Lab, 6);
+        let im = render(&p, &pose_seeing_origin(&p, dist, a, 0.0), LightingPreset::Lab, 6);
         assert!(
             s.process(&im.view(), 0.1).unwrap().detection.pair.is_some(),
             "{dist} m {a}°"

@@ -2,57 +2,19 @@
 //! from the blue height and α from the quadratic against the true pose, across the angles
 //! and distances of the paper's experiments, and the sign of α on either side.
 
-use marsupial::geometry::Pose2;
-use marsupial::perception::RgbImage;
-use marsupial::perception::camera_model::CameraModel;
-use marsupial::profile::Profile;
+mod common;
+
+use common::{pose_seeing_origin, render_lab, renderer, shipped_profile};
 use marsupial::schemas::PyramidSchema;
-use marsupial::sim::camera::camera_pose;
-use marsupial::sim::lighting::{LightingRun, LightingSpec};
-use marsupial::sim::render::{Renderer, SensorParams};
-use marsupial::sim::rng::Rng;
 use marsupial::sim::world;
-use std::path::Path;
-
-fn raposa() -> Profile {
-    Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml")).unwrap()
-}
-
-/// Robot pose with its camera at distance `d` from the ball, at angle `alpha_deg` around
-/// the pyramid axis, looking at the ball.
-fn pose_at(p: &Profile, d: f64, alpha_deg: f64) -> Pose2 {
-    let a = alpha_deg.to_radians();
-    let (cx, cy) = (d * a.cos(), d * a.sin());
-    // Camera looks along −(cx, cy); the body faces the other way.
-    let theta = a;
-    let mount = &p.cameras[0].mount;
-    // Camera at body (x_m, 0): centre = camera − R(θ)·(x_m, 0).
-    Pose2::new(cx - mount.x_m * theta.cos(), cy - mount.x_m * theta.sin(), theta)
-}
-
-fn render(p: &Profile, w: &world::World, pose: &Pose2, seed: u64) -> RgbImage {
-    let cam = &p.cameras[0];
-    let mut r = Renderer::new(CameraModel::from_spec(cam), cam.width_px, cam.height_px, seed);
-    let light = LightingRun::new(LightingSpec::default().resolve(), &mut Rng::new(seed), 10.0);
-    let mut out = RgbImage::default();
-    r.render(
-        &w.scene,
-        &camera_pose(pose, &cam.mount),
-        &light.at(0.0),
-        &SensorParams::default(),
-        seed,
-        &mut out,
-    );
-    out
-}
 
 #[test]
 fn distance_and_alpha_track_the_true_pose() {
-    let p = raposa();
+    let p = shipped_profile("raposa");
     let w = world::build(&p, &[], &[]).unwrap();
     for d in [0.5, 1.0, 1.5, 2.0] {
         for a in [-60.0, -30.0, -15.0, 0.0, 15.0, 30.0, 45.0, 60.0] {
-            let im = render(&p, &w, &pose_at(&p, d, a), 7);
+            let im = render_lab(&p, &w, &mut renderer(&p, 7), &pose_seeing_origin(&p, d, a, 0.0), 7, 1);
             let mut s = PyramidSchema::from_profile(&p, 0).unwrap();
             let pc = s.process(&im.view(), 0.0).unwrap();
             let v = pc.view.expect("ellipse seen");
@@ -87,11 +49,18 @@ fn distance_and_alpha_track_the_true_pose() {
 /// be estimated there.
 #[test]
 fn dead_zone_shows_the_ball_but_no_pair() {
-    let p = raposa();
+    let p = shipped_profile("raposa");
     let w = world::build(&p, &[], &[]).unwrap();
     let inset = p.body.length_m / 2.0 + p.cameras[0].mount.x_m;
     for a in [-70.0, 70.0] {
-        let im = render(&p, &w, &pose_at(&p, 0.33 + inset, a), 3);
+        let im = render_lab(
+            &p,
+            &w,
+            &mut renderer(&p, 3),
+            &pose_seeing_origin(&p, 0.33 + inset, a, 0.0),
+            3,
+            1,
+        );
         let mut s = PyramidSchema::from_profile(&p, 0).unwrap();
         let pc = s.process(&im.view(), 0.0).unwrap();
         assert!(pc.view.is_some(), "ball seen at {a}°");

@@ -1,11 +1,12 @@
 //! Helpers shared by integration tests: drawing synthetic fiducials, loading shipped
-//! profiles, a noiseless sensor.
+//! profiles, a noiseless sensor, placing a camera and rendering what it sees.
 #![allow(dead_code)]
 
+use marsupial::geometry::Pose2;
 use marsupial::perception::{RgbImage, SctRange};
 use marsupial::profile::Profile;
 #[cfg(feature = "sim")]
-use marsupial::sim::render::SensorParams;
+use marsupial::sim::render::{Renderer, SensorParams};
 use std::path::{Path, PathBuf};
 
 /// A profile shipped in `profiles/`, by name.
@@ -18,6 +19,62 @@ pub fn shipped_profile(name: &str) -> Profile {
 #[cfg(feature = "sim")]
 pub fn quiet_sensor() -> SensorParams {
     SensorParams::noiseless()
+}
+
+/// The robot pose that puts camera 0 of `p` `d` m from the dock's origin, `alpha_deg`
+/// off the dock axis (+x), with the body's +x pointing away from the origin turned by
+/// `turn_deg` (0: a camera mounted on the body axis looking backwards sees the origin
+/// straight ahead, as Bujold's and RAPOSA's do).
+pub fn pose_seeing_origin(p: &Profile, d: f64, alpha_deg: f64, turn_deg: f64) -> Pose2 {
+    let a = alpha_deg.to_radians();
+    let theta = a + turn_deg.to_radians();
+    let x = p.cameras[0].mount.x_m;
+    Pose2::new(d * a.cos() - x * theta.cos(), d * a.sin() - x * theta.sin(), theta)
+}
+
+/// A renderer for camera 0 of `p`, its noise table seeded by `seed`.
+#[cfg(feature = "sim")]
+pub fn renderer(p: &Profile, seed: u64) -> Renderer {
+    let cam = &p.cameras[0];
+    Renderer::new(
+        marsupial::perception::camera_model::CameraModel::from_spec(cam),
+        cam.width_px,
+        cam.height_px,
+        seed,
+    )
+}
+
+/// What camera 0 of `p` sees from `pose` in `world` under the default (lab) light with
+/// the default sensor: the last of `frames` renders (auto-exposure settles over the first
+/// few), light seeded by `seed` and frame k's noise by `seed + k`.
+#[cfg(feature = "sim")]
+pub fn render_lab(
+    p: &Profile,
+    world: &marsupial::sim::world::World,
+    r: &mut Renderer,
+    pose: &Pose2,
+    seed: u64,
+    frames: u64,
+) -> RgbImage {
+    use marsupial::sim::lighting::{LightingRun, LightingSpec};
+    let cam = &p.cameras[0];
+    let light = LightingRun::new(
+        LightingSpec::default().resolve(),
+        &mut marsupial::sim::rng::Rng::new(seed),
+        10.0,
+    );
+    let mut out = RgbImage::default();
+    for k in 0..frames.max(1) {
+        r.render(
+            &world.scene,
+            &marsupial::sim::camera::camera_pose(pose, &cam.mount),
+            &light.at(0.0),
+            &SensorParams::default(),
+            seed + k,
+            &mut out,
+        );
+    }
+    out
 }
 
 pub const CYAN: [u8; 3] = [20, 190, 210];
