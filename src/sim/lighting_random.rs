@@ -226,7 +226,7 @@ impl LightingDistribution {
             })
             .collect();
         let n_shadows = count(rng, self.shadows);
-        let mut speeds = Vec::with_capacity(n_shadows as usize);
+        let mut fastest = 0.0f64;
         let shadows: Vec<ShadowSpec> = (0..n_shadows)
             .map(|_| {
                 let strength = uni(rng, self.shadow_strength);
@@ -235,7 +235,7 @@ impl LightingDistribution {
                 let travel = uni(rng, self.shadow_travel_m);
                 let angle_deg = uni(rng, self.shadow_angle_deg);
                 let offset_m = rng.range(-0.05, 0.05);
-                speeds.push(speed);
+                fastest = fastest.max(speed);
                 // A sinusoidal sweep of ±travel whose peak speed is `speed`: 2π·travel/T.
                 let (amplitude_m, period_s) = if speed > 0.0 && travel > 0.0 {
                     (travel, std::f64::consts::TAU * travel / speed)
@@ -257,35 +257,32 @@ impl LightingDistribution {
             mean_interval_s: uni(rng, self.cloud_interval_s),
             depth: uni(rng, self.cloud_depth),
         };
-        let params: BTreeMap<String, f64> = [
-            ("intensity", intensity),
-            ("outdoor", f64::from(u8::from(outdoor))),
-            ("ambient", ambient),
-            ("sun", if outdoor { sun } else { 0.0 }),
-            ("sun_elevation_deg", elevation),
-            ("sun_azimuth_deg", azimuth),
-            ("glare", glare),
-            ("beacons", f64::from(n_beacons)),
-            ("beacon_power", flashers.iter().map(|f| f.power).fold(0.0, f64::max)),
-            (
-                "beacon_distance_m",
-                flashers
-                    .iter()
-                    .map(|f| f.x_m.hypot(f.y_m))
-                    .reduce(f64::min)
-                    .unwrap_or(0.0),
-            ),
-            ("shadows", f64::from(n_shadows)),
-            ("shadow_speed_mps", speeds.iter().copied().fold(0.0, f64::max)),
-            (
-                "shadow_strength",
-                shadows.iter().map(|s| s.strength).fold(0.0, f64::max),
-            ),
-            ("clouds", f64::from(u8::from(cloudy))),
-        ]
-        .into_iter()
-        .map(|(k, v)| (k.to_string(), v))
-        .collect();
+        // In the order of [`LightingDraw::PARAMS`], which names them.
+        let values = [
+            intensity,
+            f64::from(u8::from(outdoor)),
+            ambient,
+            if outdoor { sun } else { 0.0 },
+            elevation,
+            azimuth,
+            glare,
+            f64::from(n_beacons),
+            flashers.iter().map(|f| f.power).fold(0.0, f64::max),
+            flashers
+                .iter()
+                .map(|f| f.x_m.hypot(f.y_m))
+                .reduce(f64::min)
+                .unwrap_or(0.0),
+            f64::from(n_shadows),
+            fastest,
+            shadows.iter().map(|s| s.strength).fold(0.0, f64::max),
+            f64::from(u8::from(cloudy)),
+        ];
+        let params = LightingDraw::PARAMS
+            .iter()
+            .zip(values)
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
         let spec = LightingSpec {
             preset: Some(LightingPreset::Lab),
             intensity: Some(intensity),
