@@ -256,3 +256,44 @@ fn ballistic_go_to_then_close_dock_from_beyond_sight() {
     }
     assert_eq!(c.summary.overall.successes, c.records.len());
 }
+
+/// The starts of the lighting tests: near on the axis, mid-range to one side, far.
+const LIGHTING_STARTS: &str = "seed = 31\ntrials = 1\n[starts]\ngrid = \"paper16\"\nselect = [2, 5, 9]\nposition_jitter_m = 0.02\nheading_jitter_deg = 3.0\n[sensor]\nwhite_balance = \"switch\"\n";
+
+/// A green rotating beacon (not the flashers preset's orange) 0.75 m from the flap, at
+/// twice the room's light at 1 m, sweeping its colour over the flap once a second: the
+/// adaptation must neither follow the flash nor lose the blocks while it passes.
+#[test]
+fn docks_beside_a_green_beacon_from_three_starts() {
+    let c = run_bujold(
+        "green-beacon",
+        &format!(
+            "{LIGHTING_STARTS}[axes]\nlighting = [\"beacon\"]\n[lighting.beacon]\npreset = \"lab\"\n\
+             flashers = [{{ x_m = 0.45, y_m = 0.6, z_m = 0.4, period_s = 1.0, power = 2.0, rgb = [0, 200, 60] }}]\n"
+        ),
+    );
+    assert_eq!(c.records.len(), 3);
+    for r in &c.records {
+        assert_docked(r);
+        assert_within_tolerance(&c, r);
+    }
+}
+
+/// A shadow edge (half the light removed, 1 cm penumbra) swinging ±10 cm across the
+/// 18 cm flap every 0.6 s, so at up to 2π·0.1/0.6 ≈ 1.05 m/s, walking pace: each block
+/// is lit, half-shadowed and shadowed several times a second.
+#[test]
+fn docks_under_a_fast_shadow_edge_from_three_starts() {
+    let c = run_bujold(
+        "fast-shadow",
+        &format!(
+            "{LIGHTING_STARTS}[axes]\nlighting = [\"shadow\"]\n[lighting.shadow]\npreset = \"lab\"\n\
+             shadows = [{{ strength = 0.5, angle_deg = 0.0, offset_m = 0.0, amplitude_m = 0.1, period_s = 0.6, softness_m = 0.01 }}]\n"
+        ),
+    );
+    assert_eq!(c.records.len(), 3);
+    for r in &c.records {
+        assert_docked(r);
+        assert_within_tolerance(&c, r);
+    }
+}
