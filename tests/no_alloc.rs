@@ -408,6 +408,19 @@ fn composed_raposa_ticks_do_not_allocate() {
 #[cfg(feature = "sim")]
 #[test]
 fn a_simulated_robots_lockstep_ticks_do_not_allocate() {
+    simulated_lockstep_ticks(false);
+}
+
+/// The same with every camera imperfection on (motion blur, rolling shutter, vignetting,
+/// defocus, JPEG): their buffers are sized by the first frames and reused.
+#[cfg(feature = "sim")]
+#[test]
+fn a_simulated_robots_lockstep_ticks_do_not_allocate_with_every_camera_imperfection() {
+    simulated_lockstep_ticks(true);
+}
+
+#[cfg(feature = "sim")]
+fn simulated_lockstep_ticks(imperfect: bool) {
     use marsupial::arbiter::{Lockstep, LoopStatus, ReactiveLoop};
     use marsupial::behaviors::agent_for;
     use marsupial::schemas::Mission;
@@ -417,7 +430,16 @@ fn a_simulated_robots_lockstep_ticks_do_not_allocate() {
     use marsupial::sim::scenario::Scenario;
 
     let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/bujold-table1.toml");
-    let prepared = campaign::prepare(Scenario::load(&scenario).unwrap()).unwrap();
+    let mut scenario = Scenario::load(&scenario).unwrap();
+    if imperfect {
+        let s = &mut scenario.scenario.sensor;
+        s.motion_blur = true;
+        s.rolling_shutter_readout_s = 0.03;
+        s.vignetting_corner = 0.65;
+        s.focus_m = Some(1.0);
+        s.jpeg_quality = 80;
+    }
+    let prepared = campaign::prepare(scenario).unwrap();
     let profile = &prepared.loaded.profile;
     let sim = docked_robot(&prepared, &prepared.runs[0]);
     let mut robot = sim.robot(&SimDevices::default()).unwrap();

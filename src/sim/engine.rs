@@ -11,7 +11,7 @@ use super::camera::camera_pose;
 use super::dock::{Contact, judge};
 use super::lighting::{LightState, LightingRun, ShadowBand};
 use super::motion::Motion;
-use super::render::{Renderer, SensorParams};
+use super::render::{CameraMotion, Renderer, SensorParams};
 use super::rng::Rng;
 use super::tether::Tether;
 use super::world::World;
@@ -61,6 +61,10 @@ pub struct Sim {
     light_now: LightState,
     motion: Motion,
     pose: Pose2,
+    /// The true body velocity over the last physics substep: forward m/s, leftward m/s,
+    /// yaw rad/s (slip, the pouch's walls and blocking included), which the cameras'
+    /// motion blur and rolling shutter see.
+    body_velocity: [f64; 3],
     odometry: Odometry,
     tether: Option<Tether>,
     posture: Posture,
@@ -141,6 +145,7 @@ impl Sim {
             light_now: LightState::uniform(0.0),
             motion,
             pose: Pose2::default(),
+            body_velocity: [0.0; 3],
             odometry: Odometry::new(drive_model, Pose2::default()),
             tether,
             posture: Posture::Raised,
@@ -201,6 +206,7 @@ impl Sim {
     /// odometry and the run's clocks and counters.
     pub fn place(&mut self, pose: Pose2, inside: bool) {
         self.pose = pose;
+        self.body_velocity = [0.0; 3];
         self.motion.halt();
         self.odometry = Odometry::new(self.profile.drive.model(), Pose2::default());
         self.inside = inside;
@@ -286,11 +292,32 @@ impl Sim {
             self.light_now = light;
         }
         let pose = camera_pose(&self.pose, &spec.mount);
+        if self.sensor.motion_blur || self.sensor.rolling_shutter_readout_s > 0.0 {
+            let motion = self.camera_motion(&pose);
+            self.renderers[i].set_motion(motion);
+        }
         frame.resize(spec.width_px, spec.height_px);
         let seed = self.rng.next_u64() ^ self.frame_count;
         self.renderers[i].render(&self.world.scene, &pose, &self.light_now, &self.sensor, seed, frame);
         if i + 1 == self.profile.cameras.len() {
             self.frame_count += 1;
+        }
+    }
+
+    /// The motion of a camera at `pose` (on the robot) during this frame, in the camera
+    /// frame: the body's true yaw rate, and the optical centre's velocity (the body's
+    /// velocity plus the yaw rate across the mount's lever arm).
+    fn camera_motion(&self, pose: &super::render::CameraPose) -> CameraMotion {
+        let [v, lateral, omega] = self.body_velocity;
+        let (s, c) = self.pose.theta.sin_cos();
+        let body = nalgebra::Vector3::new(c * v - s * lateral, s * v + c * lateral, 0.0);
+        let arm = pose.position - nalgebra::Point3::new(self.pose.x, self.pose.y, pose.position.z);
+        let w = nalgebra::Vector3::new(0.0, 0.0, omega);
+        let rt = pose.rotation.transpose();
+        let (wc, vc) = (rt * w, rt * (body + w.cross(&arm)));
+        CameraMotion {
+            omega: [wc.x as f32, wc.y as f32, wc.z as f32],
+            velocity: [vc.x as f32, vc.y as f32, vc.z as f32],
         }
     }
 
@@ -383,6 +410,14 @@ impl Sim {
                     return Some(PhaseEnd::Stuck { lateral, heading });
                 }
             }
+            // The true body velocity over this substep, in the body frame at its start.
+            let (sn, cs) = from.theta.sin_cos();
+            let (dx, dy) = (self.pose.x - from.x, self.pose.y - from.y);
+            self.body_velocity = [
+                (cs * dx + sn * dy) / dt,
+                (-sn * dx + cs * dy) / dt,
+                crate::geometry::wrap_angle(self.pose.theta - from.theta) / dt,
+            ];
             let enc = self.motion.encoders();
             let (dl, dr) = (enc.left - self.encoder_ref.0, enc.right - self.encoder_ref.1);
             self.encoder_ref = (enc.left, enc.right);

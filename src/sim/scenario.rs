@@ -9,7 +9,7 @@
 use super::lighting::{Lighting, LightingPreset, LightingSpec};
 use super::lighting_random::{LightingDistribution, LightingDraw};
 use super::motion::{SlipSpec, Terrain};
-use super::render::{SensorParams, WhiteBalance};
+use super::render::{Defocus, SensorParams, WhiteBalance};
 use super::rng::Rng;
 use super::world::ClutterSpec;
 use crate::config::{self, ConfigError, Validate, Validator};
@@ -181,6 +181,25 @@ pub struct SensorSpec {
     /// Auto-exposure's highlight protection: the largest fraction of pixels it lets clip
     /// (0–1; 1 meters the mean alone and lets a sunlit target burn out).
     pub highlight_clip_frac: f64,
+    /// Motion blur from the robot's own motion during each exposure, whose length
+    /// follows auto-exposure (`SensorParams::exposure_time_s`). Off by default.
+    pub motion_blur: bool,
+    /// Rolling shutter: time from the first row's exposure to the last's, s (0, the
+    /// default: a global shutter). At most 1 s.
+    pub rolling_shutter_readout_s: f64,
+    /// Vignetting: a corner's illumination relative to the centre, (0, 1]; 1 (the
+    /// default) is none.
+    pub vignetting_corner: f64,
+    /// Defocus: the distance the lens is focused at, m. Absent (the default): a pin-hole,
+    /// sharp at every depth.
+    pub focus_m: Option<f64>,
+    /// The lens's f-number, used with `focus_m` (default 2.0, a webcam's).
+    pub f_number: f64,
+    /// The lens's physical focal length, mm, used with `focus_m` (default 3.6, the usual
+    /// webcam lens).
+    pub focal_length_mm: f64,
+    /// JPEG quality of the camera's stream, 1–100; 0 (the default) delivers raw frames.
+    pub jpeg_quality: u32,
 }
 
 impl Default for SensorSpec {
@@ -194,6 +213,13 @@ impl Default for SensorSpec {
             white_balance: WhiteBalanceSpec::GreyWorld,
             white_balance_tau_s: f64::from(d.white_balance_tau_s),
             highlight_clip_frac: 0.01,
+            motion_blur: false,
+            rolling_shutter_readout_s: 0.0,
+            vignetting_corner: 1.0,
+            focus_m: None,
+            f_number: 2.0,
+            focal_length_mm: 3.6,
+            jpeg_quality: 0,
         }
     }
 }
@@ -450,6 +476,27 @@ impl Validate for Scenario {
         v.positive("sensor.max_integration", self.sensor.max_integration);
         v.non_negative("sensor.white_balance_tau_s", self.sensor.white_balance_tau_s);
         v.range("sensor.highlight_clip_frac", self.sensor.highlight_clip_frac, 0.0, 1.0);
+        v.range(
+            "sensor.rolling_shutter_readout_s",
+            self.sensor.rolling_shutter_readout_s,
+            0.0,
+            1.0,
+        );
+        v.fraction("sensor.vignetting_corner", self.sensor.vignetting_corner);
+        if let Some(f) = self.sensor.focus_m {
+            v.positive("sensor.focus_m", f);
+        }
+        v.range("sensor.f_number", self.sensor.f_number, 0.5, 64.0);
+        v.range("sensor.focal_length_mm", self.sensor.focal_length_mm, 0.5, 300.0);
+        if let Some(f) = self.sensor.focus_m {
+            let mm = self.sensor.focal_length_mm;
+            v.require(!f.is_finite() || f > mm * 1e-3, "sensor.focus_m", || {
+                format!("expected a focus farther than the focal length ({mm} mm), got {f} m")
+            });
+        }
+        v.require(self.sensor.jpeg_quality <= 100, "sensor.jpeg_quality", || {
+            format!("expected 0 (off) or a quality 1–100, got {}", self.sensor.jpeg_quality)
+        });
         v.non_negative("motion.latency_s", self.motion.latency_s);
         v.positive("motion.accel_mps2", self.motion.accel_mps2);
         v.positive("motion.yaw_accel_dps2", self.motion.yaw_accel_dps2);
@@ -623,6 +670,15 @@ impl Scenario {
             white_balance,
             white_balance_tau_s: self.sensor.white_balance_tau_s as f32,
             highlight_clip: self.sensor.highlight_clip_frac as f32,
+            motion_blur: self.sensor.motion_blur,
+            rolling_shutter_readout_s: self.sensor.rolling_shutter_readout_s as f32,
+            vignetting_corner: self.sensor.vignetting_corner as f32,
+            defocus: self.sensor.focus_m.map(|focus_m| Defocus {
+                focus_m: focus_m as f32,
+                f_number: self.sensor.f_number as f32,
+                focal_length_mm: self.sensor.focal_length_mm as f32,
+            }),
+            jpeg_quality: self.sensor.jpeg_quality.min(100) as u8,
             ..SensorParams::default()
         }
     }

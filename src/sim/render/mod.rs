@@ -14,13 +14,22 @@
 //! the row's rays (`hits::hit_row`, vectorised by the compiler), then a shading pass
 //! visits only the covered pixels that are not yet full (`texture`, shadows, glare).
 //! The `sensor` module then turns radiance into 8-bit RGB.
+//!
+//! Between the two, when a scenario asks for them, the `optics` module applies the lens
+//! and shutter's imperfections to the radiance (defocus from each pixel's depth, the
+//! camera's own motion as blur and rolling-shutter skew, vignetting), and after the
+//! sensor the `jpeg` module compresses and decodes the frame as a webcam's stream does.
+//! With all of them off (the default) the renderer keeps no depth and does no extra pass.
 
 mod hits;
+pub mod jpeg;
+pub mod optics;
 mod rays;
 mod sensor;
 mod texture;
 
-pub use sensor::{SensorParams, WhiteBalance};
+pub use optics::CameraMotion;
+pub use sensor::{Defocus, SensorParams, WhiteBalance};
 
 use super::lighting::LightState;
 use super::scene::{Prim, Scene, Shape};
@@ -61,6 +70,20 @@ pub struct Renderer {
     /// One row's open runs.
     runs: Vec<(usize, usize)>,
     sensor: Sensor,
+    /// Depth along the optical axis of the surface that covers each pixel most, m
+    /// (sized and kept only while an effect needs it).
+    depth: Vec<f32>,
+    /// Keep `depth` this frame.
+    track_depth: bool,
+    /// The camera's motion during the next exposure.
+    motion: CameraMotion,
+    /// Focal length in pixels (the pin-hole's fx; a fisheye's scale at the centre).
+    f_px: f32,
+    /// Vignetting gains per pixel, and the corner illumination they were built for.
+    vignette: Vec<f32>,
+    vignette_corner: f32,
+    optics: optics::Scratch,
+    jpeg: jpeg::JpegCodec,
 }
 
 impl Renderer {
@@ -68,8 +91,13 @@ impl Renderer {
     pub fn new(model: CameraModel, width: usize, height: usize, noise_seed: u64) -> Self {
         let mut hits = RowHits::default();
         hits.reserve_row(width);
+        let rays = RayTable::new(&model, width, height);
+        let f_px = match &model {
+            CameraModel::Pinhole(m) => m.fx as f32,
+            _ => rays.inv_ang[(height / 2) * width + width / 2],
+        };
         Self {
-            rays: RayTable::new(&model, width, height),
+            rays,
             model,
             width,
             height,
@@ -80,7 +108,26 @@ impl Renderer {
             tex_gain: vec![0.0; width],
             runs: Vec::new(),
             sensor: Sensor::new(noise_seed),
+            depth: Vec::new(),
+            track_depth: false,
+            motion: CameraMotion::default(),
+            f_px,
+            vignette: Vec::new(),
+            vignette_corner: 1.0,
+            optics: optics::Scratch::default(),
+            jpeg: jpeg::JpegCodec::new(),
         }
+    }
+
+    /// Sets the camera's motion during the next frames' exposures (camera frame), which
+    /// motion blur and the rolling shutter act on; a renderer starts still.
+    pub fn set_motion(&mut self, motion: CameraMotion) {
+        self.motion = motion;
+    }
+
+    /// The focal length in pixels the lens effects use.
+    pub fn focal_px(&self) -> f32 {
+        self.f_px
     }
 
     /// (width, height).
@@ -114,6 +161,13 @@ impl Renderer {
         let f3 = |v: Vector3<f64>| [v.x as f32, v.y as f32, v.z as f32];
         // Radiance and coverage are zero here: the ground pass and the sensor clear each
         // row as they finish with it, while it is in cache, instead of a pass of its own.
+        let moving = sensor.motion_blur || sensor.rolling_shutter_readout_s > 0.0;
+        self.track_depth = moving || sensor.defocus.is_some();
+        if self.track_depth {
+            // Sized once; every pixel starts at the sky's depth.
+            self.depth.resize(self.width * self.height, optics::SKY_DEPTH);
+            self.depth.fill(optics::SKY_DEPTH);
+        }
         // Front to back by centre distance: pixels already fully covered are skipped.
         self.order.clear();
         for (i, p) in scene.prims.iter().enumerate() {
@@ -161,8 +215,67 @@ impl Renderer {
             self.draw_prim(prim, &surface, bbox, irr, light, key);
         }
         self.draw_ground(scene, pose, light);
+        self.apply_optics(sensor);
         self.sensor
             .expose(&mut self.radiance, self.width, sensor, frame_seed, out);
+        if sensor.jpeg_quality > 0 {
+            self.jpeg.round_trip(out, sensor.jpeg_quality);
+        }
+    }
+
+    /// The lens and shutter on the radiance, in the order light meets them: defocus,
+    /// the exposure's motion (blur and rolling shutter), vignetting. The exposure time
+    /// is the one auto-exposure set from the frames before (a camera sets its shutter
+    /// before it reads the frame).
+    fn apply_optics(&mut self, sensor: &SensorParams) {
+        let w = self.width;
+        if let Some(d) = sensor.defocus {
+            let focal_m = d.focal_length_mm * 1e-3;
+            let lens = optics::Lens {
+                focus_m: d.focus_m,
+                aperture_m: focal_m / d.f_number.max(1e-3),
+                focal_m,
+                f_px: self.f_px,
+            };
+            optics::defocus(&mut self.radiance, &self.depth, w, &lens, &mut self.optics);
+        }
+        if sensor.motion_blur || sensor.rolling_shutter_readout_s > 0.0 {
+            let k = if sensor.auto_exposure {
+                self.sensor.exposure()
+            } else {
+                sensor.exposure
+            };
+            let shutter = optics::Shutter {
+                exposure_s: if sensor.motion_blur {
+                    sensor.exposure_time_s(k)
+                } else {
+                    0.0
+                },
+                readout_s: sensor.rolling_shutter_readout_s.max(0.0),
+                f_px: self.f_px,
+            };
+            let rays = [&self.rays.x[..], &self.rays.y[..], &self.rays.z[..]];
+            optics::smear(
+                &mut self.radiance,
+                &self.depth,
+                rays,
+                w,
+                &self.motion,
+                &shutter,
+                &mut self.optics,
+            );
+        }
+        if sensor.vignetting_corner < 1.0 {
+            if self.vignette_corner != sensor.vignetting_corner || self.vignette.len() != w * self.height {
+                optics::vignette_gains(w, self.height, sensor.vignetting_corner, &mut self.vignette);
+                self.vignette_corner = sensor.vignetting_corner;
+            }
+            for (px, &g) in self.radiance.iter_mut().zip(&self.vignette) {
+                for c in px.iter_mut() {
+                    *c *= g;
+                }
+            }
+        }
     }
 
     fn screen_bounds(&self, prim: &Prim, to_cam: &dyn Fn(&Point3<f64>) -> Vector3<f64>) -> Option<[usize; 4]> {
@@ -301,9 +414,20 @@ impl Renderer {
             };
             open_runs(alpha, 0, &mut self.runs);
             for &(x0, x1) in &self.runs {
-                hit_row(ground, self.rays.row(y, x0, x1), &mut self.hits);
+                let rays = self.rays.row(y, x0, x1);
+                hit_row(ground, rays, &mut self.hits);
                 let h = &self.hits;
                 let n = x1 - x0;
+                if self.track_depth {
+                    // The ground is the deepest surface: it owns the pixels still less
+                    // than half covered.
+                    let depth = &mut self.depth[y * w + x0..y * w + x1];
+                    for j in 0..n {
+                        if alpha[x0 + j] < 0.5 && h.cov[j] > 0.0 {
+                            depth[j] = h.t[j] * rays.z[j];
+                        }
+                    }
+                }
                 if let Some(base) = tex.noise_row(&h.a[..n], &h.b[..n], &h.fp[..n], &mut self.tex_gain) {
                     // Value-noise ground (the usual one): branch-free, so it vectorises.
                     // Full pixels add nothing; sky pixels add sky.
@@ -379,13 +503,29 @@ impl Renderer {
             open_runs(&self.alpha[y * w + bx0..y * w + bx1], bx0, &mut runs);
             for &(x0, x1) in &runs {
                 let rays = self.rays.row(y, x0, x1);
-                if plain_solid {
+                if plain_solid && !self.track_depth {
                     cover_row(s, rays, &mut self.hits);
                 } else {
                     hit_row(s, rays, &mut self.hits);
                 }
                 let h = &self.hits;
                 let n = x1 - x0;
+                if self.track_depth {
+                    // The surface whose coverage takes a pixel past half owns its depth.
+                    let base = y * w + x0;
+                    let (alpha, depth) = (&self.alpha[base..base + n], &mut self.depth[base..base + n]);
+                    for j in 0..n {
+                        let (a, rest) = (alpha[j], 1.0 - alpha[j]);
+                        let k = if (h.cov[j] > 0.0) & (rest > 1e-3) {
+                            rest * h.cov[j]
+                        } else {
+                            0.0
+                        };
+                        if a < 0.5 && a + k >= 0.5 {
+                            depth[j] = h.t[j] * rays.z[j];
+                        }
+                    }
+                }
                 let noise_base = tex.noise_row(&h.a[..n], &h.b[..n], &h.fp[..n], &mut self.tex_gain);
                 let base = y * w + x0;
                 if matte {

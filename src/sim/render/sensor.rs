@@ -69,13 +69,41 @@ pub struct SensorParams {
     /// Time between frames, s (the simulator renders every camera every loop tick, so it
     /// sets this from the profile's loop rate).
     pub frame_interval_s: f32,
+    /// Blur each frame by the camera's own motion during its exposure time
+    /// ([`SensorParams::exposure_time_s`]), which auto-exposure lengthens in dim light.
+    pub motion_blur: bool,
+    /// Rolling shutter: time from the first row's exposure to the last's, s (0: a global
+    /// shutter, every row at once).
+    pub rolling_shutter_readout_s: f32,
+    /// Vignetting: the light a corner pixel receives relative to the centre, (0, 1]
+    /// (1: none), with the cos⁴ law's shape in between; it darkens the radiance before
+    /// auto-exposure meters it and before the noise, as on a real sensor.
+    pub vignetting_corner: f32,
+    /// A thin lens's defocus (`None`: a pin-hole, sharp at every depth).
+    pub defocus: Option<Defocus>,
+    /// JPEG quality of the camera's stream, 1–100 (IJG scaling); 0 delivers the raw frame.
+    pub jpeg_quality: u8,
+}
+
+/// A lens focused at one distance: what makes a near target blurred.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Defocus {
+    /// Distance the lens is focused at, m.
+    pub focus_m: f32,
+    /// f-number N (focal length over aperture diameter).
+    pub f_number: f32,
+    /// Physical focal length, mm (with N it gives the aperture diameter; the image scale
+    /// in pixels comes from the camera model).
+    pub focal_length_mm: f32,
 }
 
 impl Default for SensorParams {
     /// A small, cheap colour sensor: 2,100 e⁻ full well and 12 e⁻ read noise, which at
     /// unity gain give 1.5 linear 8-bit units of read noise and 0.35·√signal of shot noise
     /// (the model's earlier defaults, now added in quadrature), grey-world white balance
-    /// settling with a 1 s time constant, 10 frames a second.
+    /// settling with a 1 s time constant, 10 frames a second. The lens and shutter
+    /// imperfections (motion blur, rolling shutter, vignetting, defocus, JPEG) are off, so
+    /// a scenario that does not ask for them renders as before.
     fn default() -> Self {
         Self {
             full_well_e: 2100.0,
@@ -89,6 +117,11 @@ impl Default for SensorParams {
             highlight_clip: 0.01,
             white_balance_tau_s: 1.0,
             frame_interval_s: 0.1,
+            motion_blur: false,
+            rolling_shutter_readout_s: 0.0,
+            vignetting_corner: 1.0,
+            defocus: None,
+            jpeg_quality: 0,
         }
     }
 }
@@ -98,6 +131,15 @@ impl SensorParams {
     /// integration time can supply it, more beyond.
     pub fn analogue_gain(&self, k: f32) -> f32 {
         self.gain.max(1e-6) * (k / self.max_integration.max(1e-6)).max(1.0)
+    }
+
+    /// Exposure (integration) time, s, of a frame taken at exposure multiplier `k`: the
+    /// integration at `max_integration` fills the frame interval, shorter exposures take
+    /// their share of it, and beyond `max_integration` the gain rises instead, so
+    /// T = min(k, max_integration) / max_integration × `frame_interval_s`.
+    pub fn exposure_time_s(&self, k: f32) -> f32 {
+        let m = self.max_integration.max(1e-6);
+        k.clamp(0.0, m) / m * self.frame_interval_s.max(0.0)
     }
 
     /// Noise SD in linear 8-bit units (0–255) of a pixel at output linear level `lin`
