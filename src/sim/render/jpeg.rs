@@ -49,6 +49,15 @@ const CHROMA_Q: [u16; 64] = [
     99, 99, 99, 99, 99, 99, 99, 99,
 ];
 
+/// Rounds to the nearest integer (ties to even) for |x| < 2²²: adding and removing
+/// 1.5·2²³ leaves the float rounded by the FPU. `f32::round` is a libm call on the baseline
+/// x86-64 target, and the round trip rounds every sample and coefficient.
+#[inline(always)]
+fn rint(x: f32) -> f32 {
+    const MAGIC: f32 = 12_582_912.0;
+    (x + MAGIC) - MAGIC
+}
+
 /// A base table scaled for `quality` (1–100, clamped) as libjpeg scales it.
 pub fn scaled_table(base: &[u16; 64], quality: u8) -> [f32; 64] {
     let q = i32::from(quality.clamp(1, 100));
@@ -79,14 +88,22 @@ pub fn fdct8x8(c: &[[f32; 8]; 8], block: &mut [f32; 64]) {
     // Rows: tmp[y][k] = Σₙ C[k][n]·block[y][n].
     for y in 0..8 {
         for k in 0..8 {
-            tmp[y * 8 + k] = (0..8).map(|n| c[k][n] * block[y * 8 + n]).sum();
+            let mut s = 0.0;
+            for n in 0..8 {
+                s += c[k][n] * block[y * 8 + n];
+            }
+            tmp[y * 8 + k] = s;
         }
     }
-    // Columns: block[k][x] = Σₙ C[k][n]·tmp[n][x].
-    for x in 0..8 {
-        for k in 0..8 {
-            block[k * 8 + x] = (0..8).map(|n| c[k][n] * tmp[n * 8 + x]).sum();
+    // Columns: block[k][·] = Σₙ C[k][n]·tmp[n][·], a row of eight at a time.
+    for k in 0..8 {
+        let mut row = [0.0f32; 8];
+        for n in 0..8 {
+            for x in 0..8 {
+                row[x] += c[k][n] * tmp[n * 8 + x];
+            }
         }
+        block[k * 8..k * 8 + 8].copy_from_slice(&row);
     }
 }
 
@@ -95,13 +112,21 @@ pub fn idct8x8(c: &[[f32; 8]; 8], block: &mut [f32; 64]) {
     let mut tmp = [0.0f32; 64];
     for y in 0..8 {
         for n in 0..8 {
-            tmp[y * 8 + n] = (0..8).map(|k| c[k][n] * block[y * 8 + k]).sum();
+            let mut s = 0.0;
+            for k in 0..8 {
+                s += c[k][n] * block[y * 8 + k];
+            }
+            tmp[y * 8 + n] = s;
         }
     }
-    for x in 0..8 {
-        for n in 0..8 {
-            block[n * 8 + x] = (0..8).map(|k| c[k][n] * tmp[k * 8 + x]).sum();
+    for n in 0..8 {
+        let mut row = [0.0f32; 8];
+        for k in 0..8 {
+            for x in 0..8 {
+                row[x] += c[k][n] * tmp[k * 8 + x];
+            }
         }
+        block[n * 8..n * 8 + 8].copy_from_slice(&row);
     }
 }
 
@@ -113,6 +138,9 @@ pub struct JpegCodec {
     quality: u8,
     luma_q: [f32; 64],
     chroma_q: [f32; 64],
+    /// Reciprocals of the tables' entries (the quantiser multiplies).
+    luma_inv: [f32; 64],
+    chroma_inv: [f32; 64],
     /// Planes padded to whole blocks: luminance at full size, chroma at half.
     y: Vec<f32>,
     cb: Vec<f32>,
@@ -133,6 +161,8 @@ impl JpegCodec {
             quality: 0,
             luma_q: [1.0; 64],
             chroma_q: [1.0; 64],
+            luma_inv: [1.0; 64],
+            chroma_inv: [1.0; 64],
             y: Vec::new(),
             cb: Vec::new(),
             cr: Vec::new(),
@@ -150,6 +180,8 @@ impl JpegCodec {
             self.quality = quality;
             self.luma_q = scaled_table(&LUMA_Q, quality);
             self.chroma_q = scaled_table(&CHROMA_Q, quality);
+            self.luma_inv = self.luma_q.map(|q| 1.0 / q);
+            self.chroma_inv = self.chroma_q.map(|q| 1.0 / q);
         }
         // Luminance padded to whole macroblocks, so the chroma planes are whole blocks.
         let (pw, ph) = (w.div_ceil(16) * 16, h.div_ceil(16) * 16);
@@ -168,13 +200,9 @@ impl JpegCodec {
                 let sx = px.min(w - 1);
                 let i = (sy * w + sx) * 3;
                 let (r, g, b) = (bytes[i] as f32, bytes[i + 1] as f32, bytes[i + 2] as f32);
-                let yy = (0.299 * r + 0.587 * g + 0.114 * b).round();
-                let cb = (-0.168_736 * r - 0.331_264 * g + 0.5 * b + 128.0)
-                    .round()
-                    .clamp(0.0, 255.0);
-                let cr = (0.5 * r - 0.418_688 * g - 0.081_312 * b + 128.0)
-                    .round()
-                    .clamp(0.0, 255.0);
+                let yy = rint(0.299 * r + 0.587 * g + 0.114 * b);
+                let cb = rint(-0.168_736 * r - 0.331_264 * g + 0.5 * b + 128.0).clamp(0.0, 255.0);
+                let cr = rint(0.5 * r - 0.418_688 * g - 0.081_312 * b + 128.0).clamp(0.0, 255.0);
                 self.y[py * pw + px] = yy;
                 let ci = (py / 2) * cw + px / 2;
                 self.cb[ci] += cb;
@@ -182,12 +210,12 @@ impl JpegCodec {
             }
         }
         for v in self.cb.iter_mut().chain(self.cr.iter_mut()) {
-            *v = (*v * 0.25).round();
+            *v = rint(*v * 0.25);
         }
         let dct = self.dct;
-        code_plane(&dct, &mut self.y, pw, ph, &self.luma_q);
-        code_plane(&dct, &mut self.cb, cw, ch, &self.chroma_q);
-        code_plane(&dct, &mut self.cr, cw, ch, &self.chroma_q);
+        code_plane(&dct, &mut self.y, pw, ph, &self.luma_q, &self.luma_inv);
+        code_plane(&dct, &mut self.cb, cw, ch, &self.chroma_q, &self.chroma_inv);
+        code_plane(&dct, &mut self.cr, cw, ch, &self.chroma_q, &self.chroma_inv);
         let out = img.as_bytes_mut();
         for y in 0..h {
             for x in 0..w {
@@ -198,17 +226,18 @@ impl JpegCodec {
                 let g = yy - 0.344_136 * cb - 0.714_136 * cr;
                 let b = yy + 1.772 * cb;
                 let o = (y * w + x) * 3;
-                out[o] = r.round().clamp(0.0, 255.0) as u8;
-                out[o + 1] = g.round().clamp(0.0, 255.0) as u8;
-                out[o + 2] = b.round().clamp(0.0, 255.0) as u8;
+                out[o] = rint(r).clamp(0.0, 255.0) as u8;
+                out[o + 1] = rint(g).clamp(0.0, 255.0) as u8;
+                out[o + 2] = rint(b).clamp(0.0, 255.0) as u8;
             }
         }
     }
 }
 
 /// Encodes and decodes one plane (`w × h`, both multiples of 8, samples 0–255) in place:
-/// level shift, DCT, quantise with `q`, dequantise, inverse DCT, round and clamp.
-fn code_plane(dct: &[[f32; 8]; 8], plane: &mut [f32], w: usize, h: usize, q: &[f32; 64]) {
+/// level shift, DCT, quantise with `q` (`inv` its reciprocals), dequantise, inverse DCT,
+/// round and clamp.
+fn code_plane(dct: &[[f32; 8]; 8], plane: &mut [f32], w: usize, h: usize, q: &[f32; 64], inv: &[f32; 64]) {
     let mut block = [0.0f32; 64];
     for by in (0..h).step_by(8) {
         for bx in (0..w).step_by(8) {
@@ -219,14 +248,14 @@ fn code_plane(dct: &[[f32; 8]; 8], plane: &mut [f32], w: usize, h: usize, q: &[f
                 }
             }
             fdct8x8(dct, &mut block);
-            for (b, &qq) in block.iter_mut().zip(q) {
-                *b = (*b / qq).round() * qq;
+            for ((b, &qq), &iq) in block.iter_mut().zip(q).zip(inv) {
+                *b = rint(*b * iq) * qq;
             }
             idct8x8(dct, &mut block);
             for r in 0..8 {
                 let row = &mut plane[(by + r) * w + bx..][..8];
                 for (v, &b) in row.iter_mut().zip(&block[r * 8..r * 8 + 8]) {
-                    *v = (b + 128.0).round().clamp(0.0, 255.0);
+                    *v = rint(b + 128.0).clamp(0.0, 255.0);
                 }
             }
         }

@@ -67,6 +67,22 @@ impl Lens {
         let k = self.aperture_m * self.f_px * s / (s - self.focal_m).max(1e-6);
         k * (1.0 / s - 1.0 / z.max(1e-3)).abs()
     }
+
+    /// The depths (near, far), m, between which the box standing for the circle of
+    /// confusion is at most `px` pixels wide after scaling by `scale`: a pixel there
+    /// needs no blur, which a comparison tells without a division.
+    fn sharp_depths(&self, scale: f32, px: f32) -> (f32, f32) {
+        let s = self.focus_m;
+        let k = scale * self.aperture_m * self.f_px * s / (s - self.focal_m).max(1e-6);
+        let d = px / k.max(1e-12);
+        let near = 1.0 / (1.0 / s + d);
+        let far = if 1.0 / s - d > 0.0 {
+            1.0 / (1.0 / s - d)
+        } else {
+            f32::INFINITY
+        };
+        (near, far)
+    }
 }
 
 /// Row scratch: a line of values and its prefix sums.
@@ -100,7 +116,12 @@ fn integral(p: &[[f32; 3]], a: f32) -> [f32; 3] {
     let a = a.clamp(0.0, n as f32);
     let i = (a as usize).min(n - 1);
     let f = a - i as f32;
-    [0, 1, 2].map(|c| p[i][c] + f * (p[i + 1][c] - p[i][c]))
+    let (lo, hi) = (p[i], p[i + 1]);
+    [
+        lo[0] + f * (hi[0] - lo[0]),
+        lo[1] + f * (hi[1] - lo[1]),
+        lo[2] + f * (hi[2] - lo[2]),
+    ]
 }
 
 /// Replaces each value of `line` by its mean over [centre − w/2, centre + w/2] with
@@ -112,9 +133,11 @@ fn box_line(line: &mut [[f32; 3]], prefix: &mut [[f32; 3]], width: &[f32], shift
     if n == 0 {
         return;
     }
-    prefix[0] = [0.0; 3];
-    for i in 0..n {
-        prefix[i + 1] = [0, 1, 2].map(|c| prefix[i][c] + line[i][c]);
+    let mut acc = [0.0f32; 3];
+    prefix[0] = acc;
+    for (p, v) in prefix[1..=n].iter_mut().zip(line.iter()) {
+        acc = [acc[0] + v[0], acc[1] + v[1], acc[2] + v[2]];
+        *p = acc;
     }
     let p = &prefix[..=n];
     let nf = n as f32;
@@ -125,12 +148,13 @@ fn box_line(line: &mut [[f32; 3]], prefix: &mut [[f32; 3]], width: &[f32], shift
         if hi - lo < 1e-4 {
             // A box of no width, or wholly off the line: the pixel under its centre.
             let j = centre.clamp(0.0, nf - 1.0) as usize;
-            line[i] = [0, 1, 2].map(|c| p[j + 1][c] - p[j][c]);
+            let (a, b) = (p[j], p[j + 1]);
+            line[i] = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
             continue;
         }
         let (a, b) = (integral(p, lo), integral(p, hi));
         let inv = 1.0 / (hi - lo);
-        line[i] = [0, 1, 2].map(|c| (b[c] - a[c]) * inv);
+        line[i] = [(b[0] - a[0]) * inv, (b[1] - a[1]) * inv, (b[2] - a[2]) * inv];
     }
 }
 
@@ -147,29 +171,30 @@ pub(super) fn defocus(radiance: &mut [[f32; 3]], depth: &[f32], width: usize, le
         shift,
     } = s;
     shift[..width.max(height)].fill(0.0);
+    // A box within its own pixel changes nothing: rows and columns whose every depth is
+    // in this range are left alone.
+    let (near, far) = lens.sharp_depths(BOX_OF_DISC, 1.0);
+    let sharp = |z: f32| z >= near && z <= far;
     for y in 0..height {
         let row = &mut radiance[y * width..(y + 1) * width];
         let d = &depth[y * width..(y + 1) * width];
+        if d.iter().all(|&z| sharp(z)) {
+            continue;
+        }
         for (wi, &z) in w[..width].iter_mut().zip(d) {
             *wi = BOX_OF_DISC * lens.coc_px(z);
-        }
-        if w[..width].iter().all(|&v| v <= 1.0) {
-            continue; // a box within its own pixel changes nothing
         }
         line[..width].copy_from_slice(row);
         box_line(&mut line[..width], &mut prefix[..=width], &w[..width], &shift[..width]);
         row.copy_from_slice(&line[..width]);
     }
     for x in 0..width {
-        let mut any = false;
-        for y in 0..height {
-            let v = BOX_OF_DISC * lens.coc_px(depth[y * width + x]);
-            w[y] = v;
-            any |= v > 1.0;
-            line[y] = radiance[y * width + x];
-        }
-        if !any {
+        if (0..height).all(|y| sharp(depth[y * width + x])) {
             continue;
+        }
+        for y in 0..height {
+            w[y] = BOX_OF_DISC * lens.coc_px(depth[y * width + x]);
+            line[y] = radiance[y * width + x];
         }
         box_line(
             &mut line[..height],
@@ -182,6 +207,10 @@ pub(super) fn defocus(radiance: &mut [[f32; 3]], depth: &[f32], width: usize, le
         }
     }
 }
+
+/// A row whose every shift is below this, px, and whose blur stays within each pixel is
+/// left as rendered: a fiftieth of a pixel changes no output level that matters.
+const MIN_SHIFT_PX: f32 = 0.02;
 
 /// What [`smear`] needs of the camera besides its motion.
 #[derive(Debug, Clone, Copy)]
@@ -224,7 +253,7 @@ pub(super) fn smear(
             let u = f * xdot; // px/s
             s.shift[x] = -u * t_row;
             s.width[x] = u.abs() * shutter.exposure_s;
-            moved |= s.shift[x].abs() > 1e-4 || s.width[x] > 1.0;
+            moved |= s.shift[x].abs() > MIN_SHIFT_PX || s.width[x] > 1.0;
         }
         if !moved {
             continue;
