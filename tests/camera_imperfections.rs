@@ -192,7 +192,6 @@ fn defocus_blurs_a_near_edge_by_the_circle_of_confusion_and_not_a_focused_one() 
     let focused = render(&mut r, &edge_wall(1.0, 0.4), &s, 1);
     let (width, _) = edge(&focused, H / 2);
     assert!(width < 1.5, "the focused edge stays sharp: {width:.2} px");
-    // Blurred in both directions: a horizontal edge (the wall's top) blurs too.
 }
 
 /// A flat wall filling the view.
