@@ -83,6 +83,48 @@ fn malformed_scenarios_are_reported_precisely() {
             "unknown variant `ice`",
         ),
         (
+            "unknown_colour.toml",
+            "[starts]\ngrid = \"paper16\"\n[axes]\nfiducial_colors = [[\"cyan\", \"purple\"]]\n",
+            "axes.fiducial_colors[0][1]",
+            Some(6),
+            "unknown variant `purple`",
+        ),
+        (
+            "same_colour.toml",
+            "[starts]\ngrid = \"paper16\"\n[axes]\nfiducial_colors = [[\"cyan\", \"magenta\"], [\"blue\", \"blue\"]]\n",
+            "axes.fiducial_colors[1]",
+            Some(6),
+            "expected two different colours, got `blue` twice",
+        ),
+        (
+            "no_colours.toml",
+            "[starts]\ngrid = \"paper16\"\n[axes]\nfiducial_colors = []\n",
+            "axes.fiducial_colors",
+            Some(6),
+            "expected at least one [left, right] pair",
+        ),
+        (
+            "one_colour.toml",
+            "[starts]\ngrid = \"paper16\"\n[axes]\nfiducial_colors = [[\"cyan\"]]\n",
+            "axes.fiducial_colors[0]",
+            Some(6),
+            "expected an array of length 2",
+        ),
+        (
+            "grey_colour.toml",
+            "[starts]\ngrid = \"paper16\"\n[axes]\nfiducial_colors = [[\"white\", \"magenta\"]]\n",
+            "axes.fiducial_colors[0][0]",
+            Some(6),
+            "`white` lies on SCT's grey axis",
+        ),
+        (
+            "twice.toml",
+            "[starts]\ngrid = \"paper16\"\n[axes]\nfiducial_colors = [[\"cyan\", \"red\"], [\"cyan\", \"red\"]]\n",
+            "axes.fiducial_colors[1]",
+            Some(6),
+            "the pair cyan|red is already axes.fiducial_colors[0]",
+        ),
+        (
             "typo.toml",
             "trails = 3\n[starts]\ngrid = \"paper16\"\n",
             "trails",
@@ -208,6 +250,29 @@ fn malformed_scenarios_are_reported_precisely() {
         assert_eq!(l, *line, "{file}");
         assert!(m.contains(text), "{file}: {m}");
     }
+}
+
+#[test]
+fn a_colour_axis_needs_a_two_block_flap() {
+    let dir = std::env::temp_dir().join(format!("marsupial-scenario-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("raposa_colours.toml");
+    let profile = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml");
+    std::fs::write(
+        &p,
+        format!(
+            "name = \"x\"\nprofile = \"{}\"\n[starts]\ngrid = \"paper16\"\n[axes]\nfiducial_colors = [[\"cyan\", \"magenta\"]]\n",
+            profile.display()
+        ),
+    )
+    .unwrap();
+    let (path, line, message) = problem(&p);
+    assert_eq!(path, "axes.fiducial_colors");
+    assert_eq!(line, None);
+    assert!(
+        message.contains("profile `raposa` has no [fiducial.two_block]"),
+        "{message}"
+    );
 }
 
 #[test]

@@ -192,27 +192,40 @@ pub struct TrialsOptions {
     pub progress: bool,
 }
 
-/// Prints a summary as a table like the paper's.
+/// Prints a summary as a table like the paper's: one row per group (start × the axes
+/// that vary), then all runs; with a `fiducial_colors` axis, then one row per paint pair
+/// (× the other varying axes) over all starts.
 pub fn print_table(s: &Summary, out: &mut dyn Write) -> std::io::Result<()> {
-    let vary = |f: &dyn Fn(&GroupSummary) -> &String| {
-        let first = s.groups.first().map(f);
-        s.groups.iter().any(|g| Some(f(g)) != first)
-    };
-    let (vl, vs, vt) = (
-        vary(&|g| &g.lighting),
-        vary(&|g| &g.segmentation),
-        vary(&|g| &g.terrain),
-    );
     writeln!(out, "{}", s.scenario)?;
-    // The start column fits the longest label (explicit starts may be named).
-    let sw = s
-        .groups
-        .iter()
-        .map(|g| g.start.chars().count())
-        .max()
-        .unwrap_or(0)
-        .max(5);
+    print_groups(&s.groups, Some(&s.overall), out)?;
+    if !s.by_colors.is_empty() {
+        writeln!(out, "\nby fiducial colours, over all starts")?;
+        print_groups(&s.by_colors, None, out)?;
+    }
+    Ok(())
+}
+
+/// The rows of [`print_table`]: a column for the start and for each axis that varies
+/// among `groups`, then the figures; `overall` last.
+fn print_groups(groups: &[GroupSummary], overall: Option<&GroupSummary>, out: &mut dyn Write) -> std::io::Result<()> {
+    let vary = |f: &dyn Fn(&GroupSummary) -> Option<&str>| {
+        let first = groups.first().map(f);
+        groups.iter().any(|g| Some(f(g)) != first)
+    };
+    let (vc, vl, vs, vt) = (
+        vary(&|g| g.fiducial_colors.as_deref()),
+        vary(&|g| Some(&g.lighting)),
+        vary(&|g| Some(&g.segmentation)),
+        vary(&|g| Some(&g.terrain)),
+    );
+    // The start and colour columns fit their longest label (explicit starts may be named).
+    let width = |f: &dyn Fn(&GroupSummary) -> usize, least: usize| groups.iter().map(f).max().unwrap_or(0).max(least);
+    let sw = width(&|g| g.start.chars().count(), 5);
+    let cw = width(&|g| g.fiducial_colors.as_deref().map_or(0, |c| c.chars().count()), 7);
     let mut head = format!("{:<sw$} ", "start");
+    if vc {
+        head.push_str(&format!(" {:<cw$}", "colours"));
+    }
     if vl {
         head.push_str(" lighting  ");
     }
@@ -228,6 +241,9 @@ pub fn print_table(s: &Summary, out: &mut dyn Write) -> std::io::Result<()> {
     )?;
     let row = |g: &GroupSummary, out: &mut dyn Write| -> std::io::Result<()> {
         let mut line = format!("{:<sw$} ", g.start);
+        if vc {
+            line.push_str(&format!(" {:<cw$}", g.fiducial_colors.as_deref().unwrap_or("*")));
+        }
         if vl {
             line.push_str(&format!(" {:<10}", g.lighting));
         }
@@ -250,10 +266,13 @@ pub fn print_table(s: &Summary, out: &mut dyn Write) -> std::io::Result<()> {
             fails.join(" ")
         )
     };
-    for g in &s.groups {
+    for g in groups {
         row(g, out)?;
     }
-    row(&s.overall, out)
+    if let Some(g) = overall {
+        row(g, out)?;
+    }
+    Ok(())
 }
 
 /// Runs a campaign and prints its table (or JSON).

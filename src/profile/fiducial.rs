@@ -28,6 +28,21 @@ pub enum NamedColor {
 }
 
 impl NamedColor {
+    /// The name used in TOML and output (`"cyan"`).
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            NamedColor::Cyan => "cyan",
+            NamedColor::Magenta => "magenta",
+            NamedColor::Yellow => "yellow",
+            NamedColor::Orange => "orange",
+            NamedColor::Blue => "blue",
+            NamedColor::Red => "red",
+            NamedColor::Green => "green",
+            NamedColor::White => "white",
+            NamedColor::Black => "black",
+        }
+    }
+
     /// Nominal sRGB value of the paint.
     pub fn rgb(&self) -> [u8; 3] {
         match self {

@@ -156,6 +156,7 @@ mod tests {
             lighting: "mixed".into(),
             segmentation: seg.into(),
             terrain: "lab_floor".into(),
+            fiducial_colors: None,
             trial: 0,
             seed: 0,
             distance_m: 1.0,

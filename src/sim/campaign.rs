@@ -15,7 +15,7 @@ use super::scenario::{Loaded, RunSpec};
 use super::world::{self, World};
 use crate::behaviors::BuildError;
 use crate::perception::RgbImage;
-use crate::profile::Profile;
+use crate::profile::{NamedColor, Profile};
 use crate::schemas::Agent;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -40,6 +40,10 @@ pub struct RunRecord {
     pub segmentation: String,
     /// Terrain.
     pub terrain: String,
+    /// The flap's paints `[left, right]`, when the scenario has a `fiducial_colors`
+    /// axis (absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fiducial_colors: Option<[NamedColor; 2]>,
     /// Trial number.
     pub trial: u32,
     /// Run seed.
@@ -98,8 +102,11 @@ pub struct CampaignOptions {
 pub struct Prepared {
     /// Scenario and profile.
     pub loaded: Loaded,
-    /// The built world (shared by every run's simulation).
+    /// The built world (shared by every run's simulation), with the profile's paints.
     pub world: Arc<World>,
+    /// The world repainted with each pair of a `fiducial_colors` axis, in axis order
+    /// (empty without the axis).
+    pub painted: Vec<([NamedColor; 2], Arc<World>)>,
     /// Every run.
     pub runs: Vec<RunSpec>,
     /// How the simulator simulates the profile's `[[sensors]]` by kind (the built-in
@@ -121,6 +128,17 @@ pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
         .map(|b| crate::image_io::load_rgb(&dir.join(b)).map(Arc::new))
         .collect::<Result<_, _>>()?;
     let world = world::build(&loaded.profile, &loaded.scenario.clutter, &backdrops)?;
+    let painted = loaded
+        .scenario
+        .axes
+        .fiducial_colors
+        .iter()
+        .flatten()
+        .map(|pair| {
+            let profile = repainted(&loaded.profile, Some(*pair));
+            world::build(&profile, &loaded.scenario.clutter, &backdrops).map(|w| (*pair, Arc::new(w)))
+        })
+        .collect::<Result<_, _>>()?;
     let runs = loaded.scenario.runs(&loaded.profile);
     let body = &loaded.profile.body;
     if let Some(r) = runs
@@ -139,9 +157,38 @@ pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
     Ok(Prepared {
         loaded,
         world: Arc::new(world),
+        painted,
         runs,
         devices: Arc::new(SimDevices::default()),
     })
+}
+
+/// `profile` with its two-block flap painted `colors` (`[left, right]`); unchanged for
+/// `None` or a profile without a two-block flap.
+fn repainted(profile: &Profile, colors: Option<[NamedColor; 2]>) -> Profile {
+    let mut p = profile.clone();
+    if let (Some(fid), Some([left, right])) = (p.fiducial.two_block.as_mut(), colors) {
+        fid.left_color = left;
+        fid.right_color = right;
+    }
+    p
+}
+
+impl Prepared {
+    /// The profile run `spec`'s robot is built from: the scenario's, with the run's
+    /// segmentation mode and paints.
+    pub fn profile_for(&self, spec: &RunSpec) -> Profile {
+        let mut p = repainted(&self.loaded.profile, spec.fiducial_colors);
+        p.perception.mode = spec.segmentation;
+        p
+    }
+
+    /// The world run `spec` runs in: the one painted with its colours, if it has any.
+    pub fn world_for(&self, spec: &RunSpec) -> &Arc<World> {
+        spec.fiducial_colors
+            .and_then(|c| self.painted.iter().find(|(pair, _)| *pair == c))
+            .map_or(&self.world, |(_, w)| w)
+    }
 }
 
 /// Summary of a set of runs.
@@ -155,6 +202,10 @@ pub struct GroupSummary {
     pub segmentation: String,
     /// Terrain (`*` for all).
     pub terrain: String,
+    /// The flap's paints, `left|right` (absent without a `fiducial_colors` axis, and for
+    /// all runs together).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fiducial_colors: Option<String>,
     /// Runs.
     pub runs: usize,
     /// Successful runs.
@@ -183,8 +234,13 @@ pub struct Summary {
     pub scenario: String,
     /// All runs together.
     pub overall: GroupSummary,
-    /// One entry per combination of the axes (start, lighting, segmentation, terrain).
+    /// One entry per combination of the axes (start, fiducial colours, lighting,
+    /// segmentation, terrain).
     pub groups: Vec<GroupSummary>,
+    /// With a `fiducial_colors` axis: one entry per paint pair and combination of the
+    /// other axes, over all starts (`start` is `*`), in campaign order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub by_colors: Vec<GroupSummary>,
 }
 
 /// Summarises records with the given labels.
@@ -204,6 +260,7 @@ pub fn summarise(records: &[&RunRecord], labels: [&str; 4]) -> GroupSummary {
         lighting: labels[1].into(),
         segmentation: labels[2].into(),
         terrain: labels[3].into(),
+        fiducial_colors: None,
         runs: records.len(),
         successes: ok.len(),
         success_rate: if records.is_empty() {
@@ -230,32 +287,43 @@ pub fn summarise(records: &[&RunRecord], labels: [&str; 4]) -> GroupSummary {
 /// The summary of a campaign's records (in campaign order).
 pub fn summary(name: &str, records: &[RunRecord]) -> Summary {
     let all: Vec<&RunRecord> = records.iter().collect();
-    let mut keys: Vec<(usize, [String; 4])> = Vec::new();
-    for r in records {
-        let k = [
-            r.start.clone(),
-            r.lighting.clone(),
-            r.segmentation.clone(),
-            r.terrain.clone(),
-        ];
-        if !keys.iter().any(|(_, kk)| *kk == k) {
-            keys.push((r.index, k));
+    let colours = |r: &RunRecord| r.fiducial_colors.as_ref().map(super::scenario::colors_label);
+    // Groups in order of first appearance, by (start, colours, lighting, segmentation,
+    // terrain); `starts` false pools the starts.
+    let grouped = |starts: bool| -> Vec<GroupSummary> {
+        let key = |r: &RunRecord| {
+            (
+                if starts { r.start.clone() } else { "*".into() },
+                colours(r),
+                [r.lighting.clone(), r.segmentation.clone(), r.terrain.clone()],
+            )
+        };
+        let mut keys = Vec::new();
+        for r in records {
+            let k = key(r);
+            if !keys.contains(&k) {
+                keys.push(k);
+            }
         }
-    }
-    let groups = keys
-        .iter()
-        .map(|(_, k)| {
-            let rs: Vec<&RunRecord> = records
-                .iter()
-                .filter(|r| r.start == k[0] && r.lighting == k[1] && r.segmentation == k[2] && r.terrain == k[3])
-                .collect();
-            summarise(&rs, [&k[0], &k[1], &k[2], &k[3]])
-        })
-        .collect();
+        keys.iter()
+            .map(|k| {
+                let rs: Vec<&RunRecord> = records.iter().filter(|r| key(r) == *k).collect();
+                let mut g = summarise(&rs, [&k.0, &k.2[0], &k.2[1], &k.2[2]]);
+                g.fiducial_colors = k.1.clone();
+                g
+            })
+            .collect()
+    };
+    let by_colors = if records.iter().any(|r| r.fiducial_colors.is_some()) {
+        grouped(false)
+    } else {
+        Vec::new()
+    };
     Summary {
         scenario: name.into(),
         overall: summarise(&all, ["*", "*", "*", "*"]),
-        groups,
+        groups: grouped(true),
+        by_colors,
     }
 }
 

@@ -142,13 +142,13 @@ impl Rig {
 }
 
 /// The simulated world of run `spec`: its lighting (drawn from `pair`, the stream paired
-/// runs share), sensor, terrain and seed, with the run's profile (its segmentation mode).
+/// runs share), sensor, terrain, paints and seed, with the run's profile (its
+/// segmentation mode and paints).
 /// Returns the run's lighting and sensor too (the departure may run under others), and
 /// the lighting's draw when the run's lighting is a distribution.
 fn simulation(p: &Prepared, spec: &RunSpec, pair: &mut Rng) -> (Sim, LightingRun, SensorParams, Option<LightingDraw>) {
     let sc: &Scenario = &p.loaded.scenario;
-    let mut profile = p.loaded.profile.clone();
-    profile.perception.mode = spec.segmentation;
+    let profile = p.profile_for(spec);
     let (lighting, draw) = sc.lighting_for_run(&spec.lighting, spec.pair_seed);
     let run_light = LightingRun::new(lighting.clone(), pair, sc.timeout_s + 120.0);
     let sensor = sc.sensor_params(&lighting);
@@ -162,7 +162,7 @@ fn simulation(p: &Prepared, spec: &RunSpec, pair: &mut Rng) -> (Sim, LightingRun
     );
     let sim = Sim::new(
         Arc::new(profile),
-        Arc::clone(&p.world),
+        Arc::clone(p.world_for(spec)),
         run_light.clone(),
         sensor,
         motion,
@@ -206,8 +206,7 @@ pub fn run_one(
     rec: &mut Recording<'_>,
 ) -> Result<RunRecord, SimError> {
     let sc: &Scenario = &p.loaded.scenario;
-    let mut profile = p.loaded.profile.clone();
-    profile.perception.mode = spec.segmentation;
+    let profile = p.profile_for(spec);
     let agent = make_agent(&profile).map_err(|e| SimError::Unsupported(e.to_string()))?;
     let mut pair = Rng::new(spec.pair_seed);
     let (sim, run_light, sensor, draw) = simulation(p, spec, &mut pair);
@@ -221,7 +220,7 @@ pub fn run_one(
         sim,
         robot,
     };
-    let dock = p.world.dock;
+    let dock = p.world_for(spec).dock;
     // Departure: undock and imprint (paired runs share it through `pair`).
     let mut imprinted = None;
     if sc.imprint.enabled && rig.lp.begin(&Mission::Departure).is_ok() {
@@ -301,6 +300,7 @@ fn record(spec: &RunSpec, sim: &Sim, end: PhaseEnd, imprinted: Option<bool>, man
         lighting: spec.lighting.clone(),
         segmentation: spec.segmentation.as_str().into(),
         terrain: spec.terrain.as_str().into(),
+        fiducial_colors: spec.fiducial_colors,
         trial: spec.trial,
         seed: spec.seed,
         distance_m: s.distance,

@@ -14,7 +14,7 @@ use super::rng::Rng;
 use super::world::ClutterSpec;
 use crate::config::{self, ConfigError, Validate, Validator};
 use crate::geometry::Pose2;
-use crate::profile::{Profile, SegmentationMode};
+use crate::profile::{NamedColor, Profile, SegmentationMode};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -111,6 +111,13 @@ pub struct AxesSpec {
     /// Terrains.
     #[serde(default = "default_terrain")]
     pub terrain: Vec<Terrain>,
+    /// Paints of the two-block flap, `[left, right]` as `[fiducial.two_block]` names them
+    /// (`[["cyan", "magenta"], ["yellow", "blue"]]`): each run repaints the flap with one
+    /// pair, in the world and in the profile the robot is built from (its table
+    /// defaults), as `[profile_patch.fiducial.two_block] left_color/right_color` would.
+    /// Absent: the profile's own paints, and the campaign is what it was without the axis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fiducial_colors: Option<Vec<[NamedColor; 2]>>,
 }
 
 impl Default for AxesSpec {
@@ -119,8 +126,20 @@ impl Default for AxesSpec {
             lighting: default_lighting(),
             segmentation: default_segmentation(),
             terrain: default_terrain(),
+            fiducial_colors: None,
         }
     }
+}
+
+/// A flap's paint pair as tables and summaries show it: `left|right`.
+///
+/// ```
+/// use marsupial::profile::NamedColor;
+/// use marsupial::sim::scenario::colors_label;
+/// assert_eq!(colors_label(&[NamedColor::Yellow, NamedColor::Blue]), "yellow|blue");
+/// ```
+pub fn colors_label(pair: &[NamedColor; 2]) -> String {
+    format!("{}|{}", pair[0].as_str(), pair[1].as_str())
 }
 
 fn default_lighting() -> Vec<String> {
@@ -442,6 +461,30 @@ impl Validate for Scenario {
         ] {
             v.require(n >= 1, field, || "expected at least one value".into());
         }
+        if let Some(pairs) = &self.axes.fiducial_colors {
+            v.require(!pairs.is_empty(), "axes.fiducial_colors", || {
+                "expected at least one [left, right] pair of colours (leave the axis out to keep the profile's paints)"
+                    .into()
+            });
+            for (i, pair) in pairs.iter().enumerate() {
+                for (j, c) in pair.iter().enumerate() {
+                    v.require(
+                        !matches!(c, NamedColor::White | NamedColor::Black),
+                        &format!("axes.fiducial_colors[{i}][{j}]"),
+                        || format!("`{}` lies on SCT's grey axis, which the segmentation never classifies: expected a chromatic colour", c.as_str()),
+                    );
+                }
+                v.require(pair[0] != pair[1], &format!("axes.fiducial_colors[{i}]"), || {
+                    format!("expected two different colours, got `{}` twice", pair[0].as_str())
+                });
+                if let Some(k) = pairs[..i].iter().position(|p| p == pair) {
+                    v.problem(
+                        &format!("axes.fiducial_colors[{i}]"),
+                        format!("the pair {} is already axes.fiducial_colors[{k}]", colors_label(pair)),
+                    );
+                }
+            }
+        }
         for (i, name) in self.axes.lighting.iter().enumerate() {
             let known = self.lighting.contains_key(name)
                 || self.lighting_random.contains_key(name)
@@ -539,6 +582,9 @@ pub struct RunSpec {
     pub segmentation: SegmentationMode,
     /// Terrain.
     pub terrain: Terrain,
+    /// The flap's paints `[left, right]` on a `fiducial_colors` axis (`None`: the
+    /// profile's).
+    pub fiducial_colors: Option<[NamedColor; 2]>,
     /// Trial number.
     pub trial: u32,
     /// This run's seed.
@@ -602,6 +648,19 @@ impl Scenario {
             None => Profile::load(&profile_file)?,
             Some(patch) => load_patched(&profile_file, patch, path)?,
         };
+        if scenario.axes.fiducial_colors.is_some() && profile.fiducial.two_block.is_none() {
+            return Err(ConfigError::Invalid {
+                file: path.to_path_buf(),
+                problems: vec![config::Problem {
+                    path: "axes.fiducial_colors".into(),
+                    line: None,
+                    message: format!(
+                        "repaints a two-block flap, but profile `{}` has no [fiducial.two_block]",
+                        profile.name
+                    ),
+                }],
+            });
+        }
         for (i, b) in scenario.backgrounds.iter().enumerate() {
             let p = dir.join(b);
             if !p.is_file() {
@@ -768,27 +827,45 @@ impl Scenario {
         out
     }
 
-    /// Every run of the campaign in a fixed order: starts × lighting × segmentation ×
-    /// terrain × trials.
+    /// The values of the `fiducial_colors` axis: each pair, or one `None` (the profile's
+    /// paints) when the axis is absent.
+    pub fn fiducial_color_values(&self) -> Vec<Option<[NamedColor; 2]>> {
+        match &self.axes.fiducial_colors {
+            Some(pairs) => pairs.iter().copied().map(Some).collect(),
+            None => vec![None],
+        }
+    }
+
+    /// Every run of the campaign in a fixed order: starts × fiducial colours × lighting ×
+    /// segmentation × terrain × trials. Runs that differ only in their paints share a pair
+    /// seed (the same placement error and lighting draw), so colour pairs are compared
+    /// on the same runs, as segmentation modes are.
     pub fn runs(&self, profile: &Profile) -> Vec<RunSpec> {
         let mut out = Vec::new();
+        let colours = self.fiducial_color_values();
         for (si, start) in self.starts(profile).into_iter().enumerate() {
-            for (li, lighting) in self.axes.lighting.iter().enumerate() {
-                for seg in &self.axes.segmentation {
-                    for (ti, terrain) in self.axes.terrain.iter().enumerate() {
-                        for trial in 0..self.trials {
-                            let index = out.len();
-                            let key = ((si as u64) << 40) ^ ((li as u64) << 32) ^ ((ti as u64) << 24) ^ trial as u64;
-                            out.push(RunSpec {
-                                index,
-                                start: start.clone(),
-                                lighting: lighting.clone(),
-                                segmentation: *seg,
-                                terrain: *terrain,
-                                trial,
-                                seed: super::rng::splitmix64(self.seed ^ super::rng::splitmix64(index as u64 + 1)),
-                                pair_seed: super::rng::splitmix64(self.seed ^ super::rng::splitmix64(key ^ 0xA11CE)),
-                            });
+            for fiducial_colors in &colours {
+                for (li, lighting) in self.axes.lighting.iter().enumerate() {
+                    for seg in &self.axes.segmentation {
+                        for (ti, terrain) in self.axes.terrain.iter().enumerate() {
+                            for trial in 0..self.trials {
+                                let index = out.len();
+                                let key =
+                                    ((si as u64) << 40) ^ ((li as u64) << 32) ^ ((ti as u64) << 24) ^ trial as u64;
+                                out.push(RunSpec {
+                                    index,
+                                    start: start.clone(),
+                                    lighting: lighting.clone(),
+                                    segmentation: *seg,
+                                    terrain: *terrain,
+                                    fiducial_colors: *fiducial_colors,
+                                    trial,
+                                    seed: super::rng::splitmix64(self.seed ^ super::rng::splitmix64(index as u64 + 1)),
+                                    pair_seed: super::rng::splitmix64(
+                                        self.seed ^ super::rng::splitmix64(key ^ 0xA11CE),
+                                    ),
+                                });
+                            }
                         }
                     }
                 }
