@@ -22,9 +22,12 @@
 //!   tracker (colour model and imprinting) and the relative pose it gives.
 //! * [`pyramid`], [`pyramid_pose`] and [`pyramid_tracker`]: RAPOSA's pyramid detector, its
 //!   geometry, and its tracker with fixed, imprinted or adapted HSV bands.
+//! * [`circles`]: Axel's circle fiducials: detection, correspondence to the module's
+//!   model by homography, and pose.
 //! * [`overlay`]: drawing a detection over its frame.
 
 pub mod camera_model;
+pub mod circles;
 pub mod colour_model;
 pub mod components;
 pub mod fastmath;

@@ -1,0 +1,34 @@
+//! Axel's circle fiducials (seed 000 §III): detection, correspondence to the module's
+//! model, and pose.
+//!
+//! Eight 10 cm circle marks, each with one of four bar rotations, sit on the central
+//! module's face in an asymmetric layout. Per camera frame:
+//!
+//! * [`CircleDetector`] finds the marks: an adaptive threshold, black and white blobs
+//!   filtered by size, eccentricity and Euler number ([`RunIndex`]), black/white pairs
+//!   with coinciding centroids, a local re-threshold for the bar's rotation, and the
+//!   centre from a direct least-squares ellipse fit ([`fit_ellipse`]) of the perimeter;
+//! * [`correspond`] labels them against a [`CircleModel`]: the rotations split the 8!
+//!   labellings into at most 16 hypotheses, each verified by a homography
+//!   ([`Homography`], normalised DLT) and its reprojection; far points are occlusions or
+//!   false positives, and no fit from fewer than 5 marks is ever accepted.
+//!
+//! Everything is a pure function over borrowed data or a struct that allocates its
+//! buffers once; nothing allocates per frame.
+
+pub mod blobs;
+pub mod correspond;
+pub mod detect;
+pub mod ellipse;
+pub mod homography;
+pub mod model;
+
+pub mod threshold;
+
+pub use blobs::RunIndex;
+pub use correspond::{CorrespondenceError, CorrespondenceParams, MAX_DETECTIONS, ModelFit, correspond};
+pub use detect::{CircleDetector, CircleParams, DetectedMark, MarkRotation};
+pub use ellipse::{Ellipse, EllipseFit, fit_ellipse};
+pub use homography::Homography;
+pub use model::{CircleModel, MAX_MODEL_MARKS, ModelError};
+pub use threshold::{AdaptiveThreshold, Thresholder, grey_from_rgb};

@@ -1,0 +1,171 @@
+//! Adaptive (local-mean) threshold into black and white masks.
+//!
+//! Seed 000 §III.A.2 thresholds adaptively "to handle lighting variations" with levels
+//! "chosen empirically"; it gives neither the window nor the offset. Ours compares each
+//! pixel's grey level g with the mean m of a square window around it (from an integral
+//! image, so the cost does not depend on the window): black when g < m − offset, white
+//! when g > m + offset, neither in between. The dead band keeps flat regions (where m ≈ g
+//! and only noise differs) out of both masks, so they cannot join a mark's blobs.
+//!
+//! Grey is the luma approximation (R + 2G + B)/4.
+
+use crate::perception::Mask;
+use crate::perception::image::RgbView;
+
+/// Grey level of an RGB pixel: (R + 2G + B)/4, rounded.
+#[inline]
+pub fn grey_from_rgb(p: [u8; 3]) -> u8 {
+    ((p[0] as u16 + 2 * p[1] as u16 + p[2] as u16 + 2) / 4) as u8
+}
+
+/// Writes the grey image of `src` into `grey` (resized to width × height).
+pub fn grey_from_view(src: &RgbView<'_>, grey: &mut Vec<u8>) {
+    grey.clear();
+    grey.extend(
+        src.as_bytes()
+            .chunks_exact(3)
+            .map(|p| grey_from_rgb([p[0], p[1], p[2]])),
+    );
+}
+
+/// The local-mean threshold's parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AdaptiveThreshold {
+    /// Side of the square averaging window, px (made odd, at least 3).
+    pub window_px: usize,
+    /// Dead band either side of the local mean, grey levels.
+    pub offset: u8,
+}
+
+/// The threshold's reusable integral image (the masks are the caller's).
+#[derive(Debug, Clone, Default)]
+pub struct Thresholder {
+    integral: Vec<u32>,
+}
+
+impl Thresholder {
+    /// A thresholder with its integral image sized for `width × height`.
+    pub fn new(width: usize, height: usize) -> Self {
+        Self {
+            integral: Vec::with_capacity((width + 1) * (height + 1)),
+        }
+    }
+
+    /// Thresholds the `width × height` grey image into `black` and `white` (each reset to
+    /// that size; a pixel is set in at most one of them).
+    pub fn apply(
+        &mut self,
+        grey: &[u8],
+        width: usize,
+        height: usize,
+        params: &AdaptiveThreshold,
+        black: &mut Mask,
+        white: &mut Mask,
+    ) {
+        black.reset(width, height);
+        white.reset(width, height);
+        if width == 0 || height == 0 || grey.len() != width * height {
+            return;
+        }
+        let iw = width + 1;
+        self.integral.clear();
+        self.integral.resize(iw * (height + 1), 0);
+        for y in 0..height {
+            let mut row = 0u32;
+            let (above, here) = self.integral.split_at_mut((y + 1) * iw);
+            let above = &above[y * iw..];
+            for x in 0..width {
+                row += grey[y * width + x] as u32;
+                here[x + 1] = above[x + 1] + row;
+            }
+        }
+        let r = (params.window_px.max(3) | 1) / 2;
+        let off = params.offset as u32;
+        let (bd, wd) = (black.data_mut(), white.data_mut());
+        for y in 0..height {
+            let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(height));
+            let (top, bot) = (
+                &self.integral[y0 * iw..(y0 + 1) * iw],
+                &self.integral[y1 * iw..(y1 + 1) * iw],
+            );
+            let rows = (y1 - y0) as u32;
+            for x in 0..width {
+                let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(width));
+                let sum = bot[x1] + top[x0] - top[x1] - bot[x0];
+                let n = rows * (x1 - x0) as u32;
+                let g = grey[y * width + x] as u32;
+                let i = y * width + x;
+                // g < m − off  ⇔  (g + off)·n < Σ;  g > m + off  ⇔  g·n > Σ + off·n.
+                bd[i] = ((g + off) * n < sum) as u8;
+                wd[i] = (g * n > sum + off * n) as u8;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_dark_square_on_grey_is_black_its_surround_white_and_flat_areas_neither() {
+        let (w, h) = (40, 30);
+        let mut grey = vec![120u8; w * h];
+        for y in 10..20 {
+            for x in 15..25 {
+                grey[y * w + x] = 20;
+            }
+        }
+        let (mut b, mut wh) = (Mask::new(1, 1), Mask::new(1, 1));
+        let p = AdaptiveThreshold {
+            window_px: 15,
+            offset: 8,
+        };
+        Thresholder::new(w, h).apply(&grey, w, h, &p, &mut b, &mut wh);
+        assert!(b.get(20, 15) && !wh.get(20, 15), "inside the square");
+        assert!(wh.get(14, 15) && !b.get(14, 15), "just outside: brighter than its mean");
+        assert!(!b.get(2, 2) && !wh.get(2, 2), "far away: flat");
+        // Never both.
+        assert!(b.data().iter().zip(wh.data()).all(|(p, q)| p & q == 0));
+    }
+
+    #[test]
+    fn the_integral_agrees_with_a_direct_window_mean() {
+        let (w, h) = (17, 13);
+        let grey: Vec<u8> = (0..w * h).map(|i| ((i * 37 + i / 7 * 11) % 256) as u8).collect();
+        let (mut b, mut wh) = (Mask::new(1, 1), Mask::new(1, 1));
+        let p = AdaptiveThreshold {
+            window_px: 5,
+            offset: 3,
+        };
+        Thresholder::new(w, h).apply(&grey, w, h, &p, &mut b, &mut wh);
+        for y in 0..h {
+            for x in 0..w {
+                let (mut s, mut n) = (0i64, 0i64);
+                for yy in y.saturating_sub(2)..(y + 3).min(h) {
+                    for xx in x.saturating_sub(2)..(x + 3).min(w) {
+                        s += grey[yy * w + xx] as i64;
+                        n += 1;
+                    }
+                }
+                let g = grey[y * w + x] as i64;
+                assert_eq!(b.get(x, y), (g + 3) * n < s, "({x}, {y})");
+                assert_eq!(wh.get(x, y), g * n > s + 3 * n, "({x}, {y})");
+            }
+        }
+    }
+
+    #[test]
+    fn degenerate_sizes_give_empty_masks() {
+        let (mut b, mut wh) = (Mask::new(1, 1), Mask::new(1, 1));
+        let p = AdaptiveThreshold {
+            window_px: 9,
+            offset: 8,
+        };
+        let mut t = Thresholder::default();
+        t.apply(&[], 0, 0, &p, &mut b, &mut wh);
+        assert_eq!(b.size(), (0, 0));
+        t.apply(&[7], 1, 1, &p, &mut b, &mut wh);
+        assert_eq!((b.count(), wh.count()), (0, 0));
+    }
+}
