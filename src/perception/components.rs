@@ -160,6 +160,8 @@ impl Component {
 pub struct Labeler {
     width: usize,
     height: usize,
+    /// 1 for 8-connectivity (runs touching diagonally join), 0 for 4-connectivity.
+    diagonal: u32,
     runs: Vec<Run>,
     parent: Vec<u32>,
     components: Vec<Component>,
@@ -185,10 +187,26 @@ impl Labeler {
         Self {
             width,
             height,
+            diagonal: 1,
             runs: Vec::with_capacity(max_runs),
             parent: Vec::with_capacity(max_runs),
             components: Vec::with_capacity(max_runs),
         }
+    }
+
+    /// A 4-connected labeller (pixels join only through a shared side). Label the
+    /// background of an 8-connected foreground this way: with 8-connectivity on both, a
+    /// region leaks through a closed ring's diagonal steps.
+    pub fn new_four_connected(width: usize, height: usize) -> Self {
+        Self {
+            diagonal: 0,
+            ..Self::new(width, height)
+        }
+    }
+
+    /// Whether pixels join only through a shared side.
+    pub fn is_four_connected(&self) -> bool {
+        self.diagonal == 0
     }
 
     /// (width, height) this labeller was sized for.
@@ -241,11 +259,11 @@ impl Labeler {
                 let mut j = prev_start;
                 for i in row_start..self.runs.len() {
                     let cur = self.runs[i];
-                    while j < row_start && self.runs[j].x1 < cur.x0 {
+                    while j < row_start && self.runs[j].x1 + self.diagonal <= cur.x0 {
                         j += 1;
                     }
                     let mut k = j;
-                    while k < row_start && self.runs[k].x0 <= cur.x1 {
+                    while k < row_start && self.runs[k].x0 < cur.x1 + self.diagonal {
                         let a = find(&mut self.parent, self.runs[k].label);
                         let b = find(&mut self.parent, cur.label);
                         if a != b {

@@ -1,11 +1,11 @@
 //! Topology and run lists of labelled components: the Euler number of every component
 //! and, for any one of them, its runs, without rescanning the image.
 //!
-//! **Euler number.** For 8-connected foreground (and so 4-connected background, the
-//! consistent pairing), a component's Euler number is its run count minus the number of
-//! 8-touching run pairs in consecutive rows: runs are intervals (contractible), and each
-//! cycle in the graph of touching runs encloses exactly one 4-connected background
-//! region. E = 1 − holes, so a filled disc has E = 1 and a ring E = 0.
+//! **Euler number.** A component's Euler number is its run count minus the number of
+//! touching run pairs in consecutive rows (touching as its labeller joins them): runs are
+//! intervals (contractible), and each cycle in the graph of touching runs encloses exactly
+//! one background region, 4-connected for an 8-connected foreground and 8-connected for a
+//! 4-connected one. E = 1 − holes, so a filled disc has E = 1 and a ring E = 0.
 //!
 //! All buffers are sized for the labeller's worst case when built, so indexing never
 //! allocates.
@@ -61,6 +61,7 @@ impl RunIndex {
     pub fn build(&mut self, labeler: &Labeler) {
         let runs = labeler.runs();
         let n = labeler.components().len();
+        let d = (!labeler.is_four_connected()) as u32;
         self.euler.clear();
         self.euler.resize(n, 0);
         self.start.clear();
@@ -84,11 +85,11 @@ impl RunIndex {
             if prev.end > prev.start && runs[prev.start].y + 1 == y {
                 let mut k0 = prev.start;
                 for cur in &runs[i..j] {
-                    while k0 < prev.end && runs[k0].x1 < cur.x0 {
+                    while k0 < prev.end && runs[k0].x1 + d <= cur.x0 {
                         k0 += 1;
                     }
                     let mut k = k0;
-                    while k < prev.end && runs[k].x0 <= cur.x1 {
+                    while k < prev.end && runs[k].x0 < cur.x1 + d {
                         self.euler[cur.label as usize] -= 1;
                         k += 1;
                     }
@@ -141,9 +142,9 @@ mod tests {
     use super::*;
     use crate::perception::Mask;
 
-    /// Holes by flood-filling the 4-connected background from outside: the slow
-    /// reference for one-component masks.
-    fn holes_reference(mask: &Mask) -> i32 {
+    /// Holes by flood-filling the background (4-connected, or 8-connected when `eight`)
+    /// from outside: the slow reference for one-component masks.
+    fn holes_reference(mask: &Mask, eight: bool) -> i32 {
         let (w, h) = mask.size();
         let (pw, ph) = (w + 2, h + 2);
         let fg = |x: usize, y: usize| x >= 1 && y >= 1 && x <= w && y <= h && mask.get(x - 1, y - 1);
@@ -168,6 +169,12 @@ mod tests {
                     push(x.wrapping_sub(1), y);
                     push(x, y + 1);
                     push(x, y.wrapping_sub(1));
+                    if eight {
+                        push(x + 1, y + 1);
+                        push(x.wrapping_sub(1), y + 1);
+                        push(x + 1, y.wrapping_sub(1));
+                        push(x.wrapping_sub(1), y.wrapping_sub(1));
+                    }
                 }
             }
         }
@@ -188,16 +195,27 @@ mod tests {
         for _ in 0..3000 {
             let data: Vec<u8> = (0..w * h).map(|_| (next() % 100 < 60) as u8).collect();
             let mask = Mask::from_vec(w, h, data).unwrap();
-            let mut lab = Labeler::new(w, h);
-            let n = lab.label(&mask).unwrap().len();
-            if n != 1 {
-                continue;
+            for four in [false, true] {
+                let mut lab = if four {
+                    Labeler::new_four_connected(w, h)
+                } else {
+                    Labeler::new(w, h)
+                };
+                let n = lab.label(&mask).unwrap().len();
+                if n != 1 {
+                    continue;
+                }
+                let mut idx = RunIndex::new(w, h);
+                idx.build(&lab);
+                assert_eq!(
+                    idx.euler(0),
+                    1 - holes_reference(&mask, four),
+                    "four {four}: {:?}",
+                    mask.data()
+                );
+                assert_eq!(idx.runs_of(&lab, 0).count(), lab.runs().len());
+                checked += 1;
             }
-            let mut idx = RunIndex::new(w, h);
-            idx.build(&lab);
-            assert_eq!(idx.euler(0), 1 - holes_reference(&mask), "{:?}", mask.data());
-            assert_eq!(idx.runs_of(&lab, 0).count(), lab.runs().len());
-            checked += 1;
         }
         assert!(checked > 100, "{checked}");
     }

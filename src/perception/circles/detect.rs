@@ -15,7 +15,9 @@
 //! **Per frame**, into buffers the detector owns (nothing is allocated after
 //! [`CircleDetector::new`] or [`CircleDetector::resize`]):
 //! 1. grey levels, then the local-mean threshold ([`AdaptiveThreshold`]) into a black and
-//!    a white mask, each labelled (8-connected) with Euler numbers ([`RunIndex`]);
+//!    a white mask, labelled with Euler numbers ([`RunIndex`]): black 8-connected, white
+//!    4-connected (the consistent pair: a thin black rim closed only diagonally still
+//!    holds the white ring in);
 //! 2. black candidates: area within limits, the moment ellipse's axis ratio at least
 //!    `min_axis_ratio`, Euler number in `black_euler`, not touching the image border
 //!    (a cut mark's centre would be biased). White candidates: area and axis ratio;
@@ -129,6 +131,12 @@ pub struct CircleParams {
     pub max_fit_rms_frac: f64,
     /// Smallest bar anisotropy (λ₁ − λ₂)/(λ₁ + λ₂) for a rotation to be read.
     pub min_bar_anisotropy: f64,
+    /// Smallest minor semi-axis of the fitted ellipse, px.
+    pub min_radius_px: f64,
+    /// Report only marks whose bar (and so rotation) was read. The bar is the pattern
+    /// that tells a mark from any dark ring around a light disc (a bolt head, a gauge, a
+    /// washer); without it the real photos give false marks.
+    pub require_rotation: bool,
     /// At most this many marks are reported (the first in raster order of their black
     /// blobs); it bounds the per-frame work and buffers.
     pub max_marks: usize,
@@ -136,9 +144,11 @@ pub struct CircleParams {
 
 impl CircleParams {
     /// Defaults for a `width`-pixel-wide image (our choices; the paper gives none):
-    /// * window: width/24, odd, at least 15 px (43 px at 1024): wider than a mark's rim
-    ///   and ring at docking range, narrow enough to follow a shadow's edge;
-    /// * offset 10 grey levels: above the sensor noise of a flat surface, far below a
+    /// * window: width/48, odd, at least 15 px (21 px at 1024): about a small mark's size,
+    ///   so its mean is the mark's own mid-grey and not its surroundings' (a dark module
+    ///   face otherwise leaves a 2-px rim in the dead band), yet wider than the rim and
+    ///   ring of a mark at docking range;
+    /// * offset 8 grey levels: above the sensor noise of a flat surface, far below a
     ///   printed mark's black-to-white contrast even in shade;
     /// * black blob from 12 px (a rim about 9 px across) to 5 % of the image;
     /// * axis ratio ≥ 0.2 (a circle seen 78° off its normal);
@@ -147,13 +157,15 @@ impl CircleParams {
     /// * contrast ≥ 25 grey levels;
     /// * fit RMS ≤ 0.35 px + 4 % of the minor semi-axis (a square's best ellipse is off by
     ///   about 10 % of its half-side);
-    /// * bar anisotropy ≥ 0.25 (a resolved bar gives about 0.6);
+    /// * bar anisotropy ≥ 0.25 (a resolved bar gives about 0.6), and only marks with a
+    ///   resolved bar are reported;
+    /// * minor semi-axis ≥ 4 px (smaller ones cannot show a bar, and speckle makes them);
     /// * at most 64 marks.
     pub fn for_image(width: usize) -> Self {
         Self {
             threshold: AdaptiveThreshold {
-                window_px: ((width / 24).max(15)) | 1,
-                offset: 10,
+                window_px: ((width / 64).max(11)) | 1,
+                offset: 6,
             },
             min_area_px: 12,
             max_area_frac: 0.05,
@@ -165,6 +177,8 @@ impl CircleParams {
             max_fit_rms_px: 0.35,
             max_fit_rms_frac: 0.04,
             min_bar_anisotropy: 0.25,
+            min_radius_px: 4.0,
+            require_rotation: true,
             max_marks: 64,
         }
     }
@@ -177,7 +191,8 @@ pub struct DetectedMark {
     pub centre: [f64; 2],
     /// The ellipse fitted to the black rim's outer edge.
     pub ellipse: Ellipse,
-    /// The bar's rotation, or `None` when the bar is not resolved.
+    /// The bar's rotation, or `None` when the bar is not resolved (reported only when
+    /// [`CircleParams::require_rotation`] is off).
     pub rotation: Option<MarkRotation>,
     /// The bar's measured direction, degrees counter-clockwise from the image's +x in the
     /// rectified mark, in [−90, 90).
@@ -239,7 +254,7 @@ impl CircleDetector {
             grey: Vec::with_capacity(width * height),
             thresholder: Thresholder::new(width, height),
             masks: [Mask::new(width, height), Mask::new(width, height)],
-            labelers: [Labeler::new(width, height), Labeler::new(width, height)],
+            labelers: [Labeler::new(width, height), Labeler::new_four_connected(width, height)],
             index: [RunIndex::new(width, height), RunIndex::new(width, height)],
             black: Vec::with_capacity(max_runs),
             white: Vec::with_capacity(max_runs),
@@ -440,6 +455,7 @@ impl CircleDetector {
         let fit = fit_ellipse(&self.points)?;
         let e = fit.ellipse;
         if fit.rms > p.max_fit_rms_px + p.max_fit_rms_frac * e.semi_minor
+            || e.semi_minor < p.min_radius_px
             || e.semi_minor < p.min_axis_ratio * e.semi_major
             || e.semi_major > (self.width.max(self.height)) as f64
         {
@@ -450,6 +466,9 @@ impl CircleDetector {
         }
         let (bar_angle_deg, bar_anisotropy) = self.bar(&e, t, mw);
         let rotation = (bar_anisotropy >= p.min_bar_anisotropy).then(|| MarkRotation::nearest(bar_angle_deg));
+        if p.require_rotation && rotation.is_none() {
+            return None;
+        }
         Some(DetectedMark {
             centre: e.centre,
             ellipse: e,
