@@ -465,3 +465,40 @@ fn simulated_lockstep_ticks(imperfect: bool) {
     assert_eq!(allocs(), 0, "allocations in the simulator's lockstep ticks");
     assert_eq!(running, 60, "every counted tick ran the behavior");
 }
+
+#[test]
+fn circle_detection_and_correspondence_do_not_allocate() {
+    use marsupial::perception::circles::{CircleDetector, CircleModel, CircleParams, CorrespondenceParams, correspond};
+    let p = common::shipped_profile("axel");
+    let model = CircleModel::from_profile(&p).unwrap();
+    let (w, h) = (640, 480);
+    let frames: Vec<RgbImage> = [
+        (300.0, [320.0, 240.0]),
+        (220.0, [300.0, 260.0]),
+        (380.0, [330.0, 230.0]),
+    ]
+    .into_iter()
+    .map(|(s, c)| common::axel_marks_frame(w, h, s, c))
+    .collect();
+    let empty = common::background(w, h);
+    let mut det = CircleDetector::new(w, h, CircleParams::for_image(w));
+    let params = CorrespondenceParams::default();
+    for f in &frames {
+        let marks = det.detect(&f.view()).unwrap();
+        assert_eq!(correspond(&model, marks, &params).unwrap().inliers, 8); // warm-up
+    }
+    reset();
+    COUNTING.with(|c| c.set(true));
+    let mut fits = 0;
+    for _ in 0..5 {
+        for f in &frames {
+            let marks = det.detect(&f.view()).unwrap();
+            fits += correspond(&model, marks, &params).is_ok() as usize;
+        }
+        let marks = det.detect(&empty.view()).unwrap();
+        fits += correspond(&model, marks, &params).is_ok() as usize;
+    }
+    COUNTING.with(|c| c.set(false));
+    assert_eq!(allocs(), 0, "allocations in steady state");
+    assert_eq!(fits, 15);
+}

@@ -75,3 +75,33 @@ fn imprint_then_detect_on_a_real_colour_checker() {
         assert!(pk.found && pk.mode == ColorMode::Adapted);
     }
 }
+
+#[test]
+fn no_circle_fiducial_in_real_photos() {
+    // Axel's circle marks appear in none of the photos: the detector reports no mark and
+    // the correspondence no module, in every folder (real edges, blur, ArUco squares,
+    // chessboards, gauges, text).
+    use marsupial::perception::circles::{CircleDetector, CircleModel, CircleParams, CorrespondenceParams, correspond};
+    let Some(dir) = photos() else { return };
+    let axel = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/axel.toml")).unwrap();
+    let model = CircleModel::from_profile(&axel).unwrap();
+    let (mut checked, mut marks_seen) = (0, 0);
+    for sub in ["backgrounds", "color", "markers", "homography", "sequences"] {
+        let mut files: Vec<_> = std::fs::read_dir(dir.join(sub))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        files.sort();
+        for f in files {
+            let Ok(im) = load_rgb(&f) else { continue };
+            let mut det = CircleDetector::new(im.width(), im.height(), CircleParams::for_image(im.width()));
+            let marks = det.detect(&im.view()).unwrap();
+            marks_seen += marks.len();
+            assert!(marks.is_empty(), "{}: {marks:?}", f.display());
+            assert!(correspond(&model, marks, &CorrespondenceParams::default()).is_err());
+            checked += 1;
+        }
+    }
+    assert!(checked >= 60, "only {checked} photos read");
+    assert_eq!(marks_seen, 0);
+}

@@ -9,6 +9,7 @@
 
 use super::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount, PerceptionSpec, Profile};
 use super::{PyramidPerceptionSpec, TwoBlockSpec};
+use crate::perception::circles::{CircleModel, MarkRotation};
 use crate::perception::{
     CameraModel, ColorModelParams, Fisheye, HsvLimits, MountAngles, PairLimits, Pinhole, PyramidGeometry,
     PyramidParams, PyramidTrackerParams, SegmentationMode, TwoBlockGeometry, TwoBlockParams, VisionError,
@@ -197,6 +198,35 @@ impl TwoBlockParams {
             imprint_sample_frac: p.imprint.sample_frac,
             imprint_frames: p.imprint.frames,
         })
+    }
+}
+
+impl CircleModel {
+    /// The correspondence model of a profile's `[fiducial.circles]`: each placement's
+    /// (y_m, z_m) as face coordinates (u, v) (the module's face looks along +x, so +y is
+    /// to the right seen from in front), its rotation, and half the diameter as radius.
+    ///
+    /// # Errors
+    /// [`VisionError::Profile`] without circles, or with placements the model refuses
+    /// (fewer than 5, overlapping, a rotation other than −45, 0, 45 or 90).
+    pub fn from_profile(profile: &Profile) -> Result<Self, VisionError> {
+        let c = profile
+            .fiducial
+            .circles
+            .as_ref()
+            .ok_or_else(|| missing(format!("profile `{}` has no [fiducial.circles]", profile.name)))?;
+        let mut marks = Vec::with_capacity(c.placements.len());
+        for (i, p) in c.placements.iter().enumerate() {
+            let r = MarkRotation::from_degrees(p.rotation_deg).ok_or_else(|| {
+                missing(format!(
+                    "fiducial.circles.placements[{i}].rotation_deg: expected one of −45, 0, 45, 90, got {}",
+                    p.rotation_deg
+                ))
+            })?;
+            marks.push(([p.y_m, p.z_m], r));
+        }
+        CircleModel::new(c.diameter_m / 2.0, &marks)
+            .map_err(|e| missing(format!("profile `{}`: [fiducial.circles]: {e}", profile.name)))
     }
 }
 

@@ -217,3 +217,52 @@ pub fn scenario_file(dir: &Path, name: &str, profile: &str, rest: &str) -> PathB
     .unwrap();
     path
 }
+
+/// Draws a circle mark of the simulator's pattern (`sim::scene::CircleMark`), 4×4
+/// supersampled: centre (cx, cy) px, outer radius `r` px, bar at `rot_deg`
+/// counter-clockwise (y up), on white paper out to 1.3 r.
+pub fn circle_mark(im: &mut RgbImage, cx: f64, cy: f64, r: f64, rot_deg: f64) {
+    let (s, c) = rot_deg.to_radians().sin_cos();
+    let reach = 1.3 * r;
+    let (w, h) = (im.width() as f64, im.height() as f64);
+    for y in ((cy - reach).floor().max(0.0) as usize)..((cy + reach).ceil().min(h) as usize) {
+        for x in ((cx - reach).floor().max(0.0) as usize)..((cx + reach).ceil().min(w) as usize) {
+            let (mut acc, mut n) = (0.0, 0.0);
+            let old = im.view().get(x, y).map_or(0.0, |p| p[1] as f64);
+            for sy in 0..4 {
+                for sx in 0..4 {
+                    let a = x as f64 + (sx as f64 + 0.5) / 4.0 - cx;
+                    let b = -(y as f64 + (sy as f64 + 0.5) / 4.0 - cy);
+                    let rr = a.hypot(b);
+                    let bar = rr < 0.6 * r && (b * c - a * s).abs() < 0.12 * r;
+                    let black = rr < r && !(0.6 * r..0.8 * r).contains(&rr) && !bar;
+                    acc += if rr >= reach {
+                        old
+                    } else if black {
+                        12.0
+                    } else {
+                        220.0
+                    };
+                    n += 1.0;
+                }
+            }
+            let v = (acc / n).round() as u8;
+            im.put(x, y, [v, v, v]);
+        }
+    }
+}
+
+/// Axel's eight marks (`profiles/axel.toml`) seen face-on at `px_per_m`, the face's
+/// (0, 0.6) m at `centre`: a frame for detection and correspondence without the
+/// simulator.
+pub fn axel_marks_frame(w: usize, h: usize, px_per_m: f64, centre: [f64; 2]) -> RgbImage {
+    let mut im = background(w, h);
+    let p = shipped_profile("axel");
+    let c = p.fiducial.circles.expect("axel has circles");
+    for pl in &c.placements {
+        let x = centre[0] + px_per_m * pl.y_m;
+        let y = centre[1] - px_per_m * (pl.z_m - 0.6);
+        circle_mark(&mut im, x, y, px_per_m * c.diameter_m / 2.0, pl.rotation_deg);
+    }
+    im
+}
