@@ -7,7 +7,13 @@
 //! filters, geometry) on a rendered frame of the pyramid, at the profile's 160×120 and at
 //! 640×480.
 //!
-//! Run: `cargo bench --bench perception` (add `-- --quick` for a fast pass).
+//! Axel's circle fiducials (issue 16): detection, correspondence, and both for the stereo
+//! pair, on rendered 640×480 frames of the central module 1.5 m away, 15° off its axis.
+//! Target (issue 16): detection, correspondence and pose for a stereo pair under 5 ms on
+//! one core (the pose is not built yet).
+//!
+//! Run: `cargo bench --bench perception` (add `-- --quick` for a fast pass; `-- axel`
+//! for the circle cases only).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use marsupial::geometry::Pose2;
@@ -151,7 +157,66 @@ fn bench_pyramid(c: &mut Criterion, w: usize, h: usize) {
     g.finish();
 }
 
+fn bench_circles(c: &mut Criterion) {
+    use marsupial::perception::circles::{CircleDetector, CircleModel, CircleParams, CorrespondenceParams, correspond};
+    let (w, h) = (640, 480);
+    let mut p = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/axel.toml")).expect("profile");
+    for cam in &mut p.cameras {
+        cam.width_px = w;
+        cam.height_px = h;
+    }
+    let world = world::build(&p, &[], &[]).expect("world");
+    let model = CircleModel::from_profile(&p).expect("model");
+    let a = 15f64.to_radians();
+    let robot = Pose2::new(1.5 * a.cos(), 1.5 * a.sin(), a + std::f64::consts::PI);
+    let light = LightingRun::new(LightingSpec::default().resolve(), &mut Rng::new(1), 10.0);
+    let frames: Vec<_> = p
+        .cameras
+        .iter()
+        .map(|cam| {
+            let mut r = Renderer::new(CameraModel::from_spec(cam), w, h, 1);
+            let mut frame = marsupial::perception::RgbImage::default();
+            for k in 0..4 {
+                r.render(
+                    &world.scene,
+                    &camera_pose(&robot, &cam.mount),
+                    &light.at(0.0),
+                    &SensorParams::default(),
+                    1 + k,
+                    &mut frame,
+                );
+            }
+            frame
+        })
+        .collect();
+    let mut det = CircleDetector::new(w, h, CircleParams::for_image(w));
+    let params = CorrespondenceParams::default();
+    for f in &frames {
+        let marks = det.detect(&f.view()).expect("detect");
+        assert_eq!(marks.len(), 8, "bench frames must show all eight marks");
+        assert_eq!(correspond(&model, marks, &params).expect("fit").inliers, 8);
+    }
+    let marks = det.detect(&frames[0].view()).expect("detect").to_vec();
+    let mut g = c.benchmark_group(format!("axel_circles_{w}x{h}"));
+    g.bench_function("detect_one_frame", |b| {
+        b.iter(|| black_box(det.detect(black_box(&frames[0].view())).expect("detect").len()))
+    });
+    g.bench_function("correspond_eight_marks", |b| {
+        b.iter(|| black_box(correspond(&model, black_box(&marks), &params).expect("fit").inliers))
+    });
+    g.bench_function("detect_and_correspond_stereo_pair", |b| {
+        b.iter(|| {
+            for f in &frames {
+                let m = det.detect(black_box(&f.view())).expect("detect");
+                black_box(correspond(&model, m, &params).expect("fit").inliers);
+            }
+        })
+    });
+    g.finish();
+}
+
 fn benches(c: &mut Criterion) {
+    bench_circles(c);
     bench_size(c, 640, 480);
     bench_size(c, 256, 240);
     bench_pyramid(c, 160, 120);

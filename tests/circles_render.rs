@@ -114,6 +114,7 @@ fn every_visible_mark_is_found_labelled_and_centred_from_several_poses() {
             // Every visible mark is detected once, near its projected centre, with its
             // rotation; nothing else is detected.
             let mut err_max: f64 = 0.0;
+            let mut bar_max: f64 = 0.0;
             for (j, tr) in truth.iter().enumerate() {
                 let Some((c, rad)) = tr else { continue };
                 let near: Vec<_> = marks
@@ -128,6 +129,8 @@ fn every_visible_mark_is_found_labelled_and_centred_from_several_poses() {
                 let m = near[0];
                 let e = (m.centre[0] - c[0]).hypot(m.centre[1] - c[1]);
                 err_max = err_max.max(e);
+                let d = (m.bar_angle_deg - rotations[j].degrees() + 90.0).rem_euclid(180.0) - 90.0;
+                bar_max = bar_max.max(d.abs());
                 assert_eq!(
                     m.rotation,
                     Some(rotations[j]),
@@ -148,9 +151,10 @@ fn every_visible_mark_is_found_labelled_and_centred_from_several_poses() {
                 );
             }
             eprintln!(
-                "{label}: {visible} marks, centroid error ≤ {err_max:.3} px, reprojection RMS {:.3} px, hypothesis {} of {}",
+                "{label}: {visible} marks, centroid error ≤ {err_max:.3} px, bar angle error ≤ {bar_max:.1}°, reprojection RMS {:.3} px, hypothesis {} of {}",
                 fit.rms_px, fit.hypothesis, fit.hypotheses_tried
             );
+            assert!(bar_max < 10.0, "{label}: bar angle error {bar_max:.1}°");
             worst = worst.max(err_max);
             found_total += visible;
         }

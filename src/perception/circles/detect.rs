@@ -131,6 +131,9 @@ pub struct CircleParams {
     pub max_fit_rms_frac: f64,
     /// Smallest bar anisotropy (λ₁ − λ₂)/(λ₁ + λ₂) for a rotation to be read.
     pub min_bar_anisotropy: f64,
+    /// Largest difference between the bar's measured direction and its rotation's,
+    /// degrees: a bar between two rotations is no mark's.
+    pub max_bar_error_deg: f64,
     /// Smallest minor semi-axis of the fitted ellipse, px.
     pub min_radius_px: f64,
     /// Report only marks whose bar (and so rotation) was read. The bar is the pattern
@@ -144,7 +147,7 @@ pub struct CircleParams {
 
 impl CircleParams {
     /// Defaults for a `width`-pixel-wide image (our choices; the paper gives none):
-    /// * window: width/48, odd, at least 15 px (21 px at 1024): about a small mark's size,
+    /// * window: width/64, odd, at least 11 px (17 px at 1024): about a small mark's size,
     ///   so its mean is the mark's own mid-grey and not its surroundings' (a dark module
     ///   face otherwise leaves a 2-px rim in the dead band), yet wider than the rim and
     ///   ring of a mark at docking range;
@@ -154,18 +157,20 @@ impl CircleParams {
     /// * axis ratio ≥ 0.2 (a circle seen 78° off its normal);
     /// * black Euler number from −3 to 0 (at least one hole, a few from noise);
     /// * centroids within 0.2 of the radius; white/black area 0.25–4;
-    /// * contrast ≥ 25 grey levels;
+    /// * contrast ≥ 40 grey levels (rendered marks in lab light show 90–190);
     /// * fit RMS ≤ 0.35 px + 4 % of the minor semi-axis (a square's best ellipse is off by
     ///   about 10 % of its half-side);
-    /// * bar anisotropy ≥ 0.25 (a resolved bar gives about 0.6), and only marks with a
+    /// * bar anisotropy ≥ 0.5 (a resolved bar gives about 0.9), and only marks with a
     ///   resolved bar are reported;
+    /// * bar direction within 12° of its rotation (rendered marks up to 35° off the
+    ///   face's normal read within 6°; a 45° step leaves 22.5°);
     /// * minor semi-axis ≥ 4 px (smaller ones cannot show a bar, and speckle makes them);
     /// * at most 64 marks.
     pub fn for_image(width: usize) -> Self {
         Self {
             threshold: AdaptiveThreshold {
                 window_px: ((width / 64).max(11)) | 1,
-                offset: 6,
+                offset: 8,
             },
             min_area_px: 12,
             max_area_frac: 0.05,
@@ -173,10 +178,11 @@ impl CircleParams {
             black_euler: [-3, 0],
             max_centroid_offset: 0.2,
             area_ratio: [0.25, 4.0],
-            min_contrast: 25.0,
+            min_contrast: 40.0,
             max_fit_rms_px: 0.35,
             max_fit_rms_frac: 0.04,
-            min_bar_anisotropy: 0.25,
+            min_bar_anisotropy: 0.5,
+            max_bar_error_deg: 12.0,
             min_radius_px: 4.0,
             require_rotation: true,
             max_marks: 64,
@@ -333,6 +339,15 @@ impl CircleDetector {
                 self.white.push(i as u32);
             }
         }
+        // White candidates by centroid x, for the pairing's range search (an unstable sort
+        // in place: no allocation; ties cannot change which partner is closest).
+        let comps = self.labelers[WHITE].components();
+        self.white.sort_unstable_by(|a, b| {
+            comps[*a as usize]
+                .centroid()
+                .0
+                .total_cmp(&comps[*b as usize].centroid().0)
+        });
         for bi in 0..self.black.len() {
             if self.marks.len() >= p.max_marks {
                 break;
@@ -355,8 +370,15 @@ impl CircleDetector {
         let radius = (bc.width() + bc.height()) as f64 / 4.0;
         let tol = (p.max_centroid_offset * radius).max(1.0);
         let mut best: Option<(f64, usize)> = None;
-        for &wi in &self.white {
-            let wc = &self.labelers[WHITE].components()[wi as usize];
+        let comps = self.labelers[WHITE].components();
+        let from = self
+            .white
+            .partition_point(|&wi| comps[wi as usize].centroid().0 < bx - tol);
+        for &wi in &self.white[from..] {
+            let wc = &comps[wi as usize];
+            if wc.centroid().0 > bx + tol {
+                break;
+            }
             if wc.bbox[0] <= bc.bbox[0]
                 || wc.bbox[1] <= bc.bbox[1]
                 || wc.bbox[2] >= bc.bbox[2]
@@ -465,7 +487,10 @@ impl CircleDetector {
             return None;
         }
         let (bar_angle_deg, bar_anisotropy) = self.bar(&e, t, mw);
-        let rotation = (bar_anisotropy >= p.min_bar_anisotropy).then(|| MarkRotation::nearest(bar_angle_deg));
+        let rotation = Some(MarkRotation::nearest(bar_angle_deg)).filter(|r| {
+            let off = (bar_angle_deg - r.degrees() + 90.0).rem_euclid(180.0) - 90.0;
+            bar_anisotropy >= p.min_bar_anisotropy && off.abs() <= p.max_bar_error_deg
+        });
         if p.require_rotation && rotation.is_none() {
             return None;
         }

@@ -89,15 +89,35 @@ impl Thresholder {
                 &self.integral[y1 * iw..(y1 + 1) * iw],
             );
             let rows = (y1 - y0) as u32;
-            for x in 0..width {
+            let g_row = &grey[y * width..(y + 1) * width];
+            let (b_row, w_row) = (&mut bd[y * width..(y + 1) * width], &mut wd[y * width..(y + 1) * width]);
+            // g < m − off  ⇔  (g + off)·n < Σ;  g > m + off  ⇔  g·n > Σ + off·n.
+            let mut one = |x: usize| {
                 let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(width));
                 let sum = bot[x1] + top[x0] - top[x1] - bot[x0];
                 let n = rows * (x1 - x0) as u32;
-                let g = grey[y * width + x] as u32;
-                let i = y * width + x;
-                // g < m − off  ⇔  (g + off)·n < Σ;  g > m + off  ⇔  g·n > Σ + off·n.
-                bd[i] = ((g + off) * n < sum) as u8;
-                wd[i] = (g * n > sum + off * n) as u8;
+                let g = g_row[x] as u32;
+                b_row[x] = ((g + off) * n < sum) as u8;
+                w_row[x] = (g * n > sum + off * n) as u8;
+            };
+            if width <= 2 * r + 1 {
+                (0..width).for_each(&mut one);
+                continue;
+            }
+            (0..r).for_each(&mut one);
+            (width - r - 1..width).for_each(&mut one);
+            // Interior: the whole window in the row, a constant n; branch-free so it
+            // vectorises.
+            let n = rows * (2 * r + 1) as u32;
+            let m = width - 2 * r - 1;
+            let (tl, tr, bl, br) = (&top[..m], &top[2 * r + 1..][..m], &bot[..m], &bot[2 * r + 1..][..m]);
+            let g_mid = &g_row[r..][..m];
+            let (b_mid, w_mid) = (&mut b_row[r..][..m], &mut w_row[r..][..m]);
+            for i in 0..m {
+                let sum = br[i] + tl[i] - tr[i] - bl[i];
+                let g = g_mid[i] as u32;
+                b_mid[i] = ((g + off) * n < sum) as u8;
+                w_mid[i] = (g * n > sum + off * n) as u8;
             }
         }
     }
