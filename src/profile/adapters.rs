@@ -9,7 +9,7 @@
 
 use super::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount, PerceptionSpec, Profile};
 use super::{PyramidPerceptionSpec, TwoBlockSpec};
-use crate::perception::circles::{CircleModel, MarkRotation};
+use crate::perception::circles::{CircleModel, MarkRotation, RigCamera};
 use crate::perception::{
     CameraModel, ColorModelParams, Fisheye, HsvLimits, MountAngles, PairLimits, Pinhole, PyramidGeometry,
     PyramidParams, PyramidTrackerParams, SegmentationMode, TwoBlockGeometry, TwoBlockParams, VisionError,
@@ -227,6 +227,23 @@ impl CircleModel {
         }
         CircleModel::new(c.diameter_m / 2.0, &marks)
             .map_err(|e| missing(format!("profile `{}`: [fiducial.circles]: {e}", profile.name)))
+    }
+}
+
+impl RigCamera {
+    /// Camera `camera_index` of a profile as a rig camera: its model from the spec, its
+    /// mount's angles and its offset (x_m, y_m, z_m) in the rover frame.
+    ///
+    /// # Errors
+    /// [`VisionError::Profile`] when the profile has no such camera.
+    pub fn from_profile(profile: &Profile, camera_index: usize) -> Result<Self, VisionError> {
+        let cam = camera(profile, camera_index)?;
+        let m = &cam.mount;
+        Ok(Self::new(
+            CameraModel::from_spec(cam),
+            MountAngles::from(m),
+            [m.x_m, m.y_m, m.z_m],
+        ))
     }
 }
 

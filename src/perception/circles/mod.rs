@@ -11,7 +11,12 @@
 //! * [`correspond`] labels them against a [`CircleModel`]: the rotations split the 8!
 //!   labellings into at most 16 hypotheses, each verified by a homography
 //!   ([`Homography`], normalised DLT) and its reprojection; far points are occlusions or
-//!   false positives, and no fit from fewer than 5 marks is ever accepted.
+//!   false positives, and no fit from fewer than 5 marks is ever accepted;
+//! * [`module_pose`] turns the labelled marks ([`MarkObservations`]) into the module's
+//!   pose in the rover frame ([`ModulePose`]): midpoint triangulation of the marks both
+//!   cameras detected and a least-squares rigid (SVD) fit ([`stereo_pose`]), or, when
+//!   only one camera sees the module, the planar pose from a homography on undistorted
+//!   normalised coordinates ([`mono_pose`]).
 //!
 //! Everything is a pure function over borrowed data or a struct that allocates its
 //! buffers once; nothing allocates per frame.
@@ -22,6 +27,7 @@ pub mod detect;
 pub mod ellipse;
 pub mod homography;
 pub mod model;
+pub mod pose;
 
 pub mod threshold;
 
@@ -31,4 +37,8 @@ pub use detect::{CircleDetector, CircleParams, DetectedMark, MarkRotation};
 pub use ellipse::{Ellipse, EllipseFit, fit_ellipse};
 pub use homography::Homography;
 pub use model::{CircleModel, MAX_MODEL_MARKS, ModelError};
+pub use pose::{
+    MarkObservations, ModulePose, PoseBuffers, PoseError, PoseParams, PoseSource, RigCamera, module_pose, mono_pose,
+    rigid_fit, stereo_pose,
+};
 pub use threshold::{AdaptiveThreshold, Thresholder, grey_from_rgb};
