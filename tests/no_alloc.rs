@@ -6,7 +6,9 @@
 //! * the per-tick camera list, and the simulator's whole lockstep tick (device reads
 //!   through the hardware traits, rendering, the composed behavior, the command, the
 //!   physics step);
-//! * the composed Bujold and RAPOSA behaviors through their phases.
+//! * the composed Bujold and RAPOSA behaviors through their phases;
+//! * Axel's circle marks: detection, correspondence and the module's pose (stereo, mono
+//!   and the fallback choice).
 //!
 //! A counting global allocator, gated to the test's own thread, proves it. (The threaded
 //! runtime builds the same per-tick lists as the lockstep; its threads are not counted.)
@@ -501,4 +503,57 @@ fn circle_detection_and_correspondence_do_not_allocate() {
     COUNTING.with(|c| c.set(false));
     assert_eq!(allocs(), 0, "allocations in steady state");
     assert_eq!(fits, 15);
+}
+
+#[test]
+fn circle_pose_does_not_allocate() {
+    use marsupial::perception::circles::{
+        CircleDetector, CircleModel, CircleParams, CorrespondenceParams, MarkObservations, PoseBuffers, PoseParams,
+        RigCamera, correspond, module_pose, mono_pose, stereo_pose,
+    };
+    use nalgebra::{Rotation3, Vector3};
+    let p = common::shipped_profile("axel");
+    let model = CircleModel::from_profile(&p).unwrap();
+    let cams = [
+        RigCamera::from_profile(&p, 0).unwrap(),
+        RigCamera::from_profile(&p, 1).unwrap(),
+    ];
+    // Stereo: the model projected through both cameras with the module 2 m ahead.
+    let r = *Rotation3::from_axis_angle(&Vector3::z_axis(), std::f64::consts::PI + 0.1).matrix();
+    let t = Vector3::new(2.0, 0.1, 0.0);
+    let mut obs = [MarkObservations::new(model.len()); 2];
+    for (k, o) in obs.iter_mut().enumerate() {
+        for (j, c) in model.centres().iter().enumerate() {
+            o.set(j, cams[k].project(&(r * Vector3::new(0.0, c[0], c[1]) + t)));
+        }
+    }
+    // Mono: a detected frame, labelled (the synthetic frame's scale is not a camera's,
+    // but the pose still runs through every step).
+    let (w, h) = (640, 480);
+    let frame = common::axel_marks_frame(w, h, 300.0, [320.0, 240.0]);
+    let mut det = CircleDetector::new(w, h, CircleParams::for_image(w));
+    let cparams = CorrespondenceParams::default();
+    let params = PoseParams::default();
+    let mut buf = PoseBuffers::new();
+    let empty = MarkObservations::new(model.len());
+    let mut run = |buf: &mut PoseBuffers| {
+        let mut ok = 0;
+        ok += stereo_pose(&model, [&cams[0], &cams[1]], [&obs[0], &obs[1]], &params, buf).is_ok() as usize;
+        ok += module_pose(&model, [&cams[0], &cams[1]], [&empty, &obs[1]], &params, buf).is_ok() as usize;
+        let marks = det.detect(&frame.view()).unwrap();
+        let fit = correspond(&model, marks, &cparams).unwrap();
+        let seen = MarkObservations::from_fit(&fit, marks);
+        ok += mono_pose(&model, &cams[0], 0, &seen, &params, buf).is_ok() as usize;
+        ok
+    };
+    assert_eq!(run(&mut buf), 3); // warm-up
+    reset();
+    COUNTING.with(|c| c.set(true));
+    let mut ok = 0;
+    for _ in 0..5 {
+        ok += run(&mut buf);
+    }
+    COUNTING.with(|c| c.set(false));
+    assert_eq!(allocs(), 0, "allocations in steady state");
+    assert_eq!(ok, 15);
 }
