@@ -7,10 +7,11 @@
 //! filters, geometry) on a rendered frame of the pyramid, at the profile's 160×120 and at
 //! 640×480.
 //!
-//! Axel's circle fiducials (issue 16): detection, correspondence, and both for the stereo
-//! pair, on rendered 640×480 frames of the central module 1.5 m away, 15° off its axis.
-//! Target (issue 16): detection, correspondence and pose for a stereo pair under 5 ms on
-//! one core (the pose is not built yet).
+//! Axel's circle fiducials (issue 16): detection, correspondence, the module's pose
+//! (stereo triangulation and rigid fit; the monocular fallback), and the whole stereo
+//! pipeline (detect, correspond and pose both frames), on rendered 640×480 frames of the
+//! central module 1.5 m away, 15° off its axis. Target (issue 16): detection,
+//! correspondence and pose for a stereo pair under 5 ms on one core.
 //!
 //! Run: `cargo bench --bench perception` (add `-- --quick` for a fast pass; `-- axel`
 //! for the circle cases only).
@@ -158,7 +159,10 @@ fn bench_pyramid(c: &mut Criterion, w: usize, h: usize) {
 }
 
 fn bench_circles(c: &mut Criterion) {
-    use marsupial::perception::circles::{CircleDetector, CircleModel, CircleParams, CorrespondenceParams, correspond};
+    use marsupial::perception::circles::{
+        CircleDetector, CircleModel, CircleParams, CorrespondenceParams, MarkObservations, PoseBuffers, PoseParams,
+        RigCamera, correspond, mono_pose, stereo_pose,
+    };
     let (w, h) = (640, 480);
     let mut p = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/axel.toml")).expect("profile");
     for cam in &mut p.cameras {
@@ -197,6 +201,21 @@ fn bench_circles(c: &mut Criterion) {
         assert_eq!(correspond(&model, marks, &params).expect("fit").inliers, 8);
     }
     let marks = det.detect(&frames[0].view()).expect("detect").to_vec();
+    let cams = [
+        RigCamera::from_profile(&p, 0).expect("left"),
+        RigCamera::from_profile(&p, 1).expect("right"),
+    ];
+    let pose_params = PoseParams::default();
+    let mut buf = PoseBuffers::new();
+    let obs: Vec<MarkObservations> = frames
+        .iter()
+        .map(|f| {
+            let m = det.detect(&f.view()).expect("detect");
+            MarkObservations::from_fit(&correspond(&model, m, &params).expect("fit"), m)
+        })
+        .collect();
+    let stereo = stereo_pose(&model, [&cams[0], &cams[1]], [&obs[0], &obs[1]], &pose_params, &mut buf).expect("pose");
+    assert_eq!(stereo.marks_used, 8, "bench frames must give an 8-mark stereo pose");
     let mut g = c.benchmark_group(format!("axel_circles_{w}x{h}"));
     g.bench_function("detect_one_frame", |b| {
         b.iter(|| black_box(det.detect(black_box(&frames[0].view())).expect("detect").len()))
@@ -204,12 +223,44 @@ fn bench_circles(c: &mut Criterion) {
     g.bench_function("correspond_eight_marks", |b| {
         b.iter(|| black_box(correspond(&model, black_box(&marks), &params).expect("fit").inliers))
     });
+    g.bench_function("pose_stereo", |b| {
+        b.iter(|| {
+            let p = stereo_pose(&model, [&cams[0], &cams[1]], [&obs[0], &obs[1]], &pose_params, &mut buf);
+            black_box(p.expect("pose").marks_used)
+        })
+    });
+    g.bench_function("pose_mono", |b| {
+        b.iter(|| {
+            black_box(
+                mono_pose(&model, &cams[0], 0, &obs[0], &pose_params, &mut buf)
+                    .expect("pose")
+                    .marks_used,
+            )
+        })
+    });
     g.bench_function("detect_and_correspond_stereo_pair", |b| {
         b.iter(|| {
             for f in &frames {
                 let m = det.detect(black_box(&f.view())).expect("detect");
                 black_box(correspond(&model, m, &params).expect("fit").inliers);
             }
+        })
+    });
+    g.bench_function("detect_correspond_and_pose_stereo_pair", |b| {
+        let mut seen = [MarkObservations::new(model.len()); 2];
+        b.iter(|| {
+            for (k, f) in frames.iter().enumerate() {
+                let m = det.detect(black_box(&f.view())).expect("detect");
+                seen[k] = MarkObservations::from_fit(&correspond(&model, m, &params).expect("fit"), m);
+            }
+            let p = stereo_pose(
+                &model,
+                [&cams[0], &cams[1]],
+                [&seen[0], &seen[1]],
+                &pose_params,
+                &mut buf,
+            );
+            black_box(p.expect("pose").translation)
         })
     });
     g.finish();
