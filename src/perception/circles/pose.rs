@@ -10,7 +10,7 @@
 //! points into the rover frame: p_rover = R·p_module + t.
 //!
 //! **Stereo** ([`stereo_pose`]): for every mark *detected* in both cameras (marks
-//! correspondence filled in from the reprojection are not measurements, and are not
+//! the correspondence filled in from the reprojection are not measurements, and are not
 //! used), each camera's model turns the centre into a unit ray ([`CameraModel::ray`], so
 //! a distorted or fisheye lens is handled), the mount puts it in the rover frame, and the
 //! point is the **midpoint of the two rays' common perpendicular** (ALGORITHMS.md §7: it
