@@ -3,8 +3,7 @@
 //!
 //! **Frames.** The *module frame* is the dock frame of [`super::model`]: its face is the
 //! plane x = 0 and looks along +x, and mark j sits at (0, uⱼ, vⱼ) with (uⱼ, vⱼ) its face
-//! coordinates. The *rover frame* is the body frame of
-//! [`body_from_camera`]: +x forward,
+//! coordinates. The *rover frame* is the body frame of [`body_from_camera`]: +x forward,
 //! +y left, +z up, the origin on the ground under the rover's reference point (where a
 //! profile's `[cameras.mount]` offsets are measured from). A [`ModulePose`] maps module
 //! points into the rover frame: p_rover = R·p_module + t.
