@@ -6,7 +6,8 @@
 //! lost, duplicated or cut in the middle.
 //!
 //! The kills are drawn from a seeded generator (the seed is printed; set
-//! `MARSUPIAL_RESUME_SEED` to replay one) and land anywhere: during start-up, during a
+//! `MARSUPIAL_RESUME_SEED` to replay its delays, `--jobs` and write pauses, though where a
+//! delay lands in the campaign still depends on the machine's speed) and land anywhere: during start-up, during a
 //! run, while a record is being written (the campaign's `MARSUPIAL_TEST_SLOW_WRITE` hook
 //! writes each line in two halves with a pause between, to widen that window), during
 //! the resume's own truncation, while `summary.json` is written, or after the end. Each
