@@ -177,7 +177,8 @@ pub struct TrialsOptions {
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub jobs: usize,
-    /// Skip runs already in DIR/runs.jsonl.
+    /// Go on with an interrupted campaign: keep the runs in DIR/runs.jsonl (dropping a
+    /// torn last line) and run the rest.
     #[arg(long, requires = "out")]
     pub resume: bool,
     /// Print success binned by a drawn lighting parameter, `PARAM` or `PARAM:N` (N bins,

@@ -3,9 +3,25 @@
 //! Runs are independent and seeded from (scenario seed, run index), so a run's record does
 //! not depend on which worker ran it or when. Records are written in run order (a small
 //! reorder buffer holds early finishers), so the same scenario and seed give the same
-//! `runs.jsonl` byte for byte whatever `--jobs` is; `--resume` skips runs already in the
-//! file. Runs that differ only in segmentation mode share a `pair_seed`: same lighting
-//! instant, same placement error and the same imprint, as in the paper's paired protocol.
+//! `runs.jsonl` byte for byte whatever `--jobs` is. Runs that differ only in segmentation
+//! mode share a `pair_seed`: same lighting instant, same placement error and the same
+//! imprint, as in the paper's paired protocol.
+//!
+//! # Killed campaigns and `--resume`
+//! Each record is appended as one whole line with a single `write_all`, after the run's
+//! own files (trajectory CSV, frames) are written, so a campaign killed at any instant
+//! (SIGKILL, a crash, Ctrl-C) leaves in `runs.jsonl` the whole lines of runs `0..k` and at
+//! most one torn last line. `--resume` ([`read_resumable`]) checks those lines against the
+//! campaign, cuts the file after the last whole record (one truncation, never a rewrite,
+//! so being killed during the resume loses nothing either) and appends the remaining
+//! runs: the result is byte for byte the file of an uninterrupted campaign, with any
+//! `--jobs` on either side (`tests/campaign_resume.rs` kills campaigns at random instants
+//! and mid-write). Any other damage (a bad line before the last, a run out of place, a
+//! file from another scenario or seed) is an error naming the line, not silently
+//! dropped. `summary.json` and the plots are written from every record, resumed ones
+//! included, at the end; `summary.json` is replaced atomically. The guarantee is for
+//! the process being killed; after a power loss the operating system may not have
+//! written the file's last pages.
 
 use super::SimError;
 use super::lighting_random::LightingDraw;
@@ -90,7 +106,9 @@ pub struct CampaignOptions {
     pub out: Option<PathBuf>,
     /// Worker threads (0: all cores).
     pub jobs: usize,
-    /// Skip runs already in `out/runs.jsonl`.
+    /// Go on with an interrupted campaign in `out`: keep the runs already in
+    /// `out/runs.jsonl` (dropping a torn last line, see [`read_resumable`]) and run the
+    /// rest.
     pub resume: bool,
     /// Show a progress bar on stderr.
     pub progress: bool,
@@ -327,11 +345,133 @@ pub fn summary(name: &str, records: &[RunRecord]) -> Summary {
     }
 }
 
-/// Reads the records of an earlier (possibly interrupted) campaign.
+/// Reads the records of a `runs.jsonl` for analysis, leniently: lines that are not run
+/// records are skipped, and a missing file gives none. `--resume` does not use this: it
+/// reads with [`read_resumable`], which refuses anything but a torn last line.
 pub fn read_runs(path: &Path) -> Vec<RunRecord> {
     std::fs::read_to_string(path)
         .map(|s| s.lines().filter_map(|l| serde_json::from_str(l).ok()).collect())
         .unwrap_or_default()
+}
+
+/// What `--resume` keeps of an interrupted campaign's `runs.jsonl` ([`read_resumable`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Resumable {
+    /// The finished runs, in campaign order: runs `0..records.len()`.
+    pub records: Vec<RunRecord>,
+    /// Bytes of the file that hold them (whole lines, each ending in `\n`); the file is
+    /// cut to this length before the campaign goes on.
+    pub keep_bytes: u64,
+    /// Bytes after them: a torn last line (a write the kill cut short), dropped.
+    pub torn_bytes: u64,
+}
+
+/// Reads an interrupted campaign's `runs.jsonl` for `--resume`, checking it against the
+/// campaign's `runs`.
+///
+/// The campaign appends one whole line per run, in run order, so a kill at any instant
+/// leaves whole lines for runs `0..k`, then possibly a torn last line: bytes after the
+/// last `\n` (a line cut short mid-write), or a last line that does not parse. That torn
+/// line, and only it, is dropped (its run runs again). A missing file is an empty one.
+///
+/// # Errors
+/// [`SimError::Io`] when the file cannot be read, or names the first line (1-based) that
+/// a kill cannot explain: a line before the last that is not a run record, or a record
+/// that is not the campaign's run for its line (its index, start, trial and seed), as
+/// when the file was edited or written by another scenario or seed. Nothing is dropped
+/// silently; fix or remove the file, or run without `--resume`.
+pub fn read_resumable(path: &Path, runs: &[RunSpec]) -> Result<Resumable, SimError> {
+    let bytes = match std::fs::read(path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+        Err(e) => return Err(io(path)(e)),
+    };
+    let bad = |line: usize, what: String| SimError::Io {
+        path: path.display().to_string(),
+        source: std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "line {line}: {what}; --resume only drops a torn last line (fix or remove the file, or run without --resume)"
+            ),
+        ),
+    };
+    // Whole lines end in `\n`; anything after the last one is a torn write.
+    let whole = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let lines: Vec<&[u8]> = bytes[..whole].split_inclusive(|&b| b == b'\n').collect();
+    let mut records = Vec::with_capacity(lines.len());
+    let mut keep = 0usize;
+    for (i, line) in lines.iter().enumerate() {
+        let record: RunRecord = match serde_json::from_slice(&line[..line.len() - 1]) {
+            Ok(r) => r,
+            // The last line may be whole but unparseable only if nothing follows it.
+            Err(_) if i + 1 == lines.len() && whole == bytes.len() => break,
+            Err(e) => return Err(bad(i + 1, format!("not a run record ({e})"))),
+        };
+        match runs.get(i) {
+            Some(spec)
+                if record.index == spec.index
+                    && record.seed == spec.seed
+                    && record.trial == spec.trial
+                    && record.start == spec.start.label => {}
+            Some(spec) => {
+                return Err(bad(
+                    i + 1,
+                    format!(
+                        "run {} (start {}, trial {}, seed {}) where this campaign's run {} (start {}, trial {}, seed {}) belongs",
+                        record.index,
+                        record.start,
+                        record.trial,
+                        record.seed,
+                        spec.index,
+                        spec.start.label,
+                        spec.trial,
+                        spec.seed
+                    ),
+                ));
+            }
+            None => return Err(bad(i + 1, format!("the campaign has only {} runs", runs.len()))),
+        }
+        records.push(record);
+        keep += line.len();
+    }
+    Ok(Resumable {
+        records,
+        keep_bytes: keep as u64,
+        torn_bytes: (bytes.len() - keep) as u64,
+    })
+}
+
+/// The environment variable of a test hook: when it holds a number of milliseconds, each
+/// `runs.jsonl` line is written in two halves with that sleep between them, so a test
+/// that kills the campaign can land the kill mid-write (`tests/campaign_resume.rs`).
+/// Read once per campaign; unset (always, outside tests), a line is one `write_all`.
+pub const TEST_SLOW_WRITE_ENV: &str = "MARSUPIAL_TEST_SLOW_WRITE";
+
+/// Appends one whole `runs.jsonl` line (`line` ends in `\n`) with a single `write_all`,
+/// or, under the [`TEST_SLOW_WRITE_ENV`] hook, in two halves `pause` apart.
+fn append_line(f: &mut std::fs::File, line: &[u8], pause: Option<std::time::Duration>) -> std::io::Result<()> {
+    match pause {
+        None => f.write_all(line),
+        Some(d) => {
+            let (a, b) = line.split_at(line.len() / 2);
+            f.write_all(a)?;
+            std::thread::sleep(d);
+            f.write_all(b)
+        }
+    }
+}
+
+/// Replaces `path` with `bytes` atomically: a temporary file in the same folder, synced,
+/// then renamed over it, so a kill leaves the old file or the new one, never a torn one.
+fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut name = path.file_name().unwrap_or_default().to_os_string();
+    name.push(".tmp");
+    let tmp = path.with_file_name(name);
+    let mut f = std::fs::File::create(&tmp)?;
+    f.write_all(bytes)?;
+    f.sync_all()?;
+    drop(f);
+    std::fs::rename(&tmp, path)
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> SimError + '_ {
@@ -357,25 +497,39 @@ pub fn run_campaign(
     if let Some(dir) = &opts.out {
         std::fs::create_dir_all(dir).map_err(io(dir))?;
         let path = dir.join("runs.jsonl");
-        if opts.resume {
-            for r in read_runs(&path) {
-                done.insert(r.index, r);
+        let f = if opts.resume {
+            // Keep the finished runs' whole lines where they are and cut off a torn last
+            // line: one truncation, so a kill here too leaves a file a resume accepts.
+            let kept = read_resumable(&path, &p.runs)?;
+            if kept.torn_bytes > 0 {
+                tracing::info!(
+                    "{}: dropped a torn last line ({} bytes) after {} finished runs",
+                    path.display(),
+                    kept.torn_bytes,
+                    kept.records.len()
+                );
             }
-            // Rewrite the file with only complete, ordered lines.
-            let mut f = std::fs::File::create(&path).map_err(io(&path))?;
-            for r in done.values() {
-                writeln!(f, "{}", serde_json::to_string(r).unwrap_or_default()).map_err(io(&path))?;
-            }
+            let f = std::fs::OpenOptions::new()
+                .append(true)
+                .create(true)
+                .open(&path)
+                .map_err(io(&path))?;
+            f.set_len(kept.keep_bytes).map_err(io(&path))?;
+            done.extend(kept.records.into_iter().map(|r| (r.index, r)));
+            f
         } else {
             std::fs::File::create(&path).map_err(io(&path))?;
-        }
-        jsonl = Some(
             std::fs::OpenOptions::new()
                 .append(true)
                 .open(&path)
-                .map_err(io(&path))?,
-        );
+                .map_err(io(&path))?
+        };
+        jsonl = Some((f, path));
     }
+    let slow_write = std::env::var(TEST_SLOW_WRITE_ENV)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .map(std::time::Duration::from_millis);
     let pending: Vec<&RunSpec> = p.runs.iter().filter(|r| !done.contains_key(&r.index)).collect();
     let jobs = if opts.jobs == 0 {
         std::thread::available_parallelism().map_or(1, |n| n.get())
@@ -450,9 +604,16 @@ pub fn run_campaign(
                     continue;
                 }
                 let Some(r) = buffer.remove(&idx) else { break };
-                if let Some(f) = jsonl.as_mut() {
-                    let _ = writeln!(f, "{}", serde_json::to_string(&r).unwrap_or_default());
-                    let _ = f.flush();
+                if let Some((f, path)) = jsonl.as_mut() {
+                    // One whole line per write: a kill can only tear the last line.
+                    let mut line = serde_json::to_vec(&r).unwrap_or_default();
+                    line.push(b'\n');
+                    if let Err(e) = append_line(f, &line, slow_write) {
+                        // Stop: later lines after a short write would tear the middle.
+                        error.get_or_insert(io(path)(e));
+                        next.store(usize::MAX / 2, Ordering::SeqCst);
+                        jsonl = None;
+                    }
                 }
                 done.insert(idx, r);
                 cursor += 1;
@@ -468,8 +629,13 @@ pub fn run_campaign(
     let records: Vec<RunRecord> = done.into_values().collect();
     let summary = summary(&p.loaded.scenario.name, &records);
     if let Some(dir) = &opts.out {
+        // From every record, the resumed ones included; replaced atomically.
         let path = dir.join("summary.json");
-        std::fs::write(&path, serde_json::to_string_pretty(&summary).unwrap_or_default()).map_err(io(&path))?;
+        write_atomically(
+            &path,
+            serde_json::to_string_pretty(&summary).unwrap_or_default().as_bytes(),
+        )
+        .map_err(io(&path))?;
         super::plot::write_plots(dir, &p.world, &p.loaded.profile, &records).map_err(io(dir))?;
     }
     Ok((records, summary))
