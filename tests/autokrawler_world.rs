@@ -166,3 +166,65 @@ fn a_profile_without_the_gear_is_refused_with_what_it_lacks() {
         .to_string();
     assert!(e.contains("wheel_radius_m"), "{e}");
 }
+
+/// The Ackermann trapezoid makes the paper's ratio (eq. 5) a steering cue in world
+/// coordinates, with no camera involved: on each axle, d(rod left, plate left) over
+/// d(rod right, plate right) is 1 straight and moves monotonically away from 1 as |λ|
+/// grows to 30°, above 1 one way and below 1 the other. Prints the table λ → ratio.
+#[test]
+fn the_world_ratio_of_tie_rod_to_plate_marker_distances_moves_away_from_1_with_steering() {
+    let p = krawler();
+    let rest = KrawlerState::rest(&p).expect("autokrawler gear");
+    let ratio = |steer: f64, roll: f64| {
+        let gear = build(
+            &p,
+            &KrawlerState {
+                steer: [steer; 2],
+                roll: [roll, -roll],
+                ..rest
+            },
+        )
+        .unwrap();
+        let m = gear.markers;
+        [0, 4].map(|a| (m[a + 2] - m[a]).norm() / (m[a + 3] - m[a + 1]).norm())
+    };
+    for roll in [0.0, 0.15] {
+        let straight = ratio(0.0, roll);
+        for r in straight {
+            assert!((r - 1.0).abs() < 1e-9, "straight, roll {roll}: {r}");
+        }
+        for sign in [1.0, -1.0] {
+            let mut last = [1.0, 1.0];
+            let mut side = [0.0, 0.0];
+            for deg in (1..=30).map(f64::from) {
+                let lambda = sign * deg.to_radians();
+                let r = ratio(lambda, roll);
+                if deg % 5.0 == 0.0 && roll == 0.0 {
+                    println!("λ = {:+3}°: front {:.4}, rear {:.4}", sign * deg, r[0], r[1]);
+                }
+                for axle in 0..2 {
+                    assert!(
+                        (r[axle] - 1.0).abs() > (last[axle] - 1.0_f64).abs(),
+                        "axle {axle}, roll {roll}: λ = {}°: {} not further from 1 than {}",
+                        sign * deg,
+                        r[axle],
+                        last[axle]
+                    );
+                    if deg == 1.0 {
+                        side[axle] = (r[axle] - 1.0).signum();
+                    }
+                    assert_eq!((r[axle] - 1.0).signum(), side[axle], "stays on one side of 1");
+                }
+                last = r;
+            }
+            if sign < 0.0 {
+                continue;
+            }
+            // The other direction lands on the other side of 1.
+            let other = ratio(-0.3, roll);
+            for axle in 0..2 {
+                assert!((other[axle] - 1.0) * side[axle] < 0.0, "axle {axle}: {other:?}");
+            }
+        }
+    }
+}

@@ -12,9 +12,32 @@
 //! sixteen-sided prism whose faces carry a rubber tread texture, with one face painted
 //! white: the once-per-turn correction marker. Spinning a wheel turns its faces.
 //!
-//! Simplified: both wheels of an axle steer by the same angle (the paper estimates one λ
-//! per axle), the wheels stay on the axle's roll (they do not follow the ground), and the
-//! body above the camera is not drawn (a belly camera does not see it).
+//! **Ackermann linkage.** The steering arms form a trapezoid: each arm points from its
+//! kingpin toward the centre of the *other* axle (the standard Ackermann trapezoid, arms'
+//! lines meeting on the centre line at the opposite axle; seed 003 gives no linkage
+//! geometry, so this and [`ARM`]'s length are our choice). With the arms angled, steering
+//! swings the two tie-rod ends by different amounts along x, so the tie rod both shifts
+//! and tilts, and d(B1,A1) ≠ d(B2,A2) in world coordinates once λ ≠ 0: the paper's ratio
+//! (eq. 5) moves away from 1 with |λ|, with λ's sign, before any camera is involved.
+//!
+//! **The paper's definitions, adopted as our truth.** Each axle's frame has its origin at
+//! the midpoint of its two plate markers, and the axle rolls about that point (the paper:
+//! "the midpoint of the two marker coordinates is the rotational centre of the axle"), so
+//! [`KrawlerState::drop`] is the paper's d exactly: the vertical distance from the camera
+//! down to the plate markers' midpoint. The tie-rod markers sit in the same plane as the
+//! plate markers (the rod's top is level with the plate's), the plane the paper intersects
+//! their rays with (§V-B, normal R_y(ψ)·ẑ through the midpoint). No conversion is needed.
+//!
+//! **Frames.** The paper's frame (Fig. 2) has x to the right, y forward and z up; ours has
+//! x forward, y left and z up. So paper (x, y, z) = ours (−y, x, z); its planes y = ±c are
+//! our x = ±wheelbase/2, and its roll ψ about y is our roll about x (same sign for a
+//! right-handed rotation about the forward axis: positive lifts the left wheel).
+//!
+//! Simplified: both wheels of an axle steer by the same angle (the paper's assumption, one
+//! λ per axle), so the tie rod is drawn between the arms' ends and its length is not held
+//! rigid (it changes by under a centimetre over ±30°); the steering arms themselves are not
+//! drawn; the wheels stay on the axle's roll (they do not follow the ground); and the body
+//! above the camera is not drawn (a belly camera does not see it).
 
 use super::SimError;
 use super::scene::{Material, PaintedSquare, Prim, Scene, Shape, Tag, albedo, boxed};
@@ -28,7 +51,8 @@ use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vecto
 pub struct KrawlerState {
     /// Axle roll ψ (front, rear), rad: positive lifts the left wheel.
     pub roll: [f64; 2],
-    /// Vertical distance from the camera down to each axle's centre (front, rear), m.
+    /// Vertical distance from the camera down to each axle's plate-marker midpoint, the
+    /// axle's roll centre (front, rear), m: the paper's d.
     pub drop: [f64; 2],
     /// Steering λ (front, rear), rad: positive turns the wheels' fronts to the left.
     pub steer: [f64; 2],
@@ -44,7 +68,7 @@ impl KrawlerState {
     /// As [`build`], for a profile that does not describe the AutoKrawler's gear.
     pub fn rest(profile: &Profile) -> Result<Self, SimError> {
         let gear = Gear::of(profile)?;
-        let drop = gear.camera_z - gear.wheel_radius;
+        let drop = gear.camera_z - gear.wheel_radius - PLATE_TOP;
         Ok(Self {
             roll: [0.0; 2],
             drop: [drop; 2],
@@ -69,15 +93,16 @@ struct Gear {
 /// Width of a wheel's tread, m (estimate).
 const WHEEL_WIDTH: f64 = 0.08;
 /// Steering-arm length from kingpin to tie-rod end, m (estimate).
-const ARM: f64 = 0.09;
+pub const ARM: f64 = 0.09;
 /// Markers sit this far either side of the axle's centre line, m (estimate).
 const MARKER_Y: f64 = 0.1;
 /// Tread faces per wheel.
 const FACES: usize = 16;
-/// Height of the axle plate's top above the axle's centre, m.
-const PLATE_TOP: f64 = 0.021;
-/// Half the tie rod's height, m: its top carries the steering markers.
-const ROD_TOP: f64 = 0.012;
+/// Height of the axle plate's top (the markers' plane, the axle frame's origin) above the
+/// axle beam's centre, m.
+pub const PLATE_TOP: f64 = 0.021;
+/// The tie rod's height, m: its top, level with the plate's, carries the steering markers.
+const ROD_HEIGHT: f64 = 0.024;
 
 impl Gear {
     /// The gear `profile` describes: a double-Ackermann drive with a wheel radius, a
@@ -121,7 +146,8 @@ pub struct KrawlerScene {
     /// Everything the belly camera can see, in the body frame, over the ground.
     pub scene: Scene,
     /// Marker centres in the body frame: front plate left, right; front tie rod left,
-    /// right; then the same for the rear axle.
+    /// right; then the same for the rear axle. In the paper's labels (Fig. 4): A1, A2,
+    /// B1, B2, C1, C2, D1, D2, taking 1 as the left side (the figure is lost in the seed).
     pub markers: [Point3<f64>; 8],
     /// Centre of each wheel's white correction face (FL, FR, RL, RR), body frame.
     pub correction: [Point3<f64>; 4],
@@ -161,12 +187,13 @@ pub fn build(profile: &Profile, state: &KrawlerState) -> Result<KrawlerScene, Si
     let mut markers = [Point3::origin(); 8];
     let mut correction = [Point3::origin(); 4];
     for axle in 0..2 {
-        // Front axle ahead (+x), its steering arms pointing back toward the body's centre.
+        // Front axle ahead (+x); each axle's arms point back toward the other axle.
         let (x, inboard) = if axle == 0 {
             (g.wheelbase / 2.0, -1.0)
         } else {
             (-g.wheelbase / 2.0, 1.0)
         };
+        // The axle frame's origin is the plate markers' midpoint, its roll centre.
         let pose = Isometry3::from_parts(
             Translation3::new(x, 0.0, g.camera_z - state.drop[axle]),
             UnitQuaternion::from_axis_angle(&Vector3::x_axis(), state.roll[axle]),
@@ -174,40 +201,45 @@ pub fn build(profile: &Profile, state: &KrawlerState) -> Result<KrawlerScene, Si
         let mut put = |p: Prim| prims.push(transform(p, &pose));
         let half_beam = g.track / 2.0 - WHEEL_WIDTH / 2.0 - 0.01;
         for p in boxed(
-            Point3::new(-0.02, -half_beam, -0.02),
-            Point3::new(0.02, half_beam, 0.02),
+            Point3::new(-0.02, -half_beam, -0.02 - PLATE_TOP),
+            Point3::new(0.02, half_beam, 0.02 - PLATE_TOP),
             metal.clone(),
             Tag::Own,
         ) {
             put(p);
         }
-        put(flat(
-            Point3::new(0.0, 0.0, PLATE_TOP),
-            [0.06, 0.16],
-            pair(plate_albedo, 0.0),
-        ));
-        // The tie rod: the arms' ends, swung by the steering, shift it sideways.
-        let (s, c) = state.steer[axle].sin_cos();
-        let rod = Vector3::new(inboard * ARM * c, inboard * ARM * s, 0.0);
+        put(flat(Point3::origin(), [0.03, 0.16], pair(plate_albedo, 0.0)));
+        // The tie rod joins the arms' ends, each swung by the steering about its kingpin.
+        let rod_ends = tie_rod_ends(g.track, g.wheelbase, inboard, state.steer[axle]);
+        let (left_end, right_end) = (rod_ends[0], rod_ends[1]);
+        let mid = nalgebra::center(&left_end, &right_end);
+        let along = (left_end - right_end).normalize();
+        let half_rod = (left_end - right_end).norm() / 2.0;
+        let rod_pose = Isometry3::from_parts(
+            Translation3::new(mid.x, mid.y, 0.0),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), along.y.atan2(along.x) - std::f64::consts::FRAC_PI_2),
+        );
         let mut rod_box = boxed(
-            Point3::new(rod.x - 0.012, rod.y - half_beam + 0.02, -ROD_TOP),
-            Point3::new(rod.x + 0.012, rod.y + half_beam - 0.02, ROD_TOP),
+            Point3::new(-0.012, -half_rod, -ROD_HEIGHT),
+            Point3::new(0.012, half_rod, 0.0),
             metal.clone(),
             Tag::Own,
         );
-        // The box's top face is centred on the rod, u along x, v along y.
+        // The box's top face is centred on the rod, u along its width, v along its length.
         rod_box[4].material = pair(metal_albedo, 0.0);
-        rod_box.into_iter().for_each(&mut put);
+        for p in rod_box {
+            put(transform(p, &rod_pose));
+        }
         for (k, side) in [1.0, -1.0].into_iter().enumerate() {
-            let on_plate = Point3::new(0.0, side * MARKER_Y, PLATE_TOP);
-            let on_rod = Point3::new(rod.x, rod.y + side * MARKER_Y, ROD_TOP);
+            let on_plate = Point3::new(0.0, side * MARKER_Y, 0.0);
+            let on_rod = rod_pose * Point3::new(0.0, side * MARKER_Y, 0.0);
             markers[axle * 4 + k] = pose * on_plate;
             markers[axle * 4 + 2 + k] = pose * on_rod;
         }
         // Wheels: kingpins at the beam's ends; the left wheel is index 0 of the axle.
         for (k, side) in [1.0, -1.0].into_iter().enumerate() {
             let hub = Isometry3::from_parts(
-                Translation3::new(0.0, side * g.track / 2.0, 0.0),
+                Translation3::new(0.0, side * g.track / 2.0, -PLATE_TOP),
                 UnitQuaternion::from_axis_angle(&Vector3::z_axis(), state.steer[axle]),
             );
             let wheel = pose * hub;
@@ -255,6 +287,21 @@ pub fn build(profile: &Profile, state: &KrawlerState) -> Result<KrawlerScene, Si
         scene: Scene::on_floor(prims),
         markers,
         correction,
+    })
+}
+
+/// The tie rod's ends (left, right) in the axle frame, on the markers' plane (z = 0), for
+/// an axle of `track` on a rover of `wheelbase` whose arms point toward −x (`inboard` = −1,
+/// the front axle) or +x (+1, the rear), both wheels steered by `steer` (rad, positive
+/// turns the wheels' fronts left). At `steer` = 0 each arm points from its kingpin at
+/// (0, ±track/2) toward the other axle's centre, (inboard·wheelbase, 0): the Ackermann
+/// trapezoid. Public so tests can check the linkage against the rendered markers.
+pub fn tie_rod_ends(track: f64, wheelbase: f64, inboard: f64, steer: f64) -> [Point3<f64>; 2] {
+    [1.0, -1.0].map(|side: f64| {
+        let kingpin = Vector3::new(0.0, side * track / 2.0, 0.0);
+        let toward = Vector3::new(inboard * wheelbase, 0.0, 0.0) - kingpin;
+        let arm = Rotation3::from_axis_angle(&Vector3::z_axis(), steer) * toward.normalize() * ARM;
+        Point3::from(kingpin + arm)
     })
 }
 
