@@ -8,7 +8,8 @@
 //!   physics step);
 //! * the composed Bujold and RAPOSA behaviors through their phases;
 //! * Axel's circle marks: detection, correspondence and the module's pose (stereo, mono
-//!   and the fallback choice).
+//!   and the fallback choice);
+//! * the AutoKrawler's marker step: segmentation, opening, labelling, identity.
 //!
 //! A counting global allocator, gated to the test's own thread, proves it. (The threaded
 //! runtime builds the same per-tick lists as the lockstep; its threads are not counted.)
@@ -556,4 +557,59 @@ fn circle_pose_does_not_allocate() {
     COUNTING.with(|c| c.set(false));
     assert_eq!(allocs(), 0, "allocations in steady state");
     assert_eq!(ok, 15);
+}
+
+/// Eight 10×10 magenta squares on grey at `at` (shifted by `dx`), plus a stray magenta
+/// speck and a stray blob (clutter).
+fn krawler_markers_frame(at: &[[usize; 2]; 8], dx: usize) -> RgbImage {
+    let (w, h) = (640, 480);
+    let mut data = vec![110u8; w * h * 3];
+    let mut paint = |x0: usize, y0: usize, side: usize| {
+        for y in y0..y0 + side {
+            for x in x0..x0 + side {
+                data[(y * w + x) * 3..(y * w + x) * 3 + 3].copy_from_slice(&[220, 40, 210]);
+            }
+        }
+    };
+    for a in at {
+        paint(a[0] + dx - 5, a[1] - 5, 10);
+    }
+    paint(600, 20, 2);
+    paint(40, 400, 12);
+    RgbImage::from_raw(w, h, data).unwrap()
+}
+
+#[test]
+fn krawler_marker_finding_does_not_allocate() {
+    use marsupial::perception::krawler::{ExpectedMarker, MarkerFinder, MarkerParams};
+    let at = [
+        [280, 100],
+        [360, 100],
+        [270, 140],
+        [370, 140],
+        [280, 380],
+        [360, 380],
+        [270, 340],
+        [370, 340],
+    ];
+    let expected = at.map(|a| ExpectedMarker {
+        at: [a[0] as f64, a[1] as f64],
+        area: 100.0,
+    });
+    let frames: Vec<RgbImage> = (0..4).map(|dx| krawler_markers_frame(&at, dx * 2)).collect();
+    let mut finder = MarkerFinder::new(640, 480, MarkerParams::default());
+    for f in &frames {
+        assert_eq!(finder.find(&f.view(), &expected).unwrap().found(), 8); // warm-up
+    }
+    reset();
+    COUNTING.with(|c| c.set(true));
+    let mut found = 0;
+    for _ in 0..3 {
+        for f in &frames {
+            found += finder.find(&f.view(), &expected).unwrap().found();
+        }
+    }
+    COUNTING.with(|c| c.set(false));
+    assert_eq!(allocs(), 0, "allocations in steady state");
+    assert_eq!(found, 96);
 }

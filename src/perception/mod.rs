@@ -35,6 +35,7 @@ pub mod frame_change;
 pub mod hsv;
 pub mod hsv_stats;
 pub mod image;
+pub mod krawler;
 pub mod overlay;
 pub mod pyramid;
 pub mod pyramid_pose;

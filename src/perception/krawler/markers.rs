@@ -1,0 +1,347 @@
+//! The eight magenta markers (seed 003 §IV-B): HSV segmentation, erosion then dilation (a
+//! 3×3 opening), 8-connected components, and each blob's centre (the mean of its pixels,
+//! which for a convex marker is the centre of the area its contour encloses).
+//!
+//! **Identity.** A blob is given a marker's identity from where that marker is expected
+//! to project ([`ExpectedMarker`]: a pixel position and an area, which the caller predicts
+//! from the previous estimate or the rest state through the camera model). Candidate
+//! (marker, blob) pairs are those within [`MarkerParams::gate_px`] of the prediction whose
+//! area is within [`MarkerParams::area_ratio`] of the expected area; they are taken
+//! greedily, nearest first, each marker and each blob used at most once. Blobs nowhere
+//! near a predicted marker, or of the wrong size, are never assigned: that is what keeps
+//! magenta clutter out.
+//!
+//! **Corroboration.** A matched marker is reported only when another visible marker of
+//! the same axle lies where the prediction puts it relative to the first (within
+//! [`MarkerParams::consistency_px`]). A single magenta blob that happens to fall near a
+//! prediction is not enough; an axle showing only one marker reports none (one marker
+//! gives neither roll nor steering anyway).
+//!
+//! **Missing, never guessed.** A marker whose best blob touches the image border or has
+//! less than [`MarkerParams::min_visible`] of the expected area (partly hidden by a wheel,
+//! a shadow, or the frame's edge) is reported missing (`None`), as is one with no blob
+//! within the gate. Its blob is still consumed, so it cannot be handed to a neighbour.
+//!
+//! Every buffer is sized in [`MarkerFinder::new`]; [`MarkerFinder::find`] does not
+//! allocate.
+
+use crate::perception::components::Labeler;
+use crate::perception::hsv::Hsv;
+use crate::perception::image::RgbView;
+use crate::perception::segment::Mask;
+use crate::perception::{VisionError, check_same_size};
+
+/// Thresholds of the marker finder.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MarkerParams {
+    /// Hue band of magenta, degrees (low, high), low < high.
+    pub hue_deg: (f32, f32),
+    /// Minimum saturation, 0–1.
+    pub min_saturation: f32,
+    /// Minimum value (brightness), 0–1.
+    pub min_value: f32,
+    /// Blobs smaller than this after the opening are noise, pixels.
+    pub min_area_px: u64,
+    /// Largest distance from a marker's predicted position to its blob's centre, px.
+    pub gate_px: f64,
+    /// A blob's area over the expected area must lie in (1 / this, this) to be a
+    /// candidate for that marker at all.
+    pub area_ratio: f64,
+    /// A candidate with less than this fraction of the expected area is partly hidden:
+    /// its marker is reported missing.
+    pub min_visible: f64,
+    /// Corroboration: a marker is reported only if another visible marker of its axle
+    /// lies within this distance of where the prediction puts it relative to the first,
+    /// px. A lone blob near a prediction (clutter) is not a marker.
+    pub consistency_px: f64,
+}
+
+impl Default for MarkerParams {
+    /// Magenta 270–330°, saturation ≥ 0.45, value ≥ 0.15; blobs of 4 px or more; a 25 px
+    /// gate; areas within a factor 3, at least 60 % of the expected area visible, and a
+    /// 15 px corroboration tolerance.
+    fn default() -> Self {
+        Self {
+            hue_deg: (270.0, 330.0),
+            min_saturation: 0.45,
+            min_value: 0.15,
+            min_area_px: 4,
+            gate_px: 25.0,
+            area_ratio: 3.0,
+            min_visible: 0.6,
+            consistency_px: 15.0,
+        }
+    }
+}
+
+/// Where a marker is expected in the image, and how large.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExpectedMarker {
+    /// Predicted centre, px (x = column, y = row).
+    pub at: [f64; 2],
+    /// Predicted area, px².
+    pub area: f64,
+}
+
+impl ExpectedMarker {
+    /// The prediction for a square marker of side `side` centred at `centre` with edge
+    /// directions `u` and `v` (unit vectors), through `project` (a 3-D point in whatever
+    /// frame the closure expects to a pixel). The area is the parallelogram spanned by the
+    /// projected half-side steps, times four. `None` when any point does not project.
+    pub fn from_square<F>(project: F, centre: [f64; 3], u: [f64; 3], v: [f64; 3], side: f64) -> Option<Self>
+    where
+        F: Fn([f64; 3]) -> Option<[f64; 2]>,
+    {
+        let at = project(centre)?;
+        let step = |d: [f64; 3]| {
+            let q = project([
+                centre[0] + d[0] * side / 2.0,
+                centre[1] + d[1] * side / 2.0,
+                centre[2] + d[2] * side / 2.0,
+            ])?;
+            Some([q[0] - at[0], q[1] - at[1]])
+        };
+        let (a, b) = (step(u)?, step(v)?);
+        Some(Self {
+            at,
+            area: 4.0 * (a[0] * b[1] - a[1] * b[0]).abs(),
+        })
+    }
+}
+
+/// One magenta blob after the opening.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Blob {
+    /// Centre (mean pixel position), px.
+    pub centre: [f64; 2],
+    /// Area, px.
+    pub area: u64,
+    /// Whether the blob touches the image border (so it may be cut off).
+    pub on_border: bool,
+    /// Which marker it was matched to, if any (index into the eight).
+    pub marker: Option<usize>,
+    /// Matched, but not reported: partly hidden, or not corroborated by its axle.
+    pub rejected: bool,
+}
+
+/// The eight markers found in one frame, in the simulator's order: front plate left,
+/// right; front tie rod left, right; then the rear axle's (the paper's A1, A2, B1, B2,
+/// C1, C2, D1, D2, 1 on the left).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Markers {
+    /// Each marker's centre, px, or `None` when missing.
+    pub at: [Option<[f64; 2]>; 8],
+}
+
+impl Markers {
+    /// How many of the eight were found.
+    pub fn found(&self) -> usize {
+        self.at.iter().filter(|m| m.is_some()).count()
+    }
+}
+
+/// Finds and identifies the eight markers in frames of one size; owns every buffer.
+#[derive(Debug, Clone)]
+pub struct MarkerFinder {
+    params: MarkerParams,
+    mask: Mask,
+    scratch: Mask,
+    labeler: Labeler,
+    blobs: Vec<Blob>,
+    pairs: Vec<(f64, u8, u16)>,
+}
+
+/// At most this many blobs are kept per frame (the largest first is not guaranteed:
+/// raster order); more than this is clutter, not a rover.
+pub const MAX_BLOBS: usize = 512;
+
+impl MarkerFinder {
+    /// A finder for `width × height` frames.
+    pub fn new(width: usize, height: usize, params: MarkerParams) -> Self {
+        Self {
+            params,
+            mask: Mask::new(width, height),
+            scratch: Mask::new(width, height),
+            labeler: Labeler::new(width, height),
+            blobs: Vec::with_capacity(MAX_BLOBS),
+            pairs: Vec::with_capacity(8 * MAX_BLOBS),
+        }
+    }
+
+    /// The thresholds in use.
+    pub fn params(&self) -> &MarkerParams {
+        &self.params
+    }
+
+    /// The blobs of the last frame (at most [`MAX_BLOBS`]), each with the marker it was
+    /// given, if any.
+    pub fn blobs(&self) -> &[Blob] {
+        &self.blobs
+    }
+
+    /// The opened magenta mask of the last frame.
+    pub fn mask(&self) -> &Mask {
+        &self.mask
+    }
+
+    /// Finds the markers in `frame`, given where each is expected.
+    ///
+    /// # Errors
+    /// [`VisionError::SizeMismatch`] when `frame` is not the finder's size.
+    pub fn find(&mut self, frame: &RgbView<'_>, expected: &[ExpectedMarker; 8]) -> Result<Markers, VisionError> {
+        check_same_size(self.mask.size(), (frame.width(), frame.height()))?;
+        self.segment(frame);
+        open3(&mut self.mask, &mut self.scratch);
+        self.collect_blobs()?;
+        Ok(self.assign(expected))
+    }
+
+    fn segment(&mut self, frame: &RgbView<'_>) {
+        let p = &self.params;
+        let data = self.mask.data_mut();
+        for (i, px) in frame.as_bytes().chunks_exact(3).enumerate() {
+            let c = Hsv::from_rgb([px[0], px[1], px[2]]);
+            data[i] = (c.h >= p.hue_deg.0 && c.h <= p.hue_deg.1 && c.s >= p.min_saturation && c.v >= p.min_value) as u8;
+        }
+    }
+
+    fn collect_blobs(&mut self) -> Result<(), VisionError> {
+        let (w, h) = self.mask.size();
+        self.blobs.clear();
+        for c in self.labeler.label(&self.mask)? {
+            if c.count < self.params.min_area_px {
+                continue;
+            }
+            if self.blobs.len() == MAX_BLOBS {
+                break;
+            }
+            let (x, y) = c.centroid();
+            self.blobs.push(Blob {
+                centre: [x, y],
+                area: c.count,
+                on_border: c.bbox[0] == 0
+                    || c.bbox[1] == 0
+                    || c.bbox[2] as usize + 1 >= w
+                    || c.bbox[3] as usize + 1 >= h,
+                marker: None,
+                rejected: false,
+            });
+        }
+        Ok(())
+    }
+
+    fn assign(&mut self, expected: &[ExpectedMarker; 8]) -> Markers {
+        let p = self.params;
+        self.pairs.clear();
+        for (m, e) in expected.iter().enumerate() {
+            for (b, blob) in self.blobs.iter().enumerate() {
+                let d = (blob.centre[0] - e.at[0]).hypot(blob.centre[1] - e.at[1]);
+                let ratio = blob.area as f64 / e.area.max(1.0);
+                if d <= p.gate_px && ratio < p.area_ratio && ratio > 1.0 / p.area_ratio {
+                    self.pairs.push((d, m as u8, b as u16));
+                }
+            }
+        }
+        self.pairs.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        let mut out = Markers::default();
+        let mut taken = [false; 8];
+        for &(_, m, b) in &self.pairs {
+            let (m, b) = (m as usize, b as usize);
+            if taken[m] || self.blobs[b].marker.is_some() {
+                continue;
+            }
+            taken[m] = true;
+            let blob = &mut self.blobs[b];
+            blob.marker = Some(m);
+            let hidden = blob.on_border || (blob.area as f64) < p.min_visible * expected[m].area;
+            blob.rejected = hidden;
+            if !hidden {
+                out.at[m] = Some(blob.centre);
+            }
+        }
+        // Corroboration: a marker stands only if another visible marker of its axle sits
+        // where the prediction puts it relative to this one.
+        let mut keep = [false; 8];
+        for m in 0..8 {
+            let Some(c) = out.at[m] else { continue };
+            let axle = m / 4 * 4;
+            keep[m] = (axle..axle + 4).any(|n| {
+                n != m
+                    && out.at[n].is_some_and(|d| {
+                        let seen = [c[0] - d[0], c[1] - d[1]];
+                        let want = [
+                            expected[m].at[0] - expected[n].at[0],
+                            expected[m].at[1] - expected[n].at[1],
+                        ];
+                        (seen[0] - want[0]).hypot(seen[1] - want[1]) <= p.consistency_px
+                    })
+            });
+        }
+        for (at, keep) in out.at.iter_mut().zip(keep) {
+            if !keep {
+                *at = None;
+            }
+        }
+        for blob in &mut self.blobs {
+            if blob.marker.is_some_and(|m| !keep[m]) {
+                blob.rejected = true;
+            }
+        }
+        out
+    }
+}
+
+/// A 3×3 opening of `mask` (erosion, then dilation), through `scratch` (same size).
+/// Pixels outside the image count as unset, so erosion clears the border ring.
+fn open3(mask: &mut Mask, scratch: &mut Mask) {
+    let (w, h) = mask.size();
+    {
+        let src = mask.data();
+        let dst = scratch.data_mut();
+        dst.fill(0);
+        for y in 1..h.saturating_sub(1) {
+            for x in 1..w - 1 {
+                let mut all = 1u8;
+                for r in [y - 1, y, y + 1] {
+                    let row = &src[r * w + x - 1..r * w + x + 2];
+                    all &= row[0] & row[1] & row[2];
+                }
+                dst[y * w + x] = all;
+            }
+        }
+    }
+    let src = scratch.data();
+    let dst = mask.data_mut();
+    for y in 0..h {
+        for x in 0..w {
+            let mut any = 0u8;
+            for r in y.saturating_sub(1)..(y + 2).min(h) {
+                for c in x.saturating_sub(1)..(x + 2).min(w) {
+                    any |= src[r * w + c];
+                }
+            }
+            dst[y * w + x] = any;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn opening_removes_specks_and_keeps_squares() {
+        let mut m = Mask::new(20, 20);
+        for y in 5..11 {
+            for x in 5..11 {
+                m.set(x, y, true);
+            }
+        }
+        m.set(15, 15, true);
+        m.set(16, 15, true);
+        let mut s = Mask::new(20, 20);
+        open3(&mut m, &mut s);
+        assert_eq!(m.count(), 36);
+        assert!(!m.get(15, 15));
+    }
+}

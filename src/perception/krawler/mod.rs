@@ -1,0 +1,10 @@
+//! The AutoKrawler's running-gear state from its belly fisheye (seed 003, DESIGN §2.4).
+//!
+//! The paper's pipeline, one stage per module. So far: [`markers`], the perceptual step
+//! that finds the eight magenta markers (HSV segmentation, a 3×3 opening, connected
+//! components, blob centres) and gives each its identity. Axle roll and drop, steering
+//! and wheel rotation build on it.
+
+pub mod markers;
+
+pub use markers::{Blob, ExpectedMarker, MarkerFinder, MarkerParams, Markers};
