@@ -2,9 +2,12 @@
 //!
 //! The paper's pipeline, one stage per module. So far: [`markers`], the perceptual step
 //! that finds the eight magenta markers (HSV segmentation, a 3×3 opening, connected
-//! components, blob centres) and gives each its identity. Axle roll and drop, steering
-//! and wheel rotation build on it.
+//! components, blob centres) and gives each its identity; and [`axle`], axle roll ψ and
+//! drop d from each plate-marker pair by ray-plane intersection. Steering and wheel
+//! rotation build on these.
 
+pub mod axle;
 pub mod markers;
 
+pub use axle::{AxleGeometry, AxlePose};
 pub use markers::{Blob, ExpectedMarker, MarkerFinder, MarkerParams, Markers};
