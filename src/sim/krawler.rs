@@ -28,14 +28,15 @@
 //! plate markers (the rod's top is level with the plate's), the plane the paper intersects
 //! their rays with (§V-B, normal R_y(ψ)·ẑ through the midpoint). No conversion is needed.
 //!
-//! **Frames.** The paper's frame (Fig. 2) has x to the right, y forward and z up; ours has
-//! x forward, y left and z up. So paper (x, y, z) = ours (−y, x, z); its planes y = ±c are
+//! **Frames.** The paper's frame has y forward and z up, and we take its x to the right
+//! (Fig. 2 is lost in the seed; right is what makes it right-handed); ours has x forward,
+//! y left and z up. So paper (x, y, z) = ours (−y, x, z); its planes y = ±c are
 //! our x = ±wheelbase/2, and its roll ψ about y is our roll about x (same sign for a
 //! right-handed rotation about the forward axis: positive lifts the left wheel).
 //!
 //! Simplified: both wheels of an axle steer by the same angle (the paper's assumption, one
 //! λ per axle), so the tie rod is drawn between the arms' ends and its length is not held
-//! rigid (it changes by under a centimetre over ±30°); the steering arms themselves are not
+//! rigid (it lengthens by 1.1 cm, 2 %, at ±30°); the steering arms themselves are not
 //! drawn; the wheels stay on the axle's roll (they do not follow the ground); and the body
 //! above the camera is not drawn (a belly camera does not see it).
 
