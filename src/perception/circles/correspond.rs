@@ -25,7 +25,7 @@
 //! The kept hypothesis has the most inliers, then the least RMS reprojection error (seed
 //! 000 keeps "the permutation with minimal error"; counting inliers first stops a
 //! hypothesis that fits 5 marks well from beating one that fits 8). Undetected marks are
-//! filled in from the reprojection ([`ModelFit::centres`]).
+//! filled in from the reprojection ([`ModelFit::centre`]).
 //!
 //! Seed 000 §V-D: "5 of the 11 failures were attributed to a known bug … only 4 were input
 //! to the consensus-based homography algorithm"; with 4 points and one false, the fit is

@@ -8,7 +8,7 @@
 //!   filtered by size, eccentricity and Euler number ([`RunIndex`]), black/white pairs
 //!   with coinciding centroids, a local re-threshold for the bar's rotation, and the
 //!   centre from a direct least-squares ellipse fit ([`fit_ellipse`]) of the perimeter;
-//! * [`correspond`] labels them against a [`CircleModel`]: the rotations split the 8!
+//! * [`correspond()`] labels them against a [`CircleModel`]: the rotations split the 8!
 //!   labellings into at most 16 hypotheses, each verified by a homography
 //!   ([`Homography`], normalised DLT) and its reprojection; far points are occlusions or
 //!   false positives, and no fit from fewer than 5 marks is ever accepted;

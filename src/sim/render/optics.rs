@@ -47,7 +47,7 @@ pub struct CameraMotion {
     pub velocity: [f32; 3],
 }
 
-/// The thin lens's defocus: what [`defocus`] needs.
+/// The thin lens: what the defocus blur needs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Lens {
     /// Distance the lens is focused at, m.
