@@ -88,6 +88,18 @@ const CASES: &[(&str, &str, Option<usize>, &str)] = &[
         Some(70),
         "expected a number in [0, 30], got 45",
     ),
+    (
+        "pairing_limits_out_of_range.toml",
+        "perception.max_height_ratio",
+        Some(70),
+        "expected a number in [1, ",
+    ),
+    (
+        "pairing_limits_out_of_range.toml",
+        "perception.min_count_ratio",
+        Some(71),
+        "expected a number in [0, 1], got 1.5",
+    ),
     ("empty.toml", "", None, "missing field `name`"),
 ];
 

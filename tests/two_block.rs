@@ -13,6 +13,8 @@ fn limits() -> PairLimits {
         max_gap_frac: 0.5,
         gap_slack_px: 3.0,
         max_vertical_frac: 0.5,
+        max_height_ratio: 2.0,
+        min_count_ratio: 0.2,
         max_candidates: 64,
     }
 }
@@ -61,6 +63,31 @@ fn vertical_alignment_limit() {
         rect(&mut im, 10, 10, 30, 20, CYAN);
         rect(&mut im, 30, 10 + dy, 50, 20 + dy, MAGENTA);
         assert_eq!(detect(&im).is_some(), ok, "dy {dy}");
+    }
+}
+
+#[test]
+fn height_ratio_limit() {
+    // A 10 px tall left block beside right blocks of growing height, centred on it: at
+    // most 2× taller pairs (the flap's blocks are equally tall, perspective makes 1.35×).
+    for (h, ok) in [(10usize, true), (20, true), (21, false), (30, false)] {
+        let mut im = background(100, 60);
+        rect(&mut im, 10, 25, 40, 35, CYAN);
+        let top = 30 - h / 2;
+        rect(&mut im, 40, top, 55, top + h, MAGENTA);
+        assert_eq!(detect(&im).is_some(), ok, "right height {h}");
+    }
+}
+
+#[test]
+fn count_ratio_limit() {
+    // 10 px tall blocks, the left one 50 px wide (500 px): a right block of 100 px pairs
+    // (ratio 0.2), one of 90 px does not.
+    for (w, ok) in [(50usize, true), (10, true), (9, false)] {
+        let mut im = background(100, 40);
+        rect(&mut im, 10, 10, 60, 20, CYAN);
+        rect(&mut im, 60, 10, 60 + w, 20, MAGENTA);
+        assert_eq!(detect(&im).is_some(), ok, "right width {w}");
     }
 }
 

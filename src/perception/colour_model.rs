@@ -19,6 +19,9 @@
 //!
 //! SDs are clamped to [floor, ceiling] so a flat-coloured patch cannot collapse its range
 //! to nothing and a noisy one cannot swallow the colour space (ALGORITHMS §2 pitfalls).
+//! The two colours' ranges never overlap each other or reach halfway to grey
+//! ([`separate_ranges`]): adaptation cannot grow one colour's range over the other's block
+//! or over the grey body around it.
 
 use super::image::RgbView;
 use super::sct::Sct;
@@ -453,10 +456,113 @@ impl<S: Blend> ColorModel<S> {
 }
 
 impl ColorModel<[AngleStats; 2]> {
-    /// SCT segmentation ranges for the next frame.
+    /// SCT segmentation ranges for the next frame, never overlapping: see
+    /// [`separate_ranges`].
     pub fn ranges(&self) -> [SctRange; 2] {
         let p = &self.params;
-        self.current().map(|s| s.range(p))
+        let stats = self.current();
+        let mut r = stats.map(|s| s.range(p));
+        separate_ranges(&mut r, stats);
+        r
+    }
+}
+
+/// Makes the two colours' boxes disjoint from each other and from grey: where they
+/// overlap, each is cut at the midpoint between the two means along the angle (A or B)
+/// on which the means lie farther apart. A pixel is then never both colours, and one that
+/// could be either goes to the nearer. Grey is treated as a third colour
+/// (see `off_grey`): no range reaches past the midpoint between its mean and grey.
+///
+/// Why: adaptation measures each colour from the pixels its own range segmented. At a
+/// grazing view the blocks are a few pixels wide, and their shared edge holds every
+/// mixture of the two paints; a range that takes in some of those mixtures measures a
+/// larger SD, widens, takes in more, and runs away until it holds the other block too.
+/// We replayed it (bujold-table1 run 45, 2 m at +60°): cyan's B range grew from 72–81°
+/// to 5–86° over 40 s while the robot swung to 70° off the axis, the cyan block was
+/// counted over the whole flap, and the ratio cue put the robot on the wrong side of the
+/// axis. Two opposite colours never need overlapping ranges, so the cut costs nothing
+/// where adaptation is healthy (the imprint's and the table's ranges are disjoint
+/// already) and stops the runaway where it is not.
+///
+/// ```
+/// use marsupial::perception::colour_model::separate_ranges;
+/// use marsupial::perception::AngleStats;
+/// use marsupial::perception::segment::SctRange;
+///
+/// let st = |b: f64| AngleStats { mean_a: 0.8, sd_a: 0.02, mean_b: b, sd_b: 0.1, n: 100 };
+/// let stats = [st(0.2), st(1.2)]; // B 11° and 69°; grey is at B 45° (0.785 rad)
+/// let range = |s: &AngleStats, half_b: f64| SctRange {
+///     a: [s.mean_a - 0.1, s.mean_a + 0.1],
+///     b: [s.mean_b - half_b, s.mean_b + half_b],
+///     min_l: 20.0,
+///     min_chroma: 0.05,
+/// };
+/// // Healthy ranges (B 0–0.4 and 1.0–1.4) are left alone…
+/// let before = [range(&stats[0], 0.2), range(&stats[1], 0.2)];
+/// let mut r = before;
+/// separate_ranges(&mut r, &stats);
+/// assert_eq!(r, before);
+/// // …but one drifted over grey and the other colour (B 0.1–2.3) starts halfway between
+/// // its mean and grey.
+/// let mut r = [range(&stats[0], 0.2), range(&stats[1], 1.1)];
+/// separate_ranges(&mut r, &stats);
+/// assert_eq!(r[0], before[0]);
+/// let grey_b = std::f64::consts::FRAC_PI_4;
+/// assert!((r[1].b[0] - (1.2 + grey_b) / 2.0).abs() < 1e-12 && (r[1].b[1] - 2.3).abs() < 1e-12);
+/// ```
+pub fn separate_ranges(r: &mut [SctRange; 2], stats: &[AngleStats; 2]) {
+    for (range, s) in r.iter_mut().zip(stats) {
+        off_grey(range, s);
+    }
+    let overlap = |x: [f64; 2], y: [f64; 2]| x[0] < y[1] && y[0] < x[1];
+    if !(overlap(r[0].a, r[1].a) && overlap(r[0].b, r[1].b)) {
+        return;
+    }
+    let (da, db) = (stats[1].mean_a - stats[0].mean_a, stats[1].mean_b - stats[0].mean_b);
+    let [r0, r1] = r;
+    if da.abs() >= db.abs() {
+        cut(&mut r0.a, &mut r1.a, stats[0].mean_a, stats[1].mean_a);
+    } else {
+        cut(&mut r0.b, &mut r1.b, stats[0].mean_b, stats[1].mean_b);
+    }
+}
+
+/// SCT angles (A, B) of grey, r = g = b: A = atan(√2), B = 45°.
+const GREY_AB: (f64, f64) = (0.955_316_618_124_509_3, std::f64::consts::FRAC_PI_4);
+
+/// Cuts `r` at the midpoint between its colour's mean and grey, as if grey were a third
+/// colour: a pixel nearer grey than the colour is background. The chroma gate
+/// ([`SctRange::min_chroma`]) keeps out pixels within a few degrees of grey, but a grey
+/// surface's sensor noise scatters well past it; a colour range widened by adaptation
+/// toward grey (a far, thin block whose edge pixels are half body grey) then segments the
+/// mother's grey body pixel by pixel next to the block, the block's component grows into
+/// it, and the range widens further. We replayed it (bujold-table1 run 45 at 1.9 m,
+/// 60° off the axis): cyan's range came to hold half the body's rear face, and the pose
+/// read 0.5 m where the robot stood 1.9 m away.
+fn off_grey(r: &mut SctRange, s: &AngleStats) {
+    let (da, db) = (s.mean_a - GREY_AB.0, s.mean_b - GREY_AB.1);
+    let (x, mean, grey) = if da.abs() >= db.abs() {
+        (&mut r.a, s.mean_a, GREY_AB.0)
+    } else {
+        (&mut r.b, s.mean_b, GREY_AB.1)
+    };
+    let mid = (mean + grey) / 2.0;
+    if mean >= grey {
+        x[0] = x[0].max(mid);
+    } else {
+        x[1] = x[1].min(mid);
+    }
+}
+
+/// Cuts intervals `x` (about mean `mx`) and `y` (about `my`) at the midpoint of the means.
+fn cut(x: &mut [f64; 2], y: &mut [f64; 2], mx: f64, my: f64) {
+    let mid = (mx + my) / 2.0;
+    if mx <= my {
+        x[1] = x[1].min(mid);
+        y[0] = y[0].max(mid);
+    } else {
+        x[0] = x[0].max(mid);
+        y[1] = y[1].min(mid);
     }
 }
 
@@ -753,5 +859,56 @@ mod tests {
         let mut open = Imprinter::new(rects, 0.5, 20.0, 0.0);
         open.add_frame(&im.view());
         assert!(open.finish().is_some(), "without the gate the grey is imprinted");
+    }
+
+    fn box_at(a: f64, b: f64, half: f64) -> SctRange {
+        SctRange {
+            a: [a - half, a + half],
+            b: [b - half, b + half],
+            min_l: 20.0,
+            min_chroma: 0.05,
+        }
+    }
+
+    fn stats_at(a: f64, b: f64) -> AngleStats {
+        AngleStats {
+            mean_a: a,
+            sd_a: 0.02,
+            mean_b: b,
+            sd_b: 0.02,
+            n: 10,
+        }
+    }
+
+    #[test]
+    fn overlapping_colours_are_cut_at_the_midpoint_of_their_means() {
+        // Orange and red, both on the warm side of grey (A 78–79°, B 13–28°), drifted to
+        // ±15°: cut apart on B (15° apart against 1° on A) at B 20.8°.
+        let d = f64::to_radians;
+        let stats = [stats_at(d(78.0), d(13.3)), stats_at(d(79.1), d(28.3))];
+        let mut r = [box_at(d(78.0), d(13.3), d(15.0)), box_at(d(79.1), d(28.3), d(15.0))];
+        separate_ranges(&mut r, &stats);
+        let mid = d(20.8);
+        assert!((r[0].b[1] - mid).abs() < 1e-12 && (r[1].b[0] - mid).abs() < 1e-12);
+        assert_eq!(r[0].b[0], d(13.3) - d(15.0));
+        // No pixel is both colours.
+        for b in 0..900 {
+            let b = d(f64::from(b) / 10.0);
+            assert!(!(r[0].b[0] <= b && b <= r[0].b[1] && r[1].b[0] < b && b <= r[1].b[1]));
+        }
+    }
+
+    #[test]
+    fn no_range_reaches_halfway_to_grey() {
+        let d = f64::to_radians;
+        // Blue (A 22.5°, B 55°) is farther from grey (A 54.7°) on A: cut at A 38.6°.
+        let stats = [stats_at(d(22.5), d(55.1)), stats_at(d(80.5), d(45.0))];
+        let mut r = [box_at(d(22.5), d(55.1), d(30.0)), box_at(d(80.5), d(45.0), d(30.0))];
+        separate_ranges(&mut r, &stats);
+        let grey_a = 2f64.sqrt().atan();
+        assert!((r[0].a[1] - (d(22.5) + grey_a) / 2.0).abs() < 1e-12);
+        // Yellow (A 80.5°) from the other side.
+        assert!((r[1].a[0] - (d(80.5) + grey_a) / 2.0).abs() < 1e-12);
+        assert!(!r[0].contains([128, 128, 128]) && !r[1].contains([128, 128, 128]));
     }
 }

@@ -39,6 +39,8 @@ pub const RIGHT_PAINT: ([u8; 3], [u8; 3]) = ([255, 255, 0], [120, 120, 0]);
 ///     max_gap_frac: 0.5,
 ///     gap_slack_px: 3.0,
 ///     max_vertical_frac: 0.5,
+///     max_height_ratio: 2.0,
+///     min_count_ratio: 0.2,
 ///     max_candidates: 8,
 /// };
 /// let mut det = TwoBlockDetector::new(16, 8, limits);

@@ -13,7 +13,12 @@
 //! * **gap**: the right block's leftmost pixel minus the left block's rightmost pixel is
 //!   within `gap_slack_px + max_gap_frac · h` of adjacency (h the blocks' mean height;
 //!   proportional so that roll, which tilts the shared edge, is tolerated at any range);
-//! * **alignment**: centroids within `max_vertical_frac · h` vertically.
+//! * **alignment**: centroids within `max_vertical_frac · h` vertically;
+//! * **height**: the taller block at most `max_height_ratio` times the shorter (the blocks
+//!   are equally tall on the flap; a real scene's unrelated patches of the two colours
+//!   rarely are: a butterfly's wing spots in the real photos paired at 2.7×);
+//! * **balance**: the smaller block's pixel count at least `min_count_ratio` of the
+//!   larger's (two sweets in a real photo paired at 0.04).
 //!
 //! Among the surviving pairs the one whose pixel-count ratio is closest to 1 wins; ties go
 //! to the larger total, then to the lower component indices, so the choice is
@@ -40,6 +45,15 @@ pub struct PairLimits {
     pub gap_slack_px: f64,
     /// Vertical centroid tolerance as a fraction of the mean block height.
     pub max_vertical_frac: f64,
+    /// Largest ratio of the taller block's height to the shorter's (≥ 1). The blocks are
+    /// equally tall on the flap; perspective alone makes the nearer one at most 1.35×
+    /// taller anywhere in the approach zone (0.33 m, 70° off the axis, the 0.18 m flap).
+    pub max_height_ratio: f64,
+    /// Smallest ratio of the smaller block's pixel count to the larger's, in [0, 1]. The
+    /// blocks are equal on the flap; perspective and foreshortening make the smaller at
+    /// least 0.45 of the larger anywhere in the approach zone, a block half lost to a
+    /// shadow about 0.22.
+    pub min_count_ratio: f64,
     /// Largest number of components per colour paired.
     pub max_candidates: usize,
 }
@@ -99,6 +113,8 @@ pub struct Pair {
 ///     max_gap_frac: 0.5,
 ///     gap_slack_px: 3.0,
 ///     max_vertical_frac: 0.5,
+///     max_height_ratio: 2.0,
+///     min_count_ratio: 0.2,
 ///     max_candidates: 8,
 /// };
 /// let mut det = TwoBlockDetector::new(16, 8, limits);
@@ -219,7 +235,14 @@ impl TwoBlockDetector {
                 if (ly - ry).abs() > lim.max_vertical_frac * h {
                     continue;
                 }
+                let (hl, hr) = (l.height() as f64, r.height() as f64);
+                if hl.max(hr) > lim.max_height_ratio * hl.min(hr) {
+                    continue;
+                }
                 let ratio = l.count.min(r.count) as f64 / l.count.max(r.count) as f64;
+                if ratio < lim.min_count_ratio {
+                    continue;
+                }
                 let total = l.count + r.count;
                 let better = match &best {
                     None => true,
@@ -395,6 +418,8 @@ pub struct TwoBlockParams {
 ///         max_gap_frac: 0.5,
 ///         gap_slack_px: 3.0,
 ///         max_vertical_frac: 0.5,
+///         max_height_ratio: 2.0,
+///         min_count_ratio: 0.2,
 ///         max_candidates: 8,
 ///     },
 ///     colour: ColorModelParams {

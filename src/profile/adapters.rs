@@ -94,6 +94,8 @@ impl From<&PerceptionSpec> for PairLimits {
             max_gap_frac: p.max_gap_frac,
             gap_slack_px: p.gap_slack_px,
             max_vertical_frac: p.max_vertical_frac,
+            max_height_ratio: p.max_height_ratio,
+            min_count_ratio: p.min_count_ratio,
             max_candidates: p.max_candidates as usize,
         }
     }
@@ -169,7 +171,8 @@ impl PyramidGeometry {
 
 impl TwoBlockParams {
     /// The two-block tracker of camera `camera` of a profile with a
-    /// `[fiducial.two_block]`: table defaults from the fiducial's paint colours, in the
+    /// `[fiducial.two_block]`: table defaults from the fiducial's paint colours as painted
+    /// ([`NamedColor::paint_srgb`](crate::profile::NamedColor::paint_srgb)), in the
     /// order they appear in this camera's image, and everything else from `[perception]`.
     ///
     /// # Errors
@@ -189,7 +192,7 @@ impl TwoBlockParams {
         Ok(Self {
             width: cam.width_px,
             height: cam.height_px,
-            colours: [img_left.rgb(), img_right.rgb()],
+            colours: [img_left.paint_srgb(), img_right.paint_srgb()],
             table_sd: p.table_sd_deg.to_radians(),
             limits: PairLimits::from(p),
             colour: ColorModelParams::from(p),

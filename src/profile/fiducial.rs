@@ -43,7 +43,8 @@ impl NamedColor {
         }
     }
 
-    /// Nominal sRGB value of the paint.
+    /// Nominal sRGB value of the paint's pigment. A real paint is paler: see
+    /// [`NamedColor::reflectance`] and [`NamedColor::paint_srgb`] (`profile::paint`).
     pub fn rgb(&self) -> [u8; 3] {
         match self {
             NamedColor::Cyan => [0, 255, 255],

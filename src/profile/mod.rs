@@ -17,6 +17,7 @@ pub mod devices;
 pub mod drive;
 pub mod fiducial;
 pub mod geometry;
+pub mod paint;
 pub mod perception;
 pub mod pyramid_perception;
 pub mod tree;

@@ -44,6 +44,13 @@ pub struct PerceptionSpec {
     pub gap_slack_px: f64,
     /// Largest vertical offset of the block centroids, fraction of their mean height.
     pub max_vertical_frac: f64,
+    /// Largest ratio of the blocks' heights in the image (≥ 1; perspective alone gives at
+    /// most 1.35 for Bujold's flap, 2 leaves room for a block partly lost to shadow or
+    /// clipped at the image edge).
+    pub max_height_ratio: f64,
+    /// Smallest ratio of the blocks' pixel counts, in [0, 1] (perspective alone gives at
+    /// least 0.45 for Bujold's flap; 0.2 leaves room for a block half lost to shadow).
+    pub min_count_ratio: f64,
     /// Range half-width in SDs (paper: 4).
     pub n_sd: f64,
     /// Smallest SD used for a range, degrees.
@@ -77,6 +84,8 @@ impl Default for PerceptionSpec {
             max_gap_frac: 0.5,
             gap_slack_px: 3.0,
             max_vertical_frac: 0.5,
+            max_height_ratio: 2.0,
+            min_count_ratio: 0.2,
             n_sd: 4.0,
             sd_floor_deg: 0.5,
             sd_ceiling_deg: 10.0,
@@ -110,6 +119,8 @@ pub(crate) fn validate_perception(p: &PerceptionSpec, v: &mut Validator<'_>) {
     v.non_negative("perception.max_gap_frac", p.max_gap_frac);
     v.non_negative("perception.gap_slack_px", p.gap_slack_px);
     v.positive("perception.max_vertical_frac", p.max_vertical_frac);
+    v.range("perception.max_height_ratio", p.max_height_ratio, 1.0, f64::MAX);
+    v.range("perception.min_count_ratio", p.min_count_ratio, 0.0, 1.0);
     v.positive("perception.n_sd", p.n_sd);
     v.positive("perception.sd_floor_deg", p.sd_floor_deg);
     v.positive("perception.sd_ceiling_deg", p.sd_ceiling_deg);

@@ -47,6 +47,8 @@ impl Percept for TwoBlockPercept {
 ///         max_gap_frac: 0.5,
 ///         gap_slack_px: 3.0,
 ///         max_vertical_frac: 0.5,
+///         max_height_ratio: 2.0,
+///         min_count_ratio: 0.2,
 ///         max_candidates: 8,
 ///     },
 ///     colour: ColorModelParams {

@@ -12,14 +12,7 @@ pub fn albedo(srgb: [u8; 3], reflectance: f32) -> [f32; 3] {
     srgb.map(|c| srgb_to_linear(c as f32 / 255.0) * reflectance)
 }
 
-/// sRGB transfer function inverse.
-pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
+pub use crate::profile::paint::srgb_to_linear;
 
 /// What a surface looks like, as a function of its local coordinates (a, b) in metres
 /// (a along the primitive's `u` axis, b along `v`, origin at its centre).

@@ -133,19 +133,14 @@ fn yaw(v: Vector3<f64>, deg: f64) -> Vector3<f64> {
     Vector3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z)
 }
 
-/// A painted surface of a named colour: the pigment's reflectance (85 % at its peak) plus a
-/// white floor of [`PAINT_FLOOR`] at every wavelength. No real paint or ink is a pure sRGB
-/// primary: the binder's surface reflects about 4 % of all light (Fresnel at n ≈ 1.5) and
-/// pigments leak a few per cent outside their band, so a cyan flap still returns some
-/// red. Without the floor a rendered cyan sits exactly on SCT's B = 90° edge wherever no
-/// highlight reaches it, and a faint highlight moved it 12° (to B 78°) in the dusk
-/// departure frames we measured: an edge no real paint sits on.
+/// A painted surface of a named colour: its linear reflectance from the paint model the
+/// perception's table defaults share ([`crate::profile::paint`]). Without the model's
+/// floor a rendered cyan sits exactly on SCT's B = 90° edge wherever no highlight reaches
+/// it, and a faint highlight moved it 12° (to B 78°) in the dusk departure frames we
+/// measured: an edge no real paint sits on.
 pub(super) fn paint(c: NamedColor) -> [f32; 3] {
-    albedo(c.rgb(), 0.85 - PAINT_FLOOR).map(|v| v + PAINT_FLOOR)
+    c.reflectance()
 }
-
-/// Reflectance every paint returns at every wavelength (see [`paint`]).
-const PAINT_FLOOR: f32 = 0.04;
 
 /// Builds the world for `profile` with `clutter` and optional backdrop photos.
 ///
@@ -537,6 +532,7 @@ fn add_clutter(prims: &mut Vec<Prim>, c: &ClutterSpec, profile: &Profile) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::profile::paint::PAINT_FLOOR;
 
     #[test]
     fn paints_reflect_a_little_of_every_colour() {
