@@ -95,14 +95,14 @@ fn index_replays_that_campaign_run_and_writes_its_frames() {
     assert!(dir.join("trajectory.csv").exists());
 }
 
-/// Runs that are not short and not all successes: Bujold's Table I run 47 (the campaign's
-/// one failure, the README's example to watch: out of time from 2 m at +60°), and RAPOSA
+/// Runs that are not short and not all successes: Bujold's Table II run 9 (static
+/// segmentation under the rotating flashers, out of time from 0.33 m at −70°), and RAPOSA
 /// with a repainted ball, run 36 (fixed bands: stuck on the pyramid after 79 s) and run
 /// 14 (static bands imprinted on departure: docked after a region-II manoeuvre, 73 s).
 #[test]
 fn index_gives_the_campaigns_own_record_of_that_run() {
     for (name, index, outcome) in [
-        ("bujold-table1", 47, "timeout"),
+        ("bujold-table2", 9, "timeout"),
         ("raposa-repaint", 36, "stuck_contact"),
         ("raposa-repaint", 14, "docked"),
     ] {
