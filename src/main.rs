@@ -29,6 +29,13 @@ enum Command {
     /// (one line per finished run, in run order), DIR/summary.json, DIR/trajectories.svg,
     /// DIR/success_map.svg and per-run trajectories.
     Trials(marsupial::cli::sim_cmds::TrialsOptions),
+    /// Join the output folders of a campaign's shards (`trials S --shard K/N --out DIR`).
+    ///
+    /// Checks that the folders are shards 1..N of one campaign, each complete, and writes
+    /// OUT/runs.jsonl (the shards' lines in campaign order) and OUT/summary.json, equal
+    /// byte for byte to an unsharded `trials --out`; with --scenario, also the plots and
+    /// paper comparison.
+    Merge(marsupial::cli::merge::MergeOptions),
     /// Validate profile and scenario files.
     ///
     /// Prints `ok FILE` for each valid file. For each invalid file prints every problem
@@ -110,9 +117,14 @@ fn main() -> ExitCode {
         }
         Command::Dock(opts) => exit_code(marsupial::cli::sim_cmds::dock(&opts, &mut std::io::stdout())),
         Command::Trials(mut opts) => {
-            opts.progress = std::io::IsTerminal::is_terminal(&std::io::stderr());
+            opts.progress = if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+                marsupial::sim::campaign::Progress::Bar
+            } else {
+                marsupial::sim::campaign::Progress::Lines
+            };
             exit_code(marsupial::cli::sim_cmds::trials(&opts, &mut std::io::stdout()))
         }
+        Command::Merge(opts) => exit_code(marsupial::cli::merge::run(&opts, &mut std::io::stdout())),
         Command::Detect(opts) => exit_code(marsupial::cli::detect::run(&opts, &mut std::io::stdout())),
         Command::Timeline { trace } => exit_code(marsupial::cli::timeline::run(&trace, &mut std::io::stdout())),
     }

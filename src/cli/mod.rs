@@ -4,5 +4,6 @@
 pub mod calibrate;
 pub mod check;
 pub mod detect;
+pub mod merge;
 pub mod sim_cmds;
 pub mod timeline;

@@ -5,6 +5,7 @@ use crate::sim::SimError;
 use crate::sim::campaign::{self, CampaignOptions, GroupSummary, Recording, RunRecord, Summary};
 use crate::sim::paper::cell;
 use crate::sim::scenario::Scenario;
+use crate::sim::shard;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -188,9 +189,15 @@ pub struct TrialsOptions {
     /// beacon_distance_m, shadows, shadow_speed_mps, shadow_strength, clouds.
     #[arg(long, value_name = "PARAM[:N]")]
     pub bin: Vec<String>,
-    /// Progress bar on stderr (set by the binary when stderr is a terminal).
+    /// Run only shard K of N (1-based): the runs at campaign positions K−1, K−1+N, …
+    /// The same runs on any machine; join the shards' output folders with
+    /// `marsupial merge`. With --out, also writes DIR/shard.json.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<crate::sim::shard::Shard>,
+    /// Progress on stderr (the binary sets a bar when stderr is a terminal, plain lines
+    /// otherwise).
     #[arg(skip)]
-    pub progress: bool,
+    pub progress: campaign::Progress,
 }
 
 /// Prints a summary as a table like the paper's: one row per group (start × the axes
@@ -295,7 +302,22 @@ pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimE
             opts.scenario.display()
         )));
     }
-    let prepared = campaign::prepare(loaded)?;
+    let mut prepared = campaign::prepare(loaded)?;
+    if let Some(shard) = opts.shard {
+        let campaign_runs = prepared.runs.len();
+        prepared.runs = shard.select(&prepared.runs);
+        if let Some(dir) = &opts.out {
+            shard::write_info(
+                dir,
+                &shard::ShardInfo {
+                    scenario: prepared.loaded.scenario.name.clone(),
+                    shard,
+                    campaign_runs,
+                    shard_runs: prepared.runs.len(),
+                },
+            )?;
+        }
+    }
     let started = std::time::Instant::now();
     let (records, summary) = campaign::run_campaign(
         &prepared,

@@ -110,10 +110,23 @@ pub struct CampaignOptions {
     /// `out/runs.jsonl` (dropping a torn last line, see [`read_resumable`]) and run the
     /// rest.
     pub resume: bool,
-    /// Show a progress bar on stderr.
-    pub progress: bool,
+    /// How progress is shown on stderr.
+    pub progress: Progress,
     /// Write each run's trajectory CSV (and frames, when the scenario asks).
     pub per_run_files: bool,
+}
+
+/// How a campaign shows its progress on stderr.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Progress {
+    /// Nothing (the library's default).
+    #[default]
+    Off,
+    /// A live bar with the elapsed time, an ETA and the success count (for a terminal).
+    Bar,
+    /// A plain line at every tenth of the campaign (for logs and CI, where a bar's
+    /// redraws would be noise): runs done, docked, elapsed time and ETA.
+    Lines,
 }
 
 /// Everything shared by the runs of a campaign.
@@ -536,7 +549,7 @@ pub fn run_campaign(
     } else {
         opts.jobs
     };
-    let bar = opts.progress.then(|| {
+    let bar = (opts.progress == Progress::Bar).then(|| {
         let b = indicatif::ProgressBar::new(p.runs.len() as u64);
         b.set_style(
             indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {elapsed_precise} (eta {eta})  {msg}")
@@ -545,9 +558,11 @@ pub fn run_campaign(
         b.set_position(done.len() as u64);
         b
     });
+    let mut lines = (opts.progress == Progress::Lines).then(|| ProgressLines::new(p, done.values()));
     let next = AtomicUsize::new(0);
     let (tx, rx) = crossbeam::channel::unbounded::<Result<RunRecord, SimError>>();
     let mut error = None;
+    let (mut docked, mut finished) = (done.values().filter(|r| r.success).count(), done.len());
     std::thread::scope(|s| {
         for _ in 0..jobs.min(pending.len().max(1)) {
             let tx = tx.clone();
@@ -586,9 +601,17 @@ pub fn run_campaign(
         for rec in rx.iter() {
             match rec {
                 Ok(r) => {
+                    docked += usize::from(r.success);
+                    finished += 1;
                     if let Some(b) = &bar {
                         b.inc(1);
-                        b.set_message(format!("last: start {} {}", r.start, r.outcome));
+                        b.set_message(format!(
+                            "docked {docked}/{finished}  last: start {} {}",
+                            r.start, r.outcome
+                        ));
+                    }
+                    if let Some(l) = lines.as_mut() {
+                        l.record(r.success);
                     }
                     buffer.insert(r.index, r);
                 }
@@ -639,6 +662,53 @@ pub fn run_campaign(
         super::plot::write_plots(dir, &p.world, &p.loaded.profile, &records).map_err(io(dir))?;
     }
     Ok((records, summary))
+}
+
+/// [`Progress::Lines`]: a line on stderr each time another tenth of the campaign is done.
+struct ProgressLines {
+    name: String,
+    total: usize,
+    done: usize,
+    docked: usize,
+    /// Runs finished in this invocation (a resume's kept runs cost no time).
+    fresh: usize,
+    started: std::time::Instant,
+    next_tenth: usize,
+}
+
+impl ProgressLines {
+    fn new<'a>(p: &Prepared, kept: impl Iterator<Item = &'a RunRecord>) -> Self {
+        let (mut done, mut docked) = (0, 0);
+        for r in kept {
+            done += 1;
+            docked += usize::from(r.success);
+        }
+        let total = p.runs.len();
+        Self {
+            name: p.loaded.scenario.name.clone(),
+            total,
+            done,
+            docked,
+            fresh: 0,
+            started: std::time::Instant::now(),
+            next_tenth: (done * 10 / total.max(1)) + 1,
+        }
+    }
+
+    fn record(&mut self, success: bool) {
+        self.done += 1;
+        self.fresh += 1;
+        self.docked += usize::from(success);
+        if self.done * 10 >= self.next_tenth * self.total {
+            self.next_tenth = self.done * 10 / self.total.max(1) + 1;
+            let elapsed = self.started.elapsed().as_secs_f64();
+            let eta = elapsed / self.fresh as f64 * (self.total - self.done) as f64;
+            eprintln!(
+                "{}: {}/{} runs, {} docked, {:.0} s elapsed, eta {:.0} s",
+                self.name, self.done, self.total, self.docked, elapsed, eta
+            );
+        }
+    }
 }
 
 /// Writes a run's track as CSV (t, x, y).

@@ -51,4 +51,5 @@ pub mod range;
 pub mod robot;
 pub mod run;
 pub mod scenario;
+pub mod shard;
 pub mod tether;
