@@ -63,6 +63,14 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Fit the AutoKrawler's steering polynomials λ = f(x) from a sweep.
+    ///
+    /// Finds the eight markers in each frame of a recorded sweep (`--sweep`, CSV
+    /// `image,steer_front_deg,steer_rear_deg`) or of one simulated from the profile's gear
+    /// (0 → +max → −max), takes each axle's tie-rod ratio x = d(B1,A1)/d(B2,A2) after
+    /// ray-plane intersection, and fits λ = c0 + c1·(x−1) + c2·(x−1)² per axle. Prints
+    /// the coefficients and residuals; `--write` puts them into the profile.
+    CalibrateSteering(marsupial::cli::calibrate_steering::CalibrateSteeringOptions),
     /// Run the two-block perceptual schema on image files.
     ///
     /// The images are processed in order as a stream, so adaptation carries from one to
@@ -111,6 +119,9 @@ fn main() -> ExitCode {
             json,
             &mut std::io::stdout(),
         )),
+        Command::CalibrateSteering(opts) => {
+            exit_code(marsupial::cli::calibrate_steering::run(&opts, &mut std::io::stdout()))
+        }
         Command::Check { files } => {
             let bad = marsupial::cli::check::run(&files, &mut std::io::stdout(), &mut std::io::stderr());
             if bad == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE }

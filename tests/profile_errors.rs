@@ -100,6 +100,12 @@ const CASES: &[(&str, &str, Option<usize>, &str)] = &[
         Some(71),
         "expected a number in [0, 1], got 1.5",
     ),
+    (
+        "steering_poly_wrong_length.toml",
+        "fiducial.markers.steering_poly_deg[1]",
+        Some(42),
+        "expected 3 coefficients (second order) or 4 (third order), got 5",
+    ),
     ("empty.toml", "", None, "missing field `name`"),
 ];
 

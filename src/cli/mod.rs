@@ -2,6 +2,7 @@
 //! tested without spawning a process.
 
 pub mod calibrate;
+pub mod calibrate_steering;
 pub mod check;
 pub mod detect;
 pub mod merge;

@@ -10,6 +10,7 @@
 use super::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount, PerceptionSpec, Profile};
 use super::{PyramidPerceptionSpec, TwoBlockSpec};
 use crate::perception::circles::{CircleModel, MarkRotation, RigCamera};
+use crate::perception::krawler::{AxleGeometry, SteeringPoly};
 use crate::perception::{
     CameraModel, ColorModelParams, Fisheye, HsvLimits, MountAngles, PairLimits, Pinhole, PyramidGeometry,
     PyramidParams, PyramidTrackerParams, SegmentationMode, TwoBlockGeometry, TwoBlockParams, VisionError,
@@ -247,6 +248,39 @@ impl RigCamera {
             MountAngles::from(m),
             [m.x_m, m.y_m, m.z_m],
         ))
+    }
+}
+
+impl AxleGeometry {
+    /// The back-projection geometry of a double-Ackermann profile's belly camera
+    /// (`camera_index`): its model, mount rotation and position, and the axles' planes at
+    /// ± half the wheelbase.
+    ///
+    /// # Errors
+    /// [`VisionError::Profile`] without the camera or a wheelbase.
+    pub fn from_profile(profile: &Profile, camera_index: usize) -> Result<Self, VisionError> {
+        let cam = camera(profile, camera_index)?;
+        let half = profile
+            .drive
+            .wheelbase_m
+            .ok_or_else(|| missing(format!("profile `{}` has no drive.wheelbase_m", profile.name)))?
+            / 2.0;
+        let m = &cam.mount;
+        Ok(Self {
+            model: CameraModel::from_spec(cam),
+            body_from_camera: crate::perception::body_from_camera(m),
+            camera: nalgebra::Point3::new(m.x_m, m.y_m, m.z_m),
+            axle_x: [half, -half],
+        })
+    }
+}
+
+impl SteeringPoly {
+    /// The steering calibrations (front, rear) of a profile's `[fiducial.markers]`, or
+    /// `None` when it has none yet (`marsupial calibrate-steering` writes them).
+    pub fn from_profile(profile: &Profile) -> Option<[Self; 2]> {
+        let polys = profile.fiducial.markers.as_ref()?.steering_poly_deg?;
+        Some(polys.map(|c| Self { deg: c.deg }))
     }
 }
 

@@ -126,6 +126,50 @@ pub struct MarkersSpec {
     pub side_m: f64,
     /// Marker colour.
     pub color: NamedColor,
+    /// Steering calibration λ = f(x) per axle (front, rear), for the tie-rod ratio x
+    /// (seed 003 eq. 5, Fig. 6): the coefficients of 1, (x − 1), (x − 1)² and optionally
+    /// (x − 1)³, degrees. Fitted and written by `marsupial calibrate-steering`; without
+    /// it the steering is not estimated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steering_poly_deg: Option<[SteeringCoeffs; 2]>,
+}
+
+/// One axle's steering polynomial as a profile writes it: three coefficients (the
+/// paper's second order) or four (third order), degrees.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "Vec<f64>", into = "Vec<f64>")]
+pub struct SteeringCoeffs {
+    /// Coefficients of 1, (x − 1), (x − 1)², (x − 1)³ (0 for a second-order polynomial).
+    pub deg: [f64; 4],
+    /// 2 or 3.
+    pub order: usize,
+}
+
+impl TryFrom<Vec<f64>> for SteeringCoeffs {
+    type Error = String;
+
+    fn try_from(v: Vec<f64>) -> Result<Self, String> {
+        match v[..] {
+            [a, b, c] => Ok(Self {
+                deg: [a, b, c, 0.0],
+                order: 2,
+            }),
+            [a, b, c, d] => Ok(Self {
+                deg: [a, b, c, d],
+                order: 3,
+            }),
+            _ => Err(format!(
+                "expected 3 coefficients (second order) or 4 (third order), got {}",
+                v.len()
+            )),
+        }
+    }
+}
+
+impl From<SteeringCoeffs> for Vec<f64> {
+    fn from(c: SteeringCoeffs) -> Self {
+        c.deg[..=c.order].to_vec()
+    }
 }
 
 /// The `[fiducial]` table: exactly one of the sub-tables.
@@ -194,5 +238,10 @@ pub(crate) fn validate_fiducial(f: &FiducialSpec, v: &mut Validator<'_>) {
     if let Some(m) = &f.markers {
         v.nonzero("fiducial.markers.count", m.count);
         v.positive("fiducial.markers.side_m", m.side_m);
+        for (a, poly) in m.steering_poly_deg.iter().flatten().enumerate() {
+            for (k, c) in poly.deg[..=poly.order].iter().enumerate() {
+                v.finite(&format!("fiducial.markers.steering_poly_deg[{a}][{k}]"), *c);
+            }
+        }
     }
 }

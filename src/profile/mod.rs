@@ -29,7 +29,9 @@ pub use behavior::{
 pub use camera::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount};
 pub use devices::{ActuatorSpec, RANGE_KIND, RangeParams, SensorSpec};
 pub use drive::{DriveKind, DriveSpec};
-pub use fiducial::{CirclePlacement, CirclesSpec, FiducialSpec, MarkersSpec, NamedColor, PyramidSpec, TwoBlockSpec};
+pub use fiducial::{
+    CirclePlacement, CirclesSpec, FiducialSpec, MarkersSpec, NamedColor, PyramidSpec, SteeringCoeffs, TwoBlockSpec,
+};
 pub use geometry::{BodySpec, DockSpec, SuccessSpec, TetherSpec};
 pub use perception::{ImprintSpec, PerceptionSpec, SegmentationMode};
 pub use pyramid_perception::{HsvBand, PyramidPerceptionSpec};
