@@ -247,7 +247,7 @@ impl Homography {
             m += 1;
         }
         let mut best: Option<(usize, f64, [bool; CONSENSUS_MAX])> = None;
-        let mut try_subset = |q: [usize; 4], best: &mut Option<(usize, f64, [bool; CONSENSUS_MAX])>| {
+        let try_subset = |q: [usize; 4], best: &mut Option<(usize, f64, [bool; CONSENSUS_MAX])>| {
             let mut sub = [false; CONSENSUS_MAX];
             for &k in &q {
                 sub[idx[k]] = true;
