@@ -613,3 +613,53 @@ fn krawler_marker_finding_does_not_allocate() {
     assert_eq!(allocs(), 0, "allocations in steady state");
     assert_eq!(found, 96);
 }
+
+/// Shi–Tomasi corners and pyramidal Lucas–Kanade (with the forward–backward check) on
+/// 640×480 frames: pyramids, corner buffers and windows are reused, nothing allocates.
+#[test]
+fn corners_and_lucas_kanade_do_not_allocate() {
+    use marsupial::perception::flow::{CornerParams, GreyPyramid, LkParams, LucasKanade, Roi, ShiTomasi};
+    let frame = |shift: f64| {
+        let mut im = RgbImage::new(640, 480);
+        for y in 0..480 {
+            for x in 0..640 {
+                let (u, v) = (x as f64 - shift, y as f64 + 0.5 * shift);
+                let g = 128.0 + 60.0 * (u * 0.11).sin() * (v * 0.07).cos() + 40.0 * ((u + v) * 0.05).sin();
+                let g = g.clamp(0.0, 255.0) as u8;
+                im.put(x, y, [g, g, g]);
+            }
+        }
+        im
+    };
+    let frames = [frame(0.0), frame(1.3), frame(2.6)];
+    let (mut a, mut b) = (GreyPyramid::new(3), GreyPyramid::new(3));
+    let params = CornerParams {
+        min_eigen: 5.0,
+        ..CornerParams::default()
+    };
+    let mut corners = ShiTomasi::new(640, 480, params);
+    let mut lk = LucasKanade::new(LkParams::default(), 100);
+    let mut pts = [[0.0f64; 2]; 100];
+    let mut out = [None; 100];
+    let mut run = |a: &mut GreyPyramid, b: &mut GreyPyramid| {
+        let mut tracked = 0;
+        for pair in frames.windows(2) {
+            a.build_from_rgb(&pair[0].view());
+            b.build_from_rgb(&pair[1].view());
+            let c = corners.detect(a.level(0), Roi::around(320.0, 240.0, 100.0, 640, 480));
+            let n = c.len();
+            pts[..n].copy_from_slice(c);
+            lk.track_checked(a, b, &pts[..n], &mut out[..n]);
+            tracked += out[..n].iter().filter(|o| o.is_some()).count();
+        }
+        tracked
+    };
+    let warm = run(&mut a, &mut b); // warm-up
+    assert!(warm > 20, "{warm}");
+    reset();
+    COUNTING.with(|c| c.set(true));
+    let tracked = run(&mut a, &mut b);
+    COUNTING.with(|c| c.set(false));
+    assert_eq!(allocs(), 0, "allocations in steady state");
+    assert_eq!(tracked, warm);
+}

@@ -31,6 +31,7 @@ pub mod circles;
 pub mod colour_model;
 pub mod components;
 pub mod fastmath;
+pub mod flow;
 pub mod frame_change;
 pub mod hsv;
 pub mod hsv_stats;
