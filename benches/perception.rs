@@ -13,6 +13,11 @@
 //! central module 1.5 m away, 15° off its axis. Target (issue 16): detection,
 //! correspondence and pose for a stereo pair under 5 ms on one core.
 //!
+//! The AutoKrawler's stages so far (issue 17), on rendered 640×480 belly-fisheye frames:
+//! the eight markers, roll/drop and steering from them, Shi–Tomasi corners in an 80×80
+//! window on a tread, and pyramidal Lucas–Kanade of those corners to the next frame
+//! (wheels turned 3°). Target (issue 17): the whole ten-DOF estimate under 5 ms.
+//!
 //! Run: `cargo bench --bench perception` (add `-- --quick` for a fast pass; `-- axel`
 //! for the circle cases only).
 
@@ -25,7 +30,7 @@ use marsupial::perception::{
 use marsupial::profile::Profile;
 use marsupial::schemas::{PyramidSchema, TwoBlockSchema};
 use marsupial::sim::camera::camera_pose;
-use marsupial::sim::lighting::{LightingRun, LightingSpec};
+use marsupial::sim::lighting::{LightState, LightingRun, LightingSpec};
 use marsupial::sim::render::{Renderer, SensorParams};
 use marsupial::sim::rng::Rng;
 use marsupial::sim::world;
@@ -266,7 +271,106 @@ fn bench_circles(c: &mut Criterion) {
     g.finish();
 }
 
+fn bench_krawler(c: &mut Criterion) {
+    use marsupial::perception::flow::{CornerParams, GreyPyramid, LkParams, LucasKanade, Roi, ShiTomasi};
+    use marsupial::perception::krawler::{AxleGeometry, ExpectedMarker, MarkerFinder, MarkerParams, SteeringPoly};
+    use marsupial::sim::krawler::{KrawlerState, build};
+    let p = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/autokrawler.toml")).expect("profile");
+    let (w, h) = (p.cameras[0].width_px, p.cameras[0].height_px);
+    let geometry = AxleGeometry::from_profile(&p, 0).expect("geometry");
+    let polys = SteeringPoly::from_profile(&p).expect("calibrated");
+    let pose = camera_pose(&Pose2::new(0.0, 0.0, 0.0), &p.cameras[0].mount);
+    let rest = KrawlerState::rest(&p).expect("rest");
+    let state = KrawlerState {
+        roll: [0.05, -0.03],
+        steer: [0.2, -0.1],
+        ..rest
+    };
+    let mut r = Renderer::new(geometry.model.clone(), w, h, 1);
+    let mut frames = [
+        marsupial::perception::RgbImage::default(),
+        marsupial::perception::RgbImage::default(),
+    ];
+    for (k, f) in frames.iter_mut().enumerate() {
+        let turned = KrawlerState {
+            wheel: [0.05 * k as f64; 4],
+            ..state
+        };
+        let gear = build(&p, &turned).expect("gear");
+        r.render(
+            &gear.scene,
+            &pose,
+            &LightState::uniform(1.0),
+            &SensorParams::default(),
+            k as u64,
+            f,
+        );
+    }
+    let gear = build(&p, &state).expect("gear");
+    let project = |q: [f64; 3]| {
+        let c = pose.rotation.transpose() * (nalgebra::Point3::from(q) - pose.position);
+        geometry.model.project(&c)
+    };
+    let expected: [ExpectedMarker; 8] = gear.markers.map(|m| {
+        ExpectedMarker::from_square(project, m.coords.into(), [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 0.03).expect("projects")
+    });
+    let mut finder = MarkerFinder::new(w, h, MarkerParams::default());
+    let found = finder.find(&frames[0].view(), &expected).expect("find");
+    assert_eq!(found.found(), 8, "bench frame must show all eight markers");
+    let at = found.at.map(|a| a.expect("found"));
+    // A tread window: around the front-left wheel's correction face at rest, projected.
+    let tread = project(gear.correction[0].coords.into()).expect("tread projects");
+    let roi = Roi::around(tread[0], tread[1], 40.0, w, h);
+    let (mut pa, mut pb) = (GreyPyramid::new(3), GreyPyramid::new(3));
+    pa.build_from_rgb(&frames[0].view());
+    pb.build_from_rgb(&frames[1].view());
+    let mut corners = ShiTomasi::new(w, h, CornerParams::default());
+    let pts: Vec<[f64; 2]> = corners.detect(pa.level(0), roi).to_vec();
+    let mut lk = LucasKanade::new(LkParams::default(), 100);
+    let mut out = vec![None; pts.len()];
+    let mut g = c.benchmark_group(format!("autokrawler_{w}x{h}"));
+    g.bench_function("markers", |b| {
+        b.iter(|| {
+            black_box(
+                finder
+                    .find(black_box(&frames[0].view()), &expected)
+                    .expect("find")
+                    .found(),
+            )
+        })
+    });
+    g.bench_function("roll_drop_and_steering_both_axles", |b| {
+        b.iter(|| {
+            let mut s = 0.0;
+            for (axle, poly) in polys.iter().enumerate() {
+                let o = axle * 4;
+                let ap = geometry.axle_pose(axle, at[o], at[o + 1]).expect("pose");
+                let x = geometry.steering_ratio(&ap, [at[o + 2], at[o + 3]]).expect("ratio");
+                s += ap.roll + ap.drop + poly.steer(x);
+            }
+            black_box(s)
+        })
+    });
+    g.bench_function("grey_pyramids_two_frames", |b| {
+        b.iter(|| {
+            pa.build_from_rgb(black_box(&frames[0].view()));
+            pb.build_from_rgb(black_box(&frames[1].view()));
+        })
+    });
+    g.bench_function("corners_one_tread_window", |b| {
+        b.iter(|| black_box(corners.detect(pa.level(0), roi).len()))
+    });
+    g.bench_function(format!("lk_checked_{}_points_one_wheel", pts.len()), |b| {
+        b.iter(|| {
+            lk.track_checked(&pa, &pb, black_box(&pts), &mut out);
+            black_box(out.iter().filter(|o| o.is_some()).count())
+        })
+    });
+    g.finish();
+}
+
 fn benches(c: &mut Criterion) {
+    bench_krawler(c);
     bench_circles(c);
     bench_size(c, 640, 480);
     bench_size(c, 256, 240);
