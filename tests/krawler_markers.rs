@@ -109,12 +109,22 @@ fn every_marker_is_found_within_0_3_px_and_identified_from_the_rest_prediction()
         },
     ];
     let mut finder = MarkerFinder::new(640, 480, MarkerParams::default());
+    let mut whole_frame = MarkerFinder::new(
+        640,
+        480,
+        MarkerParams {
+            windows: false,
+            ..MarkerParams::default()
+        },
+    );
     let mut worst: f64 = 0.0;
     for (k, state) in states.iter().enumerate() {
         let gear = build(&p, state).unwrap();
         let truth = cam.expected(&gear, side);
         let image = cam.render(&gear);
         let found = finder.find(&image.view(), &predicted).unwrap();
+        // The search windows change nothing about the markers found.
+        assert_eq!(whole_frame.find(&image.view(), &predicted).unwrap(), found, "state {k}");
         for (i, t) in truth.iter().enumerate() {
             let at = found.at[i].unwrap_or_else(|| {
                 panic!(

@@ -58,12 +58,18 @@ pub struct MarkerParams {
     /// magenta-weighted centroid ([`MarkerFinder::find`]); off gives the binary blob's
     /// mean pixel position, the paper's contour centre.
     pub refine: bool,
+    /// Segment only in a window around each prediction (± the gate, 1.5 √area and 2 px),
+    /// as the paper restricts every stage to regions of interest from the kinematic
+    /// constraints; off segments the whole frame. A marker farther than the gate from its
+    /// prediction is not matched either way, so on and off find the same markers; off
+    /// also reports the clutter elsewhere in [`MarkerFinder::blobs`].
+    pub windows: bool,
 }
 
 impl Default for MarkerParams {
     /// Magenta 270–330°, saturation ≥ 0.45, value ≥ 0.15; blobs of 4 px or more; a 25 px
     /// gate; areas within a factor 3, at least 60 % of the expected area visible, a
-    /// 15 px corroboration tolerance, and sub-pixel refinement on.
+    /// 15 px corroboration tolerance, sub-pixel refinement and search windows on.
     fn default() -> Self {
         Self {
             hue_deg: (270.0, 330.0),
@@ -75,6 +81,7 @@ impl Default for MarkerParams {
             min_visible: 0.6,
             consistency_px: 15.0,
             refine: true,
+            windows: true,
         }
     }
 }
@@ -199,8 +206,20 @@ impl MarkerFinder {
     /// [`VisionError::SizeMismatch`] when `frame` is not the finder's size.
     pub fn find(&mut self, frame: &RgbView<'_>, expected: &[ExpectedMarker; 8]) -> Result<Markers, VisionError> {
         check_same_size(self.mask.size(), (frame.width(), frame.height()))?;
-        self.segment(frame);
-        open3(&mut self.mask, &mut self.scratch);
+        let (w, h) = self.mask.size();
+        if self.params.windows {
+            self.mask.data_mut().fill(0);
+            let mut all = Rect::EMPTY;
+            for e in expected {
+                let r = Rect::around(e, self.params.gate_px, w, h);
+                self.segment(frame, r);
+                all = all.union(r);
+            }
+            open3(&mut self.mask, &mut self.scratch, all);
+        } else {
+            self.segment(frame, Rect::full(w, h));
+            open3(&mut self.mask, &mut self.scratch, Rect::full(w, h));
+        }
         self.collect_blobs()?;
         let mut found = self.assign(expected);
         if self.params.refine {
@@ -272,12 +291,19 @@ impl MarkerFinder {
         }
     }
 
-    fn segment(&mut self, frame: &RgbView<'_>) {
+    /// Segments the pixels of `r` into the mask.
+    fn segment(&mut self, frame: &RgbView<'_>, r: Rect) {
         let p = &self.params;
+        let w = frame.width();
+        let bytes = frame.as_bytes();
         let data = self.mask.data_mut();
-        for (i, px) in frame.as_bytes().chunks_exact(3).enumerate() {
-            let c = Hsv::from_rgb([px[0], px[1], px[2]]);
-            data[i] = (c.h >= p.hue_deg.0 && c.h <= p.hue_deg.1 && c.s >= p.min_saturation && c.v >= p.min_value) as u8;
+        for y in r.y0..r.y1 {
+            for x in r.x0..r.x1 {
+                let i = y * w + x;
+                let c = Hsv::from_rgb([bytes[3 * i], bytes[3 * i + 1], bytes[3 * i + 2]]);
+                data[i] =
+                    (c.h >= p.hue_deg.0 && c.h <= p.hue_deg.1 && c.s >= p.min_saturation && c.v >= p.min_value) as u8;
+            }
         }
     }
 
@@ -368,33 +394,95 @@ impl MarkerFinder {
     }
 }
 
-/// A 3×3 opening of `mask` (erosion, then dilation), through `scratch` (same size).
-/// Pixels outside the image count as unset, so erosion clears the border ring.
-fn open3(mask: &mut Mask, scratch: &mut Mask) {
+/// Pixel bounds `[x0, x1) × [y0, y1)`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Rect {
+    x0: usize,
+    y0: usize,
+    x1: usize,
+    y1: usize,
+}
+
+impl Rect {
+    const EMPTY: Self = Self {
+        x0: usize::MAX,
+        y0: usize::MAX,
+        x1: 0,
+        y1: 0,
+    };
+
+    fn full(w: usize, h: usize) -> Self {
+        Self {
+            x0: 0,
+            y0: 0,
+            x1: w,
+            y1: h,
+        }
+    }
+
+    /// The search window of a prediction, clipped to a `w × h` image.
+    fn around(e: &ExpectedMarker, gate: f64, w: usize, h: usize) -> Self {
+        let r = gate + 1.5 * e.area.max(0.0).sqrt() + 2.0;
+        let clip = |v: f64, n: usize| {
+            if v.is_finite() {
+                v.clamp(0.0, n as f64) as usize
+            } else {
+                0
+            }
+        };
+        Self {
+            x0: clip(e.at[0] - r, w),
+            y0: clip(e.at[1] - r, h),
+            x1: clip(e.at[0] + r + 1.0, w),
+            y1: clip(e.at[1] + r + 1.0, h),
+        }
+    }
+
+    fn union(self, o: Self) -> Self {
+        if o.x0 >= o.x1 || o.y0 >= o.y1 {
+            return self;
+        }
+        Self {
+            x0: self.x0.min(o.x0),
+            y0: self.y0.min(o.y0),
+            x1: self.x1.max(o.x1),
+            y1: self.y1.max(o.y1),
+        }
+    }
+}
+
+/// A 3×3 opening of `mask` (erosion, then dilation), through `scratch` (same size), for
+/// a mask that is unset outside `r`. Pixels outside the image count as unset, so erosion
+/// clears the border ring.
+fn open3(mask: &mut Mask, scratch: &mut Mask, r: Rect) {
     let (w, h) = mask.size();
+    if r.x0 >= r.x1 || r.y0 >= r.y1 {
+        return;
+    }
     {
         let src = mask.data();
         let dst = scratch.data_mut();
         dst.fill(0);
-        for y in 1..h.saturating_sub(1) {
-            for x in 1..w - 1 {
+        for y in r.y0.max(1)..r.y1.min(h.saturating_sub(1)) {
+            for x in r.x0.max(1)..r.x1.min(w - 1) {
                 let mut all = 1u8;
-                for r in [y - 1, y, y + 1] {
-                    let row = &src[r * w + x - 1..r * w + x + 2];
+                for rr in [y - 1, y, y + 1] {
+                    let row = &src[rr * w + x - 1..rr * w + x + 2];
                     all &= row[0] & row[1] & row[2];
                 }
                 dst[y * w + x] = all;
             }
         }
     }
+    // Eroded pixels lie inside r, so the dilation reaches at most one pixel beyond it.
     let src = scratch.data();
     let dst = mask.data_mut();
-    for y in 0..h {
-        for x in 0..w {
+    for y in r.y0.saturating_sub(1)..(r.y1 + 1).min(h) {
+        for x in r.x0.saturating_sub(1)..(r.x1 + 1).min(w) {
             let mut any = 0u8;
-            for r in y.saturating_sub(1)..(y + 2).min(h) {
+            for rr in y.saturating_sub(1)..(y + 2).min(h) {
                 for c in x.saturating_sub(1)..(x + 2).min(w) {
-                    any |= src[r * w + c];
+                    any |= src[rr * w + c];
                 }
             }
             dst[y * w + x] = any;
@@ -417,7 +505,7 @@ mod tests {
         m.set(15, 15, true);
         m.set(16, 15, true);
         let mut s = Mask::new(20, 20);
-        open3(&mut m, &mut s);
+        open3(&mut m, &mut s, Rect::full(20, 20));
         assert_eq!(m.count(), 36);
         assert!(!m.get(15, 15));
     }
