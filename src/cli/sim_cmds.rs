@@ -51,7 +51,7 @@ pub struct DockOptions {
     pub record: Option<PathBuf>,
     /// With --record, store frames as JPEG (`foxglove.CompressedImage`) instead of raw
     /// RGB: files about ten times smaller, slower to write.
-    #[arg(long)]
+    #[arg(long, requires = "record")]
     pub jpeg: bool,
 }
 

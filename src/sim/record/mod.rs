@@ -28,6 +28,7 @@
 //! [`Agent::observe`]: crate::schemas::Agent::observe
 
 pub mod annotations;
+pub mod base64;
 pub mod messages;
 pub mod schemas;
 
@@ -36,7 +37,6 @@ use crate::geometry::Pose2;
 use crate::perception::RgbImage;
 use crate::profile::CameraSpec;
 use crate::schemas::{MotorOutput, Observation};
-use base64::Engine as _;
 use messages::{CameraCalibration, FrameTransform, Log, PoseInFrame, Quaternion, Time, Vector3};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -132,6 +132,9 @@ struct Channels {
     log: u16,
 }
 
+/// Room for an image message's JSON header (it is right-aligned in it, after spaces).
+const IMAGE_HEADER: usize = 192;
+
 /// Gap between the departure's last message and the docking mission's clock, ns.
 const MISSION_GAP_NS: u64 = 100_000_000;
 
@@ -155,6 +158,8 @@ pub struct McapRecorder {
     mission_start: bool,
     mission: &'static str,
     buf: Vec<u8>,
+    /// The image message being built (see [`McapRecorder::image`]).
+    image: Vec<u8>,
     jpeg: Vec<u8>,
     error: Option<RecordError>,
 }
@@ -178,8 +183,12 @@ impl McapRecorder {
             source,
         })?;
         let e = mcap_err(path);
+        // No compression, no CRCs: two passes less over every frame's bytes (readers
+        // accept a zero CRC as "not computed"), to keep recording cheap.
         let mut w = mcap::WriteOptions::new()
             .compression(None)
+            .calculate_chunk_crcs(false)
+            .calculate_data_section_crc(false)
             .profile("")
             .create(BufWriter::with_capacity(1 << 20, file))
             .map_err(&e)?;
@@ -244,6 +253,7 @@ impl McapRecorder {
             mission_start: true,
             mission: "",
             buf: Vec::with_capacity(1 << 16),
+            image: Vec::new(),
             jpeg: Vec::new(),
             error: None,
         })
@@ -465,15 +475,20 @@ impl McapRecorder {
             );
             frame.as_bytes()
         };
-        let start = self.buf.len();
-        let n = base64::encoded_len(pixels.len(), true).unwrap_or(0);
-        self.buf.resize(start + n, 0);
-        let written = base64::engine::general_purpose::STANDARD
-            .encode_slice(pixels, &mut self.buf[start..])
-            .unwrap_or(0);
-        self.buf.truncate(start + written);
-        self.buf.extend_from_slice(b"\"}");
+        // The message is [spaces | header | base64 | "}] in a buffer that keeps its length
+        // from frame to frame (JSON allows leading whitespace), so the base64 is encoded in
+        // place without zeroing 250 kB first.
+        let n = base64::encoded_len(pixels.len());
+        let head = self.buf.len();
+        let pad = IMAGE_HEADER.max(head);
+        self.image.resize(pad + n + 2, b' ');
+        self.image[..pad - head].fill(b' ');
+        self.image[pad - head..pad].copy_from_slice(&self.buf);
+        let _ = base64::encode_into(pixels, &mut self.image[pad..pad + n]);
+        self.image[pad + n..].copy_from_slice(b"\"}");
+        std::mem::swap(&mut self.buf, &mut self.image);
         self.put(id, ns);
+        std::mem::swap(&mut self.buf, &mut self.image);
     }
 
     /// Camera `i`'s pin-hole calibration (none for a fisheye camera).
