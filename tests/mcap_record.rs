@@ -138,6 +138,14 @@ fn a_run_records_every_channel_and_the_frames_byte_for_byte() {
         ]
     );
     assert!(topics.values().all(|(_, enc, _)| enc == "json"));
+    // The summary a viewer seeks with: statistics, channels and chunk indexes.
+    let bytes = std::fs::read(&file).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().expect("a summary section");
+    let stats = summary.stats.as_ref().unwrap();
+    let total: usize = topics.values().map(|(_, _, m)| m.len()).sum();
+    assert_eq!(stats.message_count as usize, total);
+    assert_eq!(summary.channels.len(), topics.len());
+    assert!(!summary.chunk_indexes.is_empty());
     // One command per tick: the loop ran 4 s at 10 Hz.
     let ticks = topics["/command"].2.len();
     assert_eq!(ticks, (record.time_s * 10.0).round() as usize, "{record:?}");
