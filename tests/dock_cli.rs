@@ -66,6 +66,8 @@ fn opts(index: Option<usize>, out: Option<PathBuf>, frames_every: Option<u32>) -
         out,
         frames_every,
         trace: None,
+        record: None,
+        jpeg: false,
     }
 }
 

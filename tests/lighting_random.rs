@@ -97,6 +97,8 @@ fn runs_draw_record_share_and_replay_their_light() {
                 out: None,
                 frames_every: None,
                 trace: None,
+                record: None,
+                jpeg: false,
             },
             &mut Vec::new(),
         )

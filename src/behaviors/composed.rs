@@ -13,7 +13,7 @@ use super::agent::BuildError;
 use super::registry::Registry;
 use crate::arbiter::{Blackboard, NodeTrace};
 use crate::profile::Profile;
-use crate::schemas::{Agent, AgentStats, Behavior, Inputs, Mission, MissionError, Status, Step};
+use crate::schemas::{Agent, AgentStats, Behavior, Inputs, Mission, MissionError, Observation, Status, Step};
 
 /// What one robot's schemas share (see the module docs).
 pub trait SharedMemory: Send + 'static {
@@ -30,6 +30,11 @@ pub trait SharedMemory: Send + 'static {
     /// Counters of the current mission.
     fn stats(&self) -> AgentStats {
         AgentStats::default()
+    }
+
+    /// This tick's percept and colour ranges ([`Agent::observe`]); `None` by default.
+    fn observe(&self) -> Option<Observation> {
+        None
     }
 }
 
@@ -164,5 +169,9 @@ impl<M: SharedMemory> Agent for Composed<M> {
 
     fn stats(&self) -> AgentStats {
         self.memory.lock().stats()
+    }
+
+    fn observe(&self) -> Option<Observation> {
+        self.memory.lock().observe()
     }
 }

@@ -4,6 +4,7 @@ use crate::behaviors::agent_for;
 use crate::sim::SimError;
 use crate::sim::campaign::{self, CampaignOptions, GroupSummary, Recording, RunRecord, Summary};
 use crate::sim::paper::cell;
+use crate::sim::record::RecordOptions;
 use crate::sim::scenario::Scenario;
 use crate::sim::shard;
 use std::io::Write;
@@ -44,6 +45,15 @@ pub struct DockOptions {
     /// scenario's `[record] frames_every`; 0 saves none.
     #[arg(long, value_name = "N", requires = "out")]
     pub frames_every: Option<u32>,
+    /// Record the run to an MCAP file for Foxglove: every frame with its calibration,
+    /// the percept (as image annotations and JSON), the command, the decision trace, the
+    /// odometry and true poses, the colour ranges and a log (see the README's topics).
+    #[arg(long, value_name = "FILE.mcap")]
+    pub record: Option<PathBuf>,
+    /// With --record, store frames as JPEG (`foxglove.CompressedImage`) instead of raw
+    /// RGB: files about ten times smaller, slower to write.
+    #[arg(long, requires = "record")]
+    pub jpeg: bool,
 }
 
 /// Parses `--at x,y,heading`.
@@ -124,6 +134,15 @@ pub fn dock(opts: &DockOptions, out: &mut dyn Write) -> Result<RunRecord, SimErr
     let mut recording = Recording {
         frames: frames_dir.as_deref().map(|d| (d, every)),
         trace: trace.as_mut().map(|w| w as &mut dyn Write),
+        mcap: opts.record.as_deref().map(|p| {
+            (
+                p,
+                RecordOptions {
+                    jpeg: opts.jpeg,
+                    ..RecordOptions::default()
+                },
+            )
+        }),
     };
     let rec = campaign::run_one(&prepared, &spec, &agent_for, &mut recording)?;
     if let (Some(w), Some(path)) = (trace.as_mut(), &opts.trace) {
@@ -194,6 +213,16 @@ pub struct TrialsOptions {
     /// `marsupial merge`. With --out, also writes DIR/shard.json.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<crate::sim::shard::Shard>,
+    /// Record each run to an MCAP file for Foxglove, `DIR/run-NNNNN.mcap` (N the run's
+    /// index; see `dock --record`).
+    #[arg(long, value_name = "DIR")]
+    pub record_dir: Option<PathBuf>,
+    /// With --record-dir, keep only the recordings of failed runs.
+    #[arg(long, requires = "record_dir")]
+    pub record_failed: bool,
+    /// With --record-dir, store frames as JPEG instead of raw RGB.
+    #[arg(long, requires = "record_dir")]
+    pub jpeg: bool,
     /// Progress on stderr (the binary sets a bar when stderr is a terminal, plain lines
     /// otherwise).
     #[arg(skip)]
@@ -328,6 +357,14 @@ pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimE
             resume: opts.resume,
             progress: opts.progress,
             per_run_files: opts.out.is_some(),
+            record: opts.record_dir.as_ref().map(|dir| campaign::RecordRuns {
+                dir: dir.clone(),
+                failed_only: opts.record_failed,
+                options: RecordOptions {
+                    jpeg: opts.jpeg,
+                    ..RecordOptions::default()
+                },
+            }),
         },
     )?;
     let comparison = prepared

@@ -27,7 +27,7 @@ use std::f64::consts::FRAC_PI_2;
 
 /// An axis-aligned box in SCT (A, B) space with a brightness floor. Angles in radians; a
 /// range with `lo > hi` on either axis matches nothing.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct SctRange {
     /// [A_lo, A_hi], radians.
     pub a: [f64; 2],
@@ -45,7 +45,7 @@ pub struct SctRange {
 
 /// A box in HSV space. Hue in degrees; `h[0] > h[1]` wraps through 0 (e.g. [340, 20] for
 /// red). S and V in [0, 1].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct HsvRange {
     /// [H_lo, H_hi], degrees.
     pub h: [f32; 2],

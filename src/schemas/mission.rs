@@ -90,4 +90,11 @@ pub trait Agent: Behavior {
     fn stats(&self) -> AgentStats {
         AgentStats::default()
     }
+
+    /// This tick's percept and colour ranges, for recorders and displays
+    /// ([`Observation`](super::Observation)); `None` (the default) for a robot without
+    /// perception.
+    fn observe(&self) -> Option<super::Observation> {
+        None
+    }
 }

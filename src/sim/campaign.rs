@@ -25,6 +25,7 @@
 
 use super::SimError;
 use super::lighting_random::LightingDraw;
+use super::record::RecordOptions;
 use super::robot::SimDevices;
 pub use super::run::{Recording, run_one};
 use super::scenario::{Loaded, RunSpec};
@@ -114,6 +115,27 @@ pub struct CampaignOptions {
     pub progress: Progress,
     /// Write each run's trajectory CSV (and frames, when the scenario asks).
     pub per_run_files: bool,
+    /// Record runs to MCAP files, one per run (`DIR/run-00042.mcap`).
+    pub record: Option<RecordRuns>,
+}
+
+/// Which runs of a campaign are recorded to MCAP, and where ([`super::record`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RecordRuns {
+    /// The folder: run N goes to `DIR/run-NNNNN.mcap`.
+    pub dir: PathBuf,
+    /// Keep only the recordings of failed runs (successful ones are deleted when they
+    /// end).
+    pub failed_only: bool,
+    /// How each run is recorded.
+    pub options: RecordOptions,
+}
+
+impl RecordRuns {
+    /// The recording of run `index`.
+    pub fn path(&self, index: usize) -> PathBuf {
+        self.dir.join(format!("run-{index:05}.mcap"))
+    }
 }
 
 /// How a campaign shows its progress on stderr.
@@ -506,6 +528,9 @@ pub fn run_campaign(
     // Fail early if the profile has no behavior.
     make_agent(&p.loaded.profile).map_err(|e| SimError::Unsupported(e.to_string()))?;
     let mut done: BTreeMap<usize, RunRecord> = BTreeMap::new();
+    if let Some(r) = &opts.record {
+        std::fs::create_dir_all(&r.dir).map_err(io(&r.dir))?;
+    }
     let mut jsonl = None;
     if let Some(dir) = &opts.out {
         std::fs::create_dir_all(dir).map_err(io(dir))?;
@@ -580,11 +605,24 @@ pub fn run_campaign(
                         let _ = std::fs::create_dir_all(d);
                     }
                     let every = p.loaded.scenario.record.frames_every;
+                    let mcap = opts.record.as_ref().map(|r| r.path(spec.index));
                     let mut rec_opts = Recording {
                         frames: frames_dir.as_deref().map(|d| (d, every)),
                         trace: None,
+                        mcap: opts
+                            .record
+                            .as_ref()
+                            .zip(mcap.as_deref())
+                            .map(|(r, path)| (path, r.options)),
                     };
                     let rec = run_one(p, spec, make_agent, &mut rec_opts);
+                    if let (Ok(r), Some(path), Some(record)) = (&rec, &mcap, &opts.record)
+                        && r.success
+                        && record.failed_only
+                        && let Err(e) = std::fs::remove_file(path)
+                    {
+                        tracing::warn!(target: "marsupial::sim", path = %path.display(), %e, "recording of a successful run not removed");
+                    }
                     if let (Ok(r), Some(d)) = (&rec, &frames_dir) {
                         let _ = write_track_csv(&d.join("trajectory.csv"), r);
                     }

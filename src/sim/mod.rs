@@ -30,6 +30,9 @@ pub enum SimError {
     /// An image (backdrop) could not be loaded.
     #[error(transparent)]
     Image(#[from] crate::image_io::ImageFileError),
+    /// A run's MCAP recording could not be written.
+    #[error(transparent)]
+    Record(#[from] record::RecordError),
     /// Output could not be written.
     #[error("{path}: {source}")]
     Io {
@@ -48,6 +51,7 @@ pub mod obstacles;
 pub mod paper;
 pub mod plot;
 pub mod range;
+pub mod record;
 pub mod robot;
 pub mod run;
 pub mod scenario;

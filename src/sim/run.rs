@@ -14,6 +14,7 @@ use super::engine::{PhaseEnd, Sim};
 use super::lighting::LightingRun;
 use super::lighting_random::LightingDraw;
 use super::motion::Motion;
+use super::record::{McapRecorder, RecordOptions, TickSample};
 use super::render::SensorParams;
 use super::rng::Rng;
 use super::robot::SimRobot;
@@ -35,6 +36,9 @@ pub struct Recording<'a> {
     pub frames: Option<(&'a Path, u32)>,
     /// Write the decision trace here, one JSON object per tick ([`TraceLine`]).
     pub trace: Option<&'a mut dyn Write>,
+    /// Record the run to this MCAP file ([`super::record`]): frames, percepts, commands,
+    /// decision trace, poses and log.
+    pub mcap: Option<(&'a Path, RecordOptions)>,
 }
 
 /// One line of a decision trace (`marsupial dock --trace`).
@@ -57,8 +61,7 @@ impl Recording<'_> {
     /// A last trace line when the simulator, not the behavior, ended the mission: the
     /// plates closed (`docked`), the robot caught the entrance (`stuck_contact`), or time
     /// ran out (`timeout`), or it drove into an obstacle (`collision`).
-    fn end(&mut self, mission: &'static str, t: f64, end: &PhaseEnd) {
-        let Some(w) = self.trace.as_mut() else { return };
+    fn end(&mut self, mission: &'static str, t: f64, end: &PhaseEnd, mcap: &mut Option<McapRecorder>) {
         let what = match end {
             PhaseEnd::Docked => "docked",
             PhaseEnd::Stuck { .. } => "stuck_contact",
@@ -66,6 +69,10 @@ impl Recording<'_> {
             PhaseEnd::Timeout => "timeout",
             PhaseEnd::Finished(_) => return,
         };
+        if let Some(m) = mcap.as_mut() {
+            m.log(t, 2, &format!("{mission}: the world ended it: {what}"));
+        }
+        let Some(w) = self.trace.as_mut() else { return };
         let line = serde_json::json!({ "mission": mission, "t": t, "world": what });
         let _ = writeln!(w, "{line}");
     }
@@ -99,6 +106,42 @@ impl Recording<'_> {
             let _ = writeln!(w, "{json}");
         }
     }
+
+    /// Records the tick to the MCAP file (after [`Recording::tick`], whose `nodes` it
+    /// reuses when a trace is written too).
+    fn mcap_tick(
+        &mut self,
+        mcap: &mut Option<McapRecorder>,
+        mission: &'static str,
+        t: f64,
+        rig: &Rig,
+        out: &TickOutput,
+        nodes: &mut Vec<NodeTrace>,
+    ) {
+        let Some(m) = mcap.as_mut() else { return };
+        let root = rig.lp.root();
+        if self.trace.is_none() {
+            nodes.clear();
+            root.explain(nodes);
+        }
+        let trace = TraceLine {
+            mission,
+            t,
+            status: &out.status,
+            command: &out.command,
+            nodes,
+        };
+        let (truth, odometry) = rig.sim.with(|s| (s.pose(), s.odometry().pose));
+        m.tick(&TickSample {
+            t,
+            frames: rig.step.frames(),
+            command: &out.command,
+            trace: &trace,
+            observation: root.observe(),
+            truth,
+            odometry,
+        });
+    }
 }
 
 /// The simulated robot and the loop that drives it through one run.
@@ -112,29 +155,42 @@ struct Rig {
 impl Rig {
     /// Runs the mission just begun until the behavior reports an outcome, the robot docks
     /// or catches the entrance edge, or `max_s` of simulated time pass.
-    fn run(&mut self, mission: &'static str, max_s: f64, rec: &mut Recording<'_>) -> PhaseEnd {
+    fn run(
+        &mut self,
+        mission: &'static str,
+        max_s: f64,
+        rec: &mut Recording<'_>,
+        mcap: &mut Option<McapRecorder>,
+    ) -> PhaseEnd {
         let t_end = self.sim.with(|s| s.time()) + max_s;
         let prefix = if mission == "departure" { "depart" } else { "frame" };
         let mut nodes = Vec::new();
+        if let Some(m) = mcap.as_mut() {
+            m.begin_mission(mission);
+        }
         loop {
             let now = self.sim.with(|s| s.time());
             if now >= t_end - 1e-9 {
-                rec.end(mission, now, &PhaseEnd::Timeout);
+                rec.end(mission, now, &PhaseEnd::Timeout, mcap);
                 return PhaseEnd::Timeout;
             }
             let out = self.step.tick(&mut self.robot, &mut self.lp, now);
             for (t, device, e) in self.step.take_errors() {
                 tracing::warn!(target: "marsupial::sim", t, device, %e, "device fault");
+                if let Some(m) = mcap.as_mut() {
+                    m.log(t, 3, &format!("device fault: {device}: {e}"));
+                }
             }
             rec.frame(prefix, self.sim.with(|s| s.frame_count()), self.step.frames());
             rec.tick(mission, now, self.lp.root(), &out, &mut nodes);
+            rec.mcap_tick(mcap, mission, now, self, &out, &mut nodes);
             match out.status {
                 LoopStatus::SafeStop { .. } => self.sim.with(|s| s.safe_stops += 1),
                 LoopStatus::Finished { outcome } => return PhaseEnd::Finished(outcome),
                 _ => {}
             }
             if let Some(end) = self.sim.advance() {
-                rec.end(mission, self.sim.with(|s| s.time()), &end);
+                rec.end(mission, self.sim.with(|s| s.time()), &end, mcap);
                 return end;
             }
         }
@@ -221,6 +277,30 @@ pub fn run_one(
         robot,
     };
     let dock = p.world_for(spec).dock;
+    let mut mcap = match rec.mcap {
+        Some((path, opts)) => {
+            let mut m = McapRecorder::create(path, &profile.cameras, opts)?;
+            m.log(
+                0.0,
+                2,
+                &format!(
+                    "run {} of {}: start {} ({:.2} m, {:+.0}°), trial {}, lighting {}, segmentation {}, terrain {}, seed {}",
+                    spec.index,
+                    sc.name,
+                    spec.start.label,
+                    spec.start.distance,
+                    spec.start.angle_deg,
+                    spec.trial,
+                    spec.lighting,
+                    spec.segmentation.as_str(),
+                    spec.terrain.as_str(),
+                    spec.seed
+                ),
+            );
+            Some(m)
+        }
+        None => None,
+    };
     // Departure: undock and imprint (paired runs share it through `pair`).
     let mut imprinted = None;
     if sc.imprint.enabled && rig.lp.begin(&Mission::Departure).is_ok() {
@@ -238,7 +318,7 @@ pub fn run_one(
             s.set_lighting(dep_light, dep_sensor);
             place_docked(s);
         });
-        let end = rig.run("departure", 90.0, rec);
+        let end = rig.run("departure", 90.0, rec, &mut mcap);
         imprinted = Some(matches!(end, PhaseEnd::Finished(Outcome::Completed)));
         let mut light = run_light;
         light.advance_session(sc.imprint.sleep_s);
@@ -272,10 +352,26 @@ pub fn run_one(
     rig.lp
         .begin(&Mission::Docking { dock_hint })
         .map_err(|e| SimError::Unsupported(e.to_string()))?;
-    let end = rig.run("docking", sc.timeout_s, rec);
+    let end = rig.run("docking", sc.timeout_s, rec, &mut mcap);
     let manoeuvres = rig.lp.root().stats().manoeuvres;
     let mut record = rig.sim.with(|sim| record(spec, sim, end, imprinted, manoeuvres));
     record.lighting_draw = draw;
+    if let Some(mut m) = mcap {
+        let t = record.time_s;
+        m.log(
+            t,
+            if record.success { 2 } else { 4 },
+            &format!(
+                "run {} ends: {} after {:.1} s, {:.2} m driven{}",
+                record.index,
+                record.outcome,
+                record.time_s,
+                record.path_m,
+                if record.success { "" } else { " (failed)" }
+            ),
+        );
+        m.finish()?;
+    }
     Ok(record)
 }
 

@@ -18,8 +18,8 @@ use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
 use crate::profile::{ApproachKind, Profile};
 use crate::schemas::TwoBlockSchema;
 use crate::schemas::{
-    Auxiliary, DriveCommand, Feedback, Inputs, Mission, MissionError, MotionVector, MotorOutput, Percept,
-    PerceptualSchema, Posture, PotentialField, RatioSteering, Step,
+    Auxiliary, ColourRanges, DriveCommand, Feedback, Inputs, Mission, MissionError, MotionVector, MotorOutput,
+    Observation, ObservedPercept, Percept, PerceptualSchema, Posture, PotentialField, RatioSteering, Step,
 };
 
 /// The approach motor schema the profile selects (`behavior.approach`).
@@ -96,6 +96,10 @@ pub struct Memory {
     pub planning: Option<FiducialView>,
     /// The fiducial was found this tick.
     pub found: bool,
+    /// This tick's percept, as the schema reported it (for [`Agent::observe`]).
+    ///
+    /// [`Agent::observe`]: crate::schemas::Agent::observe
+    pub percept: Option<TwoBlockPercept>,
     /// Low-passed viewing angle, rad: single-frame estimates are noisy at range.
     pub alpha_filtered: Option<f64>,
     /// The last raw viewing angles of reliable frames, for the repositioning decision.
@@ -204,6 +208,7 @@ impl Memory {
             view: None,
             planning: None,
             found: false,
+            percept: None,
             alpha_filtered: None,
             alpha_window: MedianWindow::new(tuning.alpha_window_frames),
             frame_change: FrameChange::new(),
@@ -241,6 +246,7 @@ impl Memory {
     pub fn digest(&mut self, inputs: &Inputs<'_>, percept: &TwoBlockPercept) {
         let now = inputs.now;
         self.now = now;
+        self.percept = Some(*percept);
         self.run_start.get_or_insert(now);
         self.odo = inputs.odometry.map(|o| o.value.pose).unwrap_or_default();
         let p = self.tuning;
@@ -363,6 +369,14 @@ impl Memory {
 impl SharedMemory for Memory {
     fn perceive(&mut self, inputs: &Inputs<'_>) {
         Memory::perceive(self, inputs);
+    }
+
+    fn observe(&self) -> Option<Observation> {
+        Some(Observation {
+            camera: self.schema.camera(),
+            percept: ObservedPercept::TwoBlock(self.percept?),
+            ranges: Some(ColourRanges::Sct(self.schema.model().ranges())),
+        })
     }
 
     fn begin(&mut self, mission: &Mission) -> Result<(), MissionError> {

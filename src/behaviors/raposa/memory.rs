@@ -21,8 +21,8 @@ use crate::geometry::{Pose2, Twist, wrap_angle};
 use crate::perception::PyramidPercept;
 use crate::profile::{Profile, SegmentationMode, SevenStateGains};
 use crate::schemas::{
-    AgentStats, Auxiliary, DriveCommand, Feedback, Guides, Inputs, Mission, MissionError, MotorOutput, PointController,
-    ServoLaw, Step,
+    AgentStats, Auxiliary, ColourRanges, DriveCommand, Feedback, Guides, Inputs, Mission, MissionError, MotorOutput,
+    Observation, ObservedPercept, PointController, ServoLaw, Step,
 };
 
 /// RAPOSA's shared memory (see the module docs).
@@ -232,6 +232,18 @@ impl Memory {
 impl SharedMemory for Memory {
     fn perceive(&mut self, inputs: &Inputs<'_>) {
         Memory::perceive(self, inputs);
+    }
+
+    fn observe(&self) -> Option<Observation> {
+        let ranges = match &self.source {
+            Source::Pyramid(s) => ColourRanges::Hsv(s.bands()),
+            Source::TwoBlock(c) => ColourRanges::Sct(c.schema.model().ranges()),
+        };
+        Some(Observation {
+            camera: 0,
+            percept: ObservedPercept::Pyramid(self.percept),
+            ranges: Some(ranges),
+        })
     }
 
     /// Departure (seed 001's robot leaves the pyramid to explore): the perception is off

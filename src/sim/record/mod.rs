@@ -1,0 +1,541 @@
+//! MCAP recordings of runs, to open in Foxglove (`marsupial dock --record FILE.mcap`,
+//! `marsupial trials --record-dir DIR`).
+//!
+//! One file per run holds, on the simulation clock (nanoseconds from the run's start:
+//! the departure from 0, the docking mission 0.1 s after the departure's last message,
+//! so a recording is the same file byte for byte for the same seed):
+//!
+//! | topic | schema | what |
+//! | --- | --- | --- |
+//! | `/camI/image` | `foxglove.RawImage` (`rgb8`), or `foxglove.CompressedImage` (JPEG) with [`RecordOptions::jpeg`] | every frame camera I delivered |
+//! | `/camI/calibration` | `foxglove.CameraCalibration` | its pin-hole intrinsics, with each frame (pin-hole cameras only) |
+//! | `/camI/annotations` | `foxglove.ImageAnnotations` | the percept drawn over the frame: block boxes, centroids, pair box ([`annotations`]) |
+//! | `/percept` | `marsupial.Percept` (JSON) | the percept ([`Observation`]) |
+//! | `/colour_ranges` | `marsupial.ColourRanges` (JSON) | the colour model's segmentation ranges |
+//! | `/command` | `marsupial.MotorCommand` (JSON) | the command sent, with its twist `v`, `omega` |
+//! | `/trace` | `marsupial.TraceLine` (JSON) | the decision trace ([`TraceLine`]) |
+//! | `/odometry` | `foxglove.PoseInFrame` | the odometry pose, frame `odom` |
+//! | `/ground_truth` | `foxglove.PoseInFrame` | the true pose, frame `dock` |
+//! | `/tf` | `foxglove.FrameTransform` | `dock`→`base_link` (truth) each tick; `dock`→`odom` and `base_link`→`camI` when a mission starts |
+//! | `/log` | `foxglove.Log` | the run's start, missions, the world's verdicts, device faults and the outcome |
+//!
+//! The `dock` frame is the dock's: origin at the entrance, +x out of it. The percept and
+//! colour ranges are recorded only when the agent exposes them ([`Agent::observe`]).
+//!
+//! Recording never changes a run: it reads the frames, the command and the poses after
+//! the loop decided, and the simulator draws no random number for it.
+//!
+//! [`Agent::observe`]: crate::schemas::Agent::observe
+
+pub mod annotations;
+pub mod base64;
+pub mod messages;
+pub mod schemas;
+
+use super::run::TraceLine;
+use crate::geometry::Pose2;
+use crate::perception::RgbImage;
+use crate::profile::CameraSpec;
+use crate::schemas::{MotorOutput, Observation};
+use messages::{CameraCalibration, FrameTransform, Log, PoseInFrame, Quaternion, Time, Vector3};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// How a recording is made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RecordOptions {
+    /// Frames as JPEG (`foxglove.CompressedImage`) instead of raw RGB.
+    pub jpeg: bool,
+    /// JPEG quality, 1–100.
+    pub jpeg_quality: u8,
+}
+
+impl Default for RecordOptions {
+    fn default() -> Self {
+        Self {
+            jpeg: false,
+            jpeg_quality: 85,
+        }
+    }
+}
+
+/// Why a recording could not be written.
+#[derive(Debug, Error)]
+pub enum RecordError {
+    /// The file could not be created or written.
+    #[error("{}: cannot write the recording: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The MCAP writer refused (an I/O error underneath, or a bad record).
+    #[error("{}: cannot write the recording: {why}", path.display())]
+    Mcap {
+        /// The file.
+        path: PathBuf,
+        /// The writer's message.
+        why: String,
+    },
+    /// A frame could not be encoded as JPEG.
+    #[error("{}: cannot encode a frame as JPEG: {why}", path.display())]
+    Jpeg {
+        /// The file.
+        path: PathBuf,
+        /// The encoder's message.
+        why: String,
+    },
+}
+
+/// What the recorder is given each tick.
+pub struct TickSample<'a> {
+    /// Loop time of the mission, s.
+    pub t: f64,
+    /// The frames the loop saw, one per camera.
+    pub frames: &'a [RgbImage],
+    /// The command sent.
+    pub command: &'a MotorOutput,
+    /// The decision trace of the tick.
+    pub trace: &'a TraceLine<'a>,
+    /// The percept and colour ranges, when the agent exposes them.
+    pub observation: Option<Observation>,
+    /// The true pose, dock frame.
+    pub truth: Pose2,
+    /// The odometry pose, odometry frame (its origin is where the mission began).
+    pub odometry: Pose2,
+}
+
+/// One camera's channels.
+struct CameraChannels {
+    frame_id: String,
+    image: u16,
+    calibration: u16,
+    annotations: u16,
+    spec: CameraSpec,
+}
+
+/// The channels of a recording.
+struct Channels {
+    cameras: Vec<CameraChannels>,
+    percept: u16,
+    colour_ranges: u16,
+    command: u16,
+    trace: u16,
+    odometry: u16,
+    ground_truth: u16,
+    tf: u16,
+    log: u16,
+}
+
+/// Room for an image message's JSON header (it is right-aligned in it, after spaces).
+const IMAGE_HEADER: usize = 192;
+
+/// Gap between the departure's last message and the docking mission's clock, ns.
+const MISSION_GAP_NS: u64 = 100_000_000;
+
+/// A run being recorded to an MCAP file (see the module docs).
+///
+/// Writing stops at the first error, which [`McapRecorder::finish`] returns; a run is
+/// never stopped by its recording.
+pub struct McapRecorder {
+    path: PathBuf,
+    writer: Option<mcap::Writer<BufWriter<File>>>,
+    opts: RecordOptions,
+    ch: Channels,
+    sequence: u32,
+    /// Start of the current mission's clock, ns.
+    base_ns: u64,
+    /// Latest time written, ns.
+    last_ns: u64,
+    /// A tick was recorded.
+    started: bool,
+    /// The next tick is a mission's first.
+    mission_start: bool,
+    mission: &'static str,
+    buf: Vec<u8>,
+    /// The image message being built (see [`McapRecorder::image`]).
+    image: Vec<u8>,
+    jpeg: Vec<u8>,
+    error: Option<RecordError>,
+}
+
+/// The MCAP writer's error, named by file.
+fn mcap_err(path: &Path) -> impl Fn(mcap::McapError) -> RecordError + '_ {
+    move |e| RecordError::Mcap {
+        path: path.to_path_buf(),
+        why: e.to_string(),
+    }
+}
+
+impl McapRecorder {
+    /// Creates `path` and declares the channels of a robot with `cameras`.
+    ///
+    /// # Errors
+    /// [`RecordError`] when the file cannot be created or written.
+    pub fn create(path: &Path, cameras: &[CameraSpec], opts: RecordOptions) -> Result<Self, RecordError> {
+        let file = File::create(path).map_err(|source| RecordError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let e = mcap_err(path);
+        // No compression, no CRCs: two passes less over every frame's bytes (readers
+        // accept a zero CRC as "not computed"), to keep recording cheap.
+        let mut w = mcap::WriteOptions::new()
+            .compression(None)
+            .calculate_chunk_crcs(false)
+            .calculate_data_section_crc(false)
+            .profile("")
+            .create(BufWriter::with_capacity(1 << 20, file))
+            .map_err(&e)?;
+        let json =
+            |w: &mut mcap::Writer<_>, name: &str, schema: &str| w.add_schema(name, "jsonschema", schema.as_bytes());
+        let none = BTreeMap::new();
+        let channel = |w: &mut mcap::Writer<_>, topic: &str, name: &str, schema: &str| -> Result<u16, RecordError> {
+            let id = json(w, name, schema).map_err(&e)?;
+            w.add_channel(id, topic, "json", &none).map_err(&e)
+        };
+        let (image_name, image_schema) = if opts.jpeg {
+            ("foxglove.CompressedImage", schemas::COMPRESSED_IMAGE)
+        } else {
+            ("foxglove.RawImage", schemas::RAW_IMAGE)
+        };
+        let mut cams = Vec::with_capacity(cameras.len());
+        for (i, spec) in cameras.iter().enumerate() {
+            let frame_id = format!("cam{i}");
+            cams.push(CameraChannels {
+                image: channel(&mut w, &format!("/{frame_id}/image"), image_name, image_schema)?,
+                calibration: channel(
+                    &mut w,
+                    &format!("/{frame_id}/calibration"),
+                    "foxglove.CameraCalibration",
+                    schemas::CAMERA_CALIBRATION,
+                )?,
+                annotations: channel(
+                    &mut w,
+                    &format!("/{frame_id}/annotations"),
+                    "foxglove.ImageAnnotations",
+                    schemas::IMAGE_ANNOTATIONS,
+                )?,
+                frame_id,
+                spec: spec.clone(),
+            });
+        }
+        let ch = Channels {
+            cameras: cams,
+            percept: channel(&mut w, "/percept", "marsupial.Percept", schemas::PERCEPT)?,
+            colour_ranges: channel(
+                &mut w,
+                "/colour_ranges",
+                "marsupial.ColourRanges",
+                schemas::COLOUR_RANGES,
+            )?,
+            command: channel(&mut w, "/command", "marsupial.MotorCommand", schemas::MOTOR_COMMAND)?,
+            trace: channel(&mut w, "/trace", "marsupial.TraceLine", schemas::TRACE_LINE)?,
+            odometry: channel(&mut w, "/odometry", "foxglove.PoseInFrame", schemas::POSE_IN_FRAME)?,
+            ground_truth: channel(&mut w, "/ground_truth", "foxglove.PoseInFrame", schemas::POSE_IN_FRAME)?,
+            tf: channel(&mut w, "/tf", "foxglove.FrameTransform", schemas::FRAME_TRANSFORM)?,
+            log: channel(&mut w, "/log", "foxglove.Log", schemas::LOG)?,
+        };
+        Ok(Self {
+            path: path.to_path_buf(),
+            writer: Some(w),
+            opts,
+            ch,
+            sequence: 0,
+            base_ns: 0,
+            last_ns: 0,
+            started: false,
+            mission_start: true,
+            mission: "",
+            buf: Vec::with_capacity(1 << 16),
+            image: Vec::new(),
+            jpeg: Vec::new(),
+            error: None,
+        })
+    }
+
+    /// The file being written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Nanoseconds on the recording's clock for mission time `t`.
+    fn ns(&self, t: f64) -> u64 {
+        self.base_ns + (t.max(0.0) * 1e9).round() as u64
+    }
+
+    /// Writes `self.buf` on `channel` at `ns`; notes the first error and stops writing.
+    fn put(&mut self, channel: u16, ns: u64) {
+        let Some(w) = self.writer.as_mut() else { return };
+        self.sequence = self.sequence.wrapping_add(1);
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence: self.sequence,
+            log_time: ns,
+            publish_time: ns,
+        };
+        if let Err(e) = w.write_to_known_channel(&header, &self.buf) {
+            self.error.get_or_insert(mcap_err(&self.path)(e));
+            self.writer = None;
+        }
+        self.last_ns = self.last_ns.max(ns);
+    }
+
+    /// Serialises `msg` as JSON and writes it on `channel` at `ns`.
+    fn put_json<T: Serialize + ?Sized>(&mut self, channel: u16, ns: u64, msg: &T) {
+        self.buf.clear();
+        if serde_json::to_writer(&mut self.buf, msg).is_ok() {
+            self.put(channel, ns);
+        }
+    }
+
+    /// A line on `/log` at mission time `t` (`level`: 2 info, 3 warning, 4 error).
+    pub fn log(&mut self, t: f64, level: u8, message: &str) {
+        let ns = self.ns(t);
+        self.put_json(
+            self.ch.log,
+            ns,
+            &Log {
+                timestamp: Time::from_ns(ns),
+                level,
+                message,
+                name: "marsupial::sim",
+                file: "",
+                line: 0,
+            },
+        );
+    }
+
+    /// Starts a mission's clock (`departure`, `docking`): its loop time 0 is 0.1 s after
+    /// the last message (0 for the first mission recorded).
+    pub fn begin_mission(&mut self, mission: &'static str) {
+        if self.started {
+            self.base_ns = self.last_ns + MISSION_GAP_NS;
+        }
+        self.mission = mission;
+        self.mission_start = true;
+        self.log(0.0, 2, &format!("{mission} begins"));
+    }
+
+    /// Records one tick.
+    pub fn tick(&mut self, s: &TickSample<'_>) {
+        let ns = self.ns(s.t);
+        let stamp = Time::from_ns(ns);
+        self.started = true;
+        if std::mem::take(&mut self.mission_start) {
+            // The odometry frame's origin: where the mission placed the robot.
+            let origin = s.truth.compose(&inverse(&s.odometry));
+            self.put_json(self.ch.tf, ns, &FrameTransform::planar(stamp, "dock", "odom", &origin));
+            for i in 0..self.ch.cameras.len() {
+                let m = self.ch.cameras[i].spec.mount;
+                let tf = FrameTransform {
+                    timestamp: stamp,
+                    parent_frame_id: "base_link",
+                    child_frame_id: &self.ch.cameras[i].frame_id,
+                    translation: Vector3 {
+                        x: m.x_m,
+                        y: m.y_m,
+                        z: m.z_m,
+                    },
+                    // Body axes (x forward, z up) turned by the mount, then to the
+                    // optical convention (z forward, x right, y down).
+                    rotation: Quaternion::from_euler(
+                        m.roll_deg.to_radians(),
+                        m.pitch_deg.to_radians(),
+                        m.yaw_deg.to_radians(),
+                    )
+                    .mul(&Quaternion {
+                        x: -0.5,
+                        y: 0.5,
+                        z: -0.5,
+                        w: 0.5,
+                    }),
+                };
+                self.buf.clear();
+                if serde_json::to_writer(&mut self.buf, &tf).is_ok() {
+                    let id = self.ch.tf;
+                    self.put(id, ns);
+                }
+            }
+        }
+        for (i, frame) in s.frames.iter().enumerate().take(self.ch.cameras.len()) {
+            self.image(i, ns, frame);
+            self.calibration(i, ns);
+        }
+        if let Some(obs) = &s.observation {
+            if let Some(cam) = self.ch.cameras.get(obs.camera) {
+                let id = cam.annotations;
+                self.put_json(id, ns, &annotations::annotate(stamp, obs));
+            }
+            #[derive(Serialize)]
+            struct PerceptMsg<'a> {
+                camera: usize,
+                percept: &'a crate::schemas::ObservedPercept,
+            }
+            self.put_json(
+                self.ch.percept,
+                ns,
+                &PerceptMsg {
+                    camera: obs.camera,
+                    percept: &obs.percept,
+                },
+            );
+            if let Some(r) = &obs.ranges {
+                self.put_json(self.ch.colour_ranges, ns, r);
+            }
+        }
+        #[derive(Serialize)]
+        struct CommandMsg<'a> {
+            mission: &'static str,
+            t: f64,
+            v: f64,
+            omega: f64,
+            command: &'a MotorOutput,
+        }
+        let twist = s.command.drive.to_twist();
+        self.put_json(
+            self.ch.command,
+            ns,
+            &CommandMsg {
+                mission: self.mission,
+                t: s.t,
+                v: twist.v,
+                omega: twist.omega,
+                command: s.command,
+            },
+        );
+        self.put_json(self.ch.trace, ns, s.trace);
+        self.put_json(
+            self.ch.odometry,
+            ns,
+            &PoseInFrame {
+                timestamp: stamp,
+                frame_id: "odom",
+                pose: (&s.odometry).into(),
+            },
+        );
+        self.put_json(
+            self.ch.ground_truth,
+            ns,
+            &PoseInFrame {
+                timestamp: stamp,
+                frame_id: "dock",
+                pose: (&s.truth).into(),
+            },
+        );
+        self.put_json(
+            self.ch.tf,
+            ns,
+            &FrameTransform::planar(stamp, "dock", "base_link", &s.truth),
+        );
+    }
+
+    /// Camera `i`'s frame as `foxglove.RawImage` or `foxglove.CompressedImage`, written
+    /// by hand: the pixels go base64 straight into the reused buffer.
+    fn image(&mut self, i: usize, ns: u64, frame: &RgbImage) {
+        use std::io::Write as _;
+        let t = Time::from_ns(ns);
+        let (w, h) = (frame.width(), frame.height());
+        let cam = &self.ch.cameras[i];
+        let id = cam.image;
+        self.buf.clear();
+        let pixels: &[u8] = if self.opts.jpeg {
+            self.jpeg.clear();
+            let mut enc = image::codecs::jpeg::JpegEncoder::new_with_quality(
+                &mut self.jpeg,
+                self.opts.jpeg_quality.clamp(1, 100),
+            );
+            if let Err(e) = enc.encode(frame.as_bytes(), w as u32, h as u32, image::ExtendedColorType::Rgb8) {
+                self.error.get_or_insert(RecordError::Jpeg {
+                    path: self.path.clone(),
+                    why: e.to_string(),
+                });
+                self.writer = None;
+                return;
+            }
+            let _ = write!(
+                self.buf,
+                r#"{{"timestamp":{{"sec":{},"nsec":{}}},"frame_id":"{}","format":"jpeg","data":""#,
+                t.sec, t.nsec, cam.frame_id
+            );
+            &self.jpeg
+        } else {
+            let _ = write!(
+                self.buf,
+                r#"{{"timestamp":{{"sec":{},"nsec":{}}},"frame_id":"{}","width":{w},"height":{h},"encoding":"rgb8","step":{},"data":""#,
+                t.sec,
+                t.nsec,
+                cam.frame_id,
+                w * 3
+            );
+            frame.as_bytes()
+        };
+        // The message is [spaces | header | base64 | "}] in a buffer that keeps its length
+        // from frame to frame (JSON allows leading whitespace), so the base64 is encoded in
+        // place without zeroing 250 kB first.
+        let n = base64::encoded_len(pixels.len());
+        let head = self.buf.len();
+        let pad = IMAGE_HEADER.max(head);
+        self.image.resize(pad + n + 2, b' ');
+        self.image[..pad - head].fill(b' ');
+        self.image[pad - head..pad].copy_from_slice(&self.buf);
+        let _ = base64::encode_into(pixels, &mut self.image[pad..pad + n]);
+        self.image[pad + n..].copy_from_slice(b"\"}");
+        std::mem::swap(&mut self.buf, &mut self.image);
+        self.put(id, ns);
+        std::mem::swap(&mut self.buf, &mut self.image);
+    }
+
+    /// Camera `i`'s pin-hole calibration (none for a fisheye camera).
+    fn calibration(&mut self, i: usize, ns: u64) {
+        let cam = &self.ch.cameras[i];
+        let Some(k) = cam.spec.pinhole_intrinsics() else {
+            return;
+        };
+        let msg = CameraCalibration {
+            timestamp: Time::from_ns(ns),
+            frame_id: &cam.frame_id,
+            width: cam.spec.width_px as u32,
+            height: cam.spec.height_px as u32,
+            distortion_model: "plumb_bob",
+            D: [k.k1, k.k2, 0.0, 0.0, 0.0],
+            K: [k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0],
+            R: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+            P: [k.fx, 0.0, k.cx, 0.0, 0.0, k.fy, k.cy, 0.0, 0.0, 0.0, 1.0, 0.0],
+        };
+        let id = cam.calibration;
+        self.buf.clear();
+        if serde_json::to_writer(&mut self.buf, &msg).is_ok() {
+            self.put(id, ns);
+        }
+    }
+
+    /// Writes the summary and closes the file.
+    ///
+    /// # Errors
+    /// The first [`RecordError`] met while recording, or one closing the file.
+    pub fn finish(mut self) -> Result<(), RecordError> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        let Some(mut w) = self.writer.take() else {
+            return Ok(());
+        };
+        w.finish().map_err(mcap_err(&self.path))?;
+        let mut inner = w.into_inner();
+        std::io::Write::flush(&mut inner).map_err(|source| RecordError::Io {
+            path: self.path.clone(),
+            source,
+        })
+    }
+}
+
+/// The inverse of a planar pose.
+fn inverse(p: &Pose2) -> Pose2 {
+    p.relative(&Pose2::default())
+}
