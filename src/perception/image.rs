@@ -258,6 +258,16 @@ pub(crate) fn for_each_cube_slab(f: impl Fn(u8, &RgbImage) + Sync) {
     });
 }
 
+/// The sRGB transfer function's inverse: an 8-bit-scaled code value in [0, 1] to linear
+/// light.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -21,15 +21,9 @@ pub const PAINT_PEAK: f32 = 0.85;
 /// Reflectance every paint returns at every wavelength (see the module docs).
 pub const PAINT_FLOOR: f32 = 0.04;
 
-/// The sRGB transfer function's inverse: an 8-bit-scaled code value in [0, 1] to linear
-/// light.
-pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
+/// The sRGB transfer function's inverse (perception's, which weighs marker pixels in
+/// linear light with it).
+pub use crate::perception::srgb_to_linear;
 
 /// The sRGB transfer function: linear light in [0, 1] to a code value in [0, 1].
 pub fn linear_to_srgb(x: f32) -> f32 {

@@ -316,7 +316,7 @@ impl Homography {
     /// ([`Homography::fit`]) on the final inliers.
     ///
     /// When the first fit leaves pairs outside their gate, trimming starts from the
-    /// inliers of the best exact four-pair fit ([`Homography::consensus`], a deterministic
+    /// inliers of the best exact four-pair fit (a deterministic
     /// RANSAC) rather than from every pair: several far outliers together can drag the
     /// least-squares fit so that leave-one-out removes good pairs first (a proptest found
     /// 3 of 18 pairs moved 40–140 px keeping two of them and dropping 7 good ones).

@@ -180,7 +180,7 @@ impl MarkerFinder {
             labeler: Labeler::new(width, height),
             blobs: Vec::with_capacity(MAX_BLOBS),
             pairs: Vec::with_capacity(8 * MAX_BLOBS),
-            linear: std::array::from_fn(|i| crate::profile::paint::srgb_to_linear(i as f32 / 255.0)),
+            linear: std::array::from_fn(|i| crate::perception::image::srgb_to_linear(i as f32 / 255.0)),
         }
     }
 
