@@ -35,27 +35,6 @@ const SCENARIO: &str = "seed = 77\ntrials = 3\ntimeout_s = 4.0\n\
     [axes]\nlighting = [\"clouds\"]\nsegmentation = [\"adaptive\"]\n\
     [imprint]\nenabled = false\n";
 
-/// A temporary folder, removed when dropped.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> Self {
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| d.subsec_nanos());
-        let dir = std::env::temp_dir().join(format!("marsupial-resume-{tag}-{}-{nanos}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Self(dir)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 /// Starts `marsupial trials SCENARIO --out OUT --jobs JOBS [--resume]`, with the slow-write
 /// hook's pause when given.
 fn spawn(scenario: &Path, out: &Path, jobs: usize, resume: bool, slow_write_ms: Option<u64>) -> Child {
@@ -224,7 +203,7 @@ fn kill_and_resume(scenario: &Path, dir: &Path, reference: &Reference, seed: u64
 /// `tests` randomized kill tests of `kills` kills each; every one must end identical
 /// (each asserts), so it returns only if all `tests` did.
 fn randomized(tag: &str, tests: usize, kills: usize) {
-    let dir = TempDir::new(tag);
+    let dir = common::TempDir::new(tag);
     let scenario = common::scenario_file(&dir.0, "resume", "bujold.toml", SCENARIO);
     let reference = reference(&scenario, &dir.0.join("reference"));
     let seed0 = std::env::var("MARSUPIAL_RESUME_SEED")
@@ -266,7 +245,7 @@ fn twenty_randomized_kill_tests_all_resume_to_the_uninterrupted_runs_jsonl() {
 /// hook) drops that half line and rewrites it whole.
 #[test]
 fn a_kill_mid_write_leaves_a_torn_line_that_resume_replaces() {
-    let dir = TempDir::new("mid-write");
+    let dir = common::TempDir::new("resume-mid-write");
     let scenario = common::scenario_file(&dir.0, "resume", "bujold.toml", SCENARIO);
     let reference = reference(&scenario, &dir.0.join("reference"));
     let out = dir.0.join("killed");
@@ -309,7 +288,7 @@ fn runs_and_lines(dir: &Path) -> (Vec<RunSpec>, Vec<Vec<u8>>) {
 
 #[test]
 fn the_resume_reader_drops_exactly_a_torn_last_line_and_names_any_other_bad_line() {
-    let dir = TempDir::new("reader");
+    let dir = common::TempDir::new("resume-reader");
     let (runs, lines) = runs_and_lines(&dir.0);
     assert_eq!(lines.len(), 12);
     let path = dir.0.join("runs.jsonl");

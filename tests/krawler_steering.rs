@@ -46,24 +46,6 @@ fn options(sweep: Option<PathBuf>, save: Option<PathBuf>, step: f64, order: usiz
     }
 }
 
-/// A temporary folder, removed when dropped.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("marsupial-steer-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Self(dir)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 /// With the markers' true projections, intersecting their rays with the axle's planes
 /// recovers the gear's own distances: the ratio equals the linkage's (to the camera
 /// model's projection accuracy) at any
@@ -144,7 +126,7 @@ fn the_shipped_calibration_is_what_calibrate_steering_fits() {
 /// the simulated sweep's fit exactly; `--write` puts it into a profile that loads.
 #[test]
 fn a_recorded_sweep_gives_the_simulated_fit_and_write_updates_the_profile() {
-    let dir = TempDir::new("recorded");
+    let dir = common::TempDir::new("steer-recorded");
     let save = dir.0.join("sweep");
     let simulated = calibrate(&krawler(), &options(None, Some(save.clone()), 3.0, 3)).unwrap();
     let csv = save.join("sweep.csv");
@@ -184,7 +166,7 @@ fn a_recorded_sweep_gives_the_simulated_fit_and_write_updates_the_profile() {
 /// a bad step or order are refused too.
 #[test]
 fn bad_sweeps_are_refused_naming_the_line() {
-    let dir = TempDir::new("bad");
+    let dir = common::TempDir::new("steer-bad");
     let save = dir.0.join("sweep");
     calibrate(&krawler(), &options(None, Some(save.clone()), 5.0, 3)).unwrap();
     let csv = save.join("sweep.csv");

@@ -7,59 +7,12 @@
 mod common;
 
 use base64::Engine as _;
-use marsupial::behaviors::{BuildError, agent_for};
-use marsupial::profile::Profile;
-use marsupial::schemas::{
-    Agent, Auxiliary, Behavior, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Outcome, Posture,
-    Step,
-};
+use marsupial::behaviors::agent_for;
 use marsupial::sim::campaign::{self, CampaignOptions, RecordRuns, Recording};
 use marsupial::sim::record::RecordOptions;
 use marsupial::sim::scenario::Scenario;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-
-/// Lowers, then backs straight at 5 cm/s until the dock switch closes (as in
-/// `tests/sim_scripted.rs`). No perception: its recordings have no percept channels'
-/// messages.
-struct Backer {
-    started: Option<f64>,
-}
-
-impl Behavior for Backer {
-    fn name(&self) -> &str {
-        "scripted_backer"
-    }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
-        let t0 = *self.started.get_or_insert(inputs.now);
-        let fb = Feedback::new("back_in", inputs.now - t0);
-        let aux = Auxiliary {
-            posture: Some(Posture::Lowered),
-            ..Default::default()
-        };
-        if inputs.docked_contact() {
-            return Some(Step::done(Outcome::Docked, MotorOutput::stop().with_aux(aux), fb));
-        }
-        Some(Step::running(
-            MotorOutput {
-                drive: DriveCommand::Straight { v: -0.05 },
-                aux,
-            },
-            fb,
-        ))
-    }
-}
-
-impl Agent for Backer {
-    fn begin(&mut self, _mission: &Mission) -> Result<(), MissionError> {
-        self.started = None;
-        Ok(())
-    }
-}
-
-fn backer(_: &Profile) -> Result<Box<dyn Agent>, BuildError> {
-    Ok(Box::new(Backer { started: None }))
-}
 
 fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("marsupial-mcap-{name}-{}", std::process::id()));
@@ -281,7 +234,7 @@ fn record_failed_keeps_only_the_failed_runs() {
             }),
             ..Default::default()
         };
-        let (records, _) = campaign::run_campaign(&p, &backer, &opts).unwrap();
+        let (records, _) = campaign::run_campaign(&p, &common::backer, &opts).unwrap();
         let mut files: Vec<String> = std::fs::read_dir(&rec_dir)
             .unwrap()
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())

@@ -16,27 +16,6 @@ const SCENARIO: &str = "seed = 91\ntrials = 2\ntimeout_s = 3.0\n\
     [axes]\nlighting = [\"clouds\"]\nsegmentation = [\"adaptive\"]\n\
     [imprint]\nenabled = false\n";
 
-/// A temporary folder, removed when dropped.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> Self {
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| d.subsec_nanos());
-        let dir = std::env::temp_dir().join(format!("marsupial-shard-{tag}-{}-{nanos}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Self(dir)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 fn marsupial(args: &[OsString]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_marsupial"))
         .args(args)
@@ -86,7 +65,7 @@ fn read(p: &Path) -> Vec<u8> {
 
 #[test]
 fn merged_shards_equal_the_unsharded_campaign() {
-    let dir = TempDir::new("identity");
+    let dir = common::TempDir::new("shard-identity");
     let scenario = common::scenario_file(&dir.0, "shard", "bujold.toml", SCENARIO);
     let whole = dir.0.join("whole");
     trials(&scenario, &whole, 2, None);
@@ -114,7 +93,7 @@ fn merged_shards_equal_the_unsharded_campaign() {
 
 #[test]
 fn merge_refuses_what_is_not_one_whole_campaign() {
-    let dir = TempDir::new("refuse");
+    let dir = common::TempDir::new("shard-refuse");
     let scenario = common::scenario_file(&dir.0, "shard", "bujold.toml", SCENARIO);
     let other = common::scenario_file(
         &dir.0.join("other"),
@@ -158,7 +137,7 @@ fn merge_refuses_what_is_not_one_whole_campaign() {
 
 #[test]
 fn bad_shard_arguments_are_refused() {
-    let dir = TempDir::new("args");
+    let dir = common::TempDir::new("shard-args");
     let scenario = common::scenario_file(&dir.0, "shard", "bujold.toml", SCENARIO);
     for bad in ["0/3", "4/3", "2", "1/0"] {
         let o = marsupial(&[os("trials"), os(&scenario), os("--shard"), os(bad)]);

@@ -1,64 +1,11 @@
 //! The simulator end to end with a trivial scripted driver (no behavior logic in the
 //! simulator): dock and trials, determinism across job counts, resume, contact failures.
 
-use marsupial::behaviors::BuildError;
-use marsupial::profile::Profile;
-use marsupial::schemas::{
-    Agent, Auxiliary, Behavior, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Outcome, Posture,
-    Step,
-};
+mod common;
+
 use marsupial::sim::campaign::{self, CampaignOptions, Prepared};
 use marsupial::sim::scenario::Scenario;
 use std::path::{Path, PathBuf};
-
-/// Lowers, then backs straight at 5 cm/s until the dock switch closes. No perception.
-struct Backer {
-    started: Option<f64>,
-}
-
-impl Behavior for Backer {
-    fn name(&self) -> &str {
-        "scripted_backer"
-    }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
-        let t0 = *self.started.get_or_insert(inputs.now);
-        let fb = Feedback::new("back_in", inputs.now - t0);
-        let aux = Auxiliary {
-            posture: Some(Posture::Lowered),
-            ..Default::default()
-        };
-        if inputs.docked_contact() {
-            return Some(Step::done(Outcome::Docked, MotorOutput::stop().with_aux(aux), fb));
-        }
-        Some(Step::running(
-            MotorOutput {
-                drive: DriveCommand::Straight { v: -0.05 },
-                aux,
-            },
-            fb,
-        ))
-    }
-}
-
-impl Agent for Backer {
-    fn begin(&mut self, mission: &Mission) -> Result<(), MissionError> {
-        match mission {
-            Mission::Departure => Err(MissionError::Unavailable {
-                robot: "scripted_backer".into(),
-                mission: "departure",
-                why: "it only backs in".into(),
-            }),
-            Mission::Docking { .. } => {
-                self.started = None;
-                Ok(())
-            }
-        }
-    }
-}
-
-fn factory(_: &Profile) -> Result<Box<dyn Agent>, BuildError> {
-    Ok(Box::new(Backer { started: None }))
-}
 
 fn scenario(body: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("marsupial-sim-{}", std::process::id()));
@@ -88,7 +35,7 @@ fn aligned_backing_docks_and_misaligned_gets_stuck() {
     );
     let (records, summary) = campaign::run_campaign(
         &p,
-        &factory,
+        &common::backer,
         &CampaignOptions {
             jobs: 1,
             ..Default::default()
@@ -124,7 +71,7 @@ fn same_seed_same_runs_jsonl_whatever_the_job_count_and_resume_works() {
             resume,
             ..Default::default()
         };
-        campaign::run_campaign(&p, &factory, &opts).unwrap();
+        campaign::run_campaign(&p, &common::backer, &opts).unwrap();
     };
     run(&out1, 1, false);
     run(&out2, 2, false);

@@ -1,5 +1,6 @@
 //! Helpers shared by integration tests: drawing synthetic fiducials, loading shipped
-//! profiles, a noiseless sensor, placing a camera and rendering what it sees.
+//! profiles, a noiseless sensor, placing a camera and rendering what it sees, temporary
+//! folders, and a scripted driver that only backs in.
 #![allow(dead_code)]
 
 use marsupial::geometry::Pose2;
@@ -265,4 +266,80 @@ pub fn axel_marks_frame(w: usize, h: usize, px_per_m: f64, centre: [f64; 2]) -> 
         circle_mark(&mut im, x, y, px_per_m * c.diameter_m / 2.0, pl.rotation_deg);
     }
     im
+}
+
+/// A temporary folder, `marsupial-{tag}-{pid}-{nanos}` under the system's, emptied when
+/// created and removed when dropped.
+pub struct TempDir(pub PathBuf);
+
+impl TempDir {
+    /// A fresh folder for `tag`.
+    pub fn new(tag: &str) -> Self {
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.subsec_nanos());
+        let dir = std::env::temp_dir().join(format!("marsupial-{tag}-{}-{nanos}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        Self(dir)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// A scripted driver with no perception: lowers, then backs straight at 5 cm/s until
+/// the dock switch closes. It refuses the departure mission (it only backs in).
+pub struct Backer {
+    started: Option<f64>,
+}
+
+impl marsupial::schemas::Behavior for Backer {
+    fn name(&self) -> &str {
+        "scripted_backer"
+    }
+    fn tick(&mut self, inputs: &marsupial::schemas::Inputs<'_>) -> Option<marsupial::schemas::Step> {
+        use marsupial::schemas::{Auxiliary, DriveCommand, Feedback, MotorOutput, Outcome, Posture, Step};
+        let t0 = *self.started.get_or_insert(inputs.now);
+        let fb = Feedback::new("back_in", inputs.now - t0);
+        let aux = Auxiliary {
+            posture: Some(Posture::Lowered),
+            ..Default::default()
+        };
+        if inputs.docked_contact() {
+            return Some(Step::done(Outcome::Docked, MotorOutput::stop().with_aux(aux), fb));
+        }
+        Some(Step::running(
+            MotorOutput {
+                drive: DriveCommand::Straight { v: -0.05 },
+                aux,
+            },
+            fb,
+        ))
+    }
+}
+
+impl marsupial::schemas::Agent for Backer {
+    fn begin(&mut self, mission: &marsupial::schemas::Mission) -> Result<(), marsupial::schemas::MissionError> {
+        use marsupial::schemas::{Mission, MissionError};
+        match mission {
+            Mission::Departure => Err(MissionError::Unavailable {
+                robot: "scripted_backer".into(),
+                mission: "departure",
+                why: "it only backs in".into(),
+            }),
+            Mission::Docking { .. } => {
+                self.started = None;
+                Ok(())
+            }
+        }
+    }
+}
+
+/// A campaign's agent factory for [`Backer`].
+pub fn backer(_: &Profile) -> Result<Box<dyn marsupial::schemas::Agent>, marsupial::behaviors::BuildError> {
+    Ok(Box::new(Backer { started: None }))
 }
