@@ -307,10 +307,7 @@ fn bench_krawler(c: &mut Criterion) {
         );
     }
     let gear = build(&p, &state).expect("gear");
-    let project = |q: [f64; 3]| {
-        let c = pose.rotation.transpose() * (nalgebra::Point3::from(q) - pose.position);
-        geometry.model.project(&c)
-    };
+    let project = |q: [f64; 3]| geometry.model.project(&pose.to_camera(&nalgebra::Point3::from(q)));
     let expected: [ExpectedMarker; 8] = gear.markers.map(|m| {
         ExpectedMarker::from_square(project, m.coords.into(), [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 0.03).expect("projects")
     });

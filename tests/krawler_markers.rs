@@ -43,8 +43,7 @@ impl Cam {
     }
 
     fn project(&self, p: [f64; 3]) -> Option<[f64; 2]> {
-        let c = self.pose.rotation.transpose() * (Point3::from(p) - self.pose.position);
-        self.model.project(&c)
+        self.model.project(&self.pose.to_camera(&Point3::from(p)))
     }
 
     /// The eight predictions for the markers at `gear`'s positions (areas from the

@@ -30,8 +30,7 @@ fn profile_path() -> PathBuf {
 }
 
 fn project(model: &CameraModel, pose: &CameraPose, p: &Point3<f64>) -> Option<[f64; 2]> {
-    let c = pose.rotation.transpose() * (p - pose.position);
-    model.project(&c)
+    model.project(&pose.to_camera(p))
 }
 
 fn options(sweep: Option<PathBuf>, save: Option<PathBuf>, step: f64, order: usize) -> CalibrateSteeringOptions {

@@ -189,10 +189,7 @@ fn nominal_prediction(
     let rest = KrawlerState::rest(profile).map_err(|e| e.to_string())?;
     let gear: KrawlerScene = build(profile, &rest).map_err(|e| e.to_string())?;
     let side = profile.fiducial.markers.map_or(0.03, |m| m.side_m);
-    let project = |q: [f64; 3]| {
-        let c = pose.rotation.transpose() * (nalgebra::Point3::from(q) - pose.position);
-        model.project(&c)
-    };
+    let project = |q: [f64; 3]| model.project(&pose.to_camera(&nalgebra::Point3::from(q)));
     let mut out = [ExpectedMarker {
         at: [0.0; 2],
         area: 0.0,

@@ -50,6 +50,13 @@ pub struct CameraPose {
     pub position: Point3<f64>,
 }
 
+impl CameraPose {
+    /// A world point in the camera's frame (what [`CameraModel::project`] takes).
+    pub fn to_camera(&self, p: &Point3<f64>) -> Vector3<f64> {
+        self.rotation.transpose() * (p - self.position)
+    }
+}
+
 /// Renders frames of one camera.
 #[derive(Debug, Clone)]
 pub struct Renderer {
