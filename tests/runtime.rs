@@ -298,6 +298,7 @@ fn missions_run_one_after_the_other_and_custom_devices_reach_the_behavior() {
     let cfg = RuntimeConfig {
         max_duration: Some(Duration::from_secs(5)),
         sensor_rate_hz: 100.0,
+        ..Default::default()
     };
     let missions = [Mission::Departure, Mission::docking(), Mission::docking()];
     let report = run_missions(&mut robot, &mut lp, &missions, &cfg, &StopHandle::new());

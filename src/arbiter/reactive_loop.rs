@@ -7,6 +7,7 @@
 //! why in [`LoopStatus::SafeStop`], and resumes on the first tick whose inputs are good.
 
 use crate::kinematics::{DriveLimits, DriveModel};
+use crate::robot::DeviceId;
 use crate::schemas::{
     Agent, Auxiliary, Behavior, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Outcome, Status,
     TetherCommand,
@@ -86,6 +87,21 @@ pub enum StopReason {
     },
     /// The behaviors proposed a command with NaN or infinity.
     NonFiniteCommand,
+    /// The tick took longer than the tightest staleness limit, so by the time its command
+    /// could be sent, the data it was computed from was stale (raised by the threaded
+    /// runtime, [`crate::arbiter::runtime`], which sends a stop instead).
+    Overrun {
+        /// How long the tick took, s.
+        tick_s: f64,
+        /// The limit, s.
+        limit_s: f64,
+    },
+    /// An actuator rejected a command (raised by the threaded runtime, which commands
+    /// stops until the device has accepted commands again for a while).
+    ActuatorFault {
+        /// Which device.
+        device: DeviceId,
+    },
 }
 
 impl StopReason {
@@ -98,7 +114,10 @@ impl StopReason {
             | (Stale { input: a, .. }, Stale { input: b, .. })
             | (NonFinite { input: a }, NonFinite { input: b }) => a == b,
             (BadFrameSize { camera: a, .. }, BadFrameSize { camera: b, .. }) => a == b,
-            (BadClock { .. }, BadClock { .. }) | (NonFiniteCommand, NonFiniteCommand) => true,
+            (BadClock { .. }, BadClock { .. })
+            | (NonFiniteCommand, NonFiniteCommand)
+            | (Overrun { .. }, Overrun { .. }) => true,
+            (ActuatorFault { device: a }, ActuatorFault { device: b }) => a == b,
             _ => false,
         }
     }
@@ -119,6 +138,13 @@ impl fmt::Display for StopReason {
             StopReason::NonFinite { input } => write!(f, "{input}: value is not finite"),
             StopReason::BadClock { previous, now } => write!(f, "loop clock went from {previous} to {now}"),
             StopReason::NonFiniteCommand => f.write_str("behaviors proposed a non-finite command"),
+            StopReason::Overrun { tick_s, limit_s } => {
+                write!(
+                    f,
+                    "tick took {tick_s:.3} s (limit {limit_s:.3} s): its command was stale"
+                )
+            }
+            StopReason::ActuatorFault { device } => write!(f, "{device} rejected a command"),
         }
     }
 }

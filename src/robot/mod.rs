@@ -16,6 +16,10 @@
 //! period and returns [`HardwareError::NotReady`] when no new frame came, so the runtime
 //! can shut down promptly.
 
+mod lending;
+
+pub use lending::{Abandoned, ActuationDevices, DeviceId, SensingDevices};
+
 use crate::perception::RgbImage;
 use crate::schemas::{DriveCommand, Guides, MotorOutput, OdometryReading, Posture, TetherCommand, TetherReading};
 use std::time::Duration;
@@ -265,31 +269,43 @@ impl Actuation<'_> {
     /// auxiliary only when the command sets it, so `None` leaves the device as it is).
     /// `report` hears each device that failed, by name.
     pub fn apply(&mut self, command: &MotorOutput, mut report: impl FnMut(&'static str, HardwareError)) {
-        let mut check = |device: &'static str, r: Result<(), HardwareError>| {
-            if let Err(e) = r {
+        self.apply_watched(command, |_| {}, |device, e| report(device.kind, e));
+    }
+
+    /// [`Actuation::apply`], telling `enter` which device it is about to call before each
+    /// call, so a watchdog can name the device a blocked call is stuck in.
+    pub fn apply_watched(
+        &mut self,
+        command: &MotorOutput,
+        mut enter: impl FnMut(DeviceId),
+        mut report: impl FnMut(DeviceId, HardwareError),
+    ) {
+        let mut call = |device: DeviceId, f: &mut dyn FnMut() -> Result<(), HardwareError>| {
+            enter(device);
+            if let Err(e) = f() {
                 report(device, e);
             }
         };
-        check("drive", self.drive.apply(&command.drive));
+        call(DeviceId::one("drive"), &mut || self.drive.apply(&command.drive));
         let aux = &command.aux;
         if let (Some(t), Some(c)) = (self.tether.as_mut(), aux.tether) {
-            check("tether", t.command(&c));
+            call(DeviceId::one("tether"), &mut || t.command(&c));
         }
         if let (Some(a), Some(p)) = (self.arm.as_mut(), aux.arm) {
-            check("arm", a.set_position(p));
+            call(DeviceId::one("arm"), &mut || a.set_position(p));
         }
         if let (Some(l), Some(on)) = (self.lights.as_mut(), aux.lights) {
-            check("lights", l.set(on));
+            call(DeviceId::one("lights"), &mut || l.set(on));
         }
         if let (Some(g), Some(gc)) = (self.guides.as_mut(), aux.guides) {
-            check("guides", g.set(gc));
+            call(DeviceId::one("guides"), &mut || g.set(gc));
         }
         if let (Some(p), Some(pc)) = (self.posture.as_mut(), aux.posture) {
-            check("posture", p.set(pc));
+            call(DeviceId::one("posture"), &mut || p.set(pc));
         }
-        for (a, v) in self.actuators.iter_mut().zip(aux.actuators) {
+        for (i, (a, v)) in self.actuators.iter_mut().zip(aux.actuators).enumerate() {
             if let Some(v) = v {
-                check("actuator", a.apply(v));
+                call(DeviceId::nth("actuator", i), &mut || a.apply(v));
             }
         }
     }
