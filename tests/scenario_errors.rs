@@ -243,6 +243,41 @@ fn malformed_scenarios_are_reported_precisely() {
             Some(6),
             "invalid type: string \"yes\", expected a boolean",
         ),
+        (
+            "fault_without_lag.toml",
+            "[starts]\ngrid = \"paper16\"\n[[faults]]\nname = \"a\"\nkind = \"camera_late\"\nat_s = 1.0\nduration_s = 2.0\nexpect = \"dock\"\n",
+            "faults[0].lag_s",
+            Some(5),
+            "`camera_late` needs `lag_s`",
+        ),
+        (
+            "fault_with_stray_side.toml",
+            "[starts]\ngrid = \"paper16\"\n[[faults]]\nname = \"a\"\nkind = \"half_speed\"\nat_s = 1.0\nduration_s = 2.0\nexpect = \"dock\"\nside = \"left\"\n",
+            "faults[0].side",
+            Some(11),
+            "`half_speed` takes no `side`",
+        ),
+        (
+            "fault_negative_duration.toml",
+            "[starts]\ngrid = \"paper16\"\n[[faults]]\nname = \"a\"\nkind = \"lights_out\"\nat_s = 1.0\nduration_s = -2.0\nexpect = \"dock\"\n",
+            "faults[0].duration_s",
+            Some(9),
+            "positive",
+        ),
+        (
+            "fault_unknown_kind.toml",
+            "[starts]\ngrid = \"paper16\"\n[[faults]]\nname = \"a\"\nkind = \"gremlins\"\nat_s = 1.0\nduration_s = 2.0\nexpect = \"dock\"\n",
+            "faults[0].kind",
+            Some(7),
+            "unknown variant `gremlins`",
+        ),
+        (
+            "fault_twice.toml",
+            "[starts]\ngrid = \"paper16\"\n[[faults]]\nname = \"a\"\nkind = \"lights_out\"\nat_s = 1.0\nduration_s = 2.0\nexpect = \"dock\"\n[[faults]]\nname = \"a\"\nkind = \"half_speed\"\nat_s = 1.0\nduration_s = 2.0\nexpect = \"dock\"\n",
+            "faults[1].name",
+            Some(12),
+            "`a` names another fault too",
+        ),
     ];
     for (file, body, path, line, text) in cases {
         let (p, l, m) = problem(&write(file, body));

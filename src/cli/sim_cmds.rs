@@ -239,6 +239,35 @@ pub fn print_table(s: &Summary, out: &mut dyn Write) -> std::io::Result<()> {
         writeln!(out, "\nby fiducial colours, over all starts")?;
         print_groups(&s.by_colors, None, out)?;
     }
+    if !s.by_fault.is_empty() {
+        let w = s
+            .by_fault
+            .iter()
+            .map(|f| f.fault.chars().count())
+            .max()
+            .unwrap_or(5)
+            .max(5);
+        writeln!(out, "\nby fault, over all starts")?;
+        writeln!(
+            out,
+            "{:<w$}  runs  as expected  docked  typed failures  other  safe stop (s)  stale-motion ticks",
+            "fault"
+        )?;
+        for f in &s.by_fault {
+            writeln!(
+                out,
+                "{:<w$}  {:>4}  {:>11}  {:>6}  {:>14}  {:>5}  {:>13.1}  {:>18}",
+                f.fault,
+                f.runs,
+                f.as_expected,
+                f.docked,
+                f.typed_failures,
+                f.other,
+                f.mean_safe_stop_s,
+                f.stale_motion_ticks
+            )?;
+        }
+    }
     Ok(())
 }
 

@@ -172,6 +172,10 @@ mod tests {
             safe_stops: 0,
             imprinted: None,
             manoeuvres: 0,
+            fault: None,
+            fault_as_expected: None,
+            stale_motion_ticks: None,
+            safe_stop_s: None,
             lighting_draw: Some(LightingDraw {
                 spec: Default::default(),
                 params,

@@ -96,6 +96,19 @@ pub struct RunRecord {
     /// distribution (absent otherwise).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lighting_draw: Option<LightingDraw>,
+    /// The injected fault's name, when the scenario has `[[faults]]` (absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fault: Option<String>,
+    /// The run ended as the fault's `expect` says.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fault_as_expected: Option<bool>,
+    /// Ticks with motion commanded while the fault left an input the loop must not act on
+    /// (must be 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stale_motion_ticks: Option<u64>,
+    /// Time in safe stop, s (with a fault).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub safe_stop_s: Option<f64>,
     /// True path, [x, y] in mm every 0.5 s.
     pub track: Vec<[i32; 2]>,
 }
@@ -294,6 +307,65 @@ pub struct Summary {
     /// other axes, over all starts (`start` is `*`), in campaign order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub by_colors: Vec<GroupSummary>,
+    /// With `[[faults]]`: one entry per fault, over all runs that had it, in campaign
+    /// order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub by_fault: Vec<FaultSummary>,
+}
+
+/// How the runs with one injected fault ended (`summary.json`'s `by_fault`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FaultSummary {
+    /// The fault's name.
+    pub fault: String,
+    /// Runs.
+    pub runs: usize,
+    /// Runs that ended as the fault's `expect` says.
+    pub as_expected: usize,
+    /// Docked runs.
+    pub docked: usize,
+    /// Runs that ended in a typed failure of the behavior.
+    pub typed_failures: usize,
+    /// Runs that ended otherwise (timeout, collision, stuck, false dock): bugs.
+    pub other: usize,
+    /// Mean time in safe stop per run, s.
+    pub mean_safe_stop_s: f64,
+    /// Ticks with motion commanded while an input was invalid, over all its runs (must
+    /// be 0).
+    pub stale_motion_ticks: u64,
+}
+
+/// The per-fault rows of a campaign with `[[faults]]` (none without).
+pub fn fault_summaries(records: &[RunRecord]) -> Vec<FaultSummary> {
+    let mut names: Vec<&str> = Vec::new();
+    for r in records {
+        if let Some(f) = r.fault.as_deref()
+            && !names.contains(&f)
+        {
+            names.push(f);
+        }
+    }
+    names
+        .iter()
+        .map(|name| {
+            let rs: Vec<&RunRecord> = records.iter().filter(|r| r.fault.as_deref() == Some(name)).collect();
+            let docked = rs.iter().filter(|r| r.outcome == "docked").count();
+            let other = rs
+                .iter()
+                .filter(|r| !super::faults::Expected::DockOrTypedFailure.accepts(&r.outcome))
+                .count();
+            FaultSummary {
+                fault: name.to_string(),
+                runs: rs.len(),
+                as_expected: rs.iter().filter(|r| r.fault_as_expected == Some(true)).count(),
+                docked,
+                typed_failures: rs.len() - docked - other,
+                other,
+                mean_safe_stop_s: rs.iter().filter_map(|r| r.safe_stop_s).sum::<f64>() / rs.len().max(1) as f64,
+                stale_motion_ticks: rs.iter().filter_map(|r| r.stale_motion_ticks).sum(),
+            }
+        })
+        .collect()
 }
 
 /// Summarises records with the given labels.
@@ -377,6 +449,7 @@ pub fn summary(name: &str, records: &[RunRecord]) -> Summary {
         overall: summarise(&all, ["*", "*", "*", "*"]),
         groups: grouped(true),
         by_colors,
+        by_fault: fault_summaries(records),
     }
 }
 

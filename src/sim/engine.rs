@@ -9,6 +9,7 @@
 
 use super::camera::camera_pose;
 use super::dock::{Contact, judge};
+use super::faults::{FaultKind, FaultSpec, Side};
 use super::lighting::{LightState, LightingRun, ShadowBand};
 use super::motion::Motion;
 use super::render::{CameraMotion, Renderer, SensorParams};
@@ -20,7 +21,9 @@ use crate::kinematics::Odometry;
 use crate::perception::RgbImage;
 use crate::perception::camera_model::CameraModel;
 use crate::profile::Profile;
+use crate::robot::{Exposure, HardwareError};
 use crate::schemas::{DriveCommand, OdometryReading, Outcome, Posture, TetherCommand, TetherReading};
+use std::collections::VecDeque;
 use std::sync::Arc;
 
 /// How a phase of a run ended.
@@ -96,8 +99,20 @@ pub struct Sim {
     next_track: f64,
     /// Ticks spent in safe stop.
     pub safe_stops: u64,
+    /// Ticks the behaviors commanded motion while the injected fault had left an input
+    /// the loop must not act on ([`FaultSpec::inputs_invalid`]); must stay 0.
+    pub stale_motion_ticks: u64,
     encoder_ref: (f64, f64),
+    /// The fault injected into this mission, if any ([`super::faults`]).
+    fault: Option<FaultSpec>,
+    /// The odometry offset of an `odometry_jump` once it struck (x, y, θ).
+    odometry_jump: Option<Pose2>,
+    /// The true pose at each of the last ticks (for late frames), oldest first.
+    past: VecDeque<(f64, Pose2)>,
 }
+
+/// Ticks of pose history kept for `camera_late` frames.
+const PAST_CAPACITY: usize = 256;
 
 impl Sim {
     /// A simulation of `profile` in `world`. The sensor's frame interval is set to the
@@ -168,8 +183,91 @@ impl Sim {
             track_every: 0.5,
             next_track: 0.0,
             safe_stops: 0,
+            stale_motion_ticks: 0,
             encoder_ref: (0.0, 0.0),
+            fault: None,
+            odometry_jump: None,
+            past: VecDeque::with_capacity(PAST_CAPACITY),
         }
+    }
+
+    /// Injects `fault` into the mission that starts now (its clock is this run's, which
+    /// [`Sim::place`] restarts), or clears it.
+    pub fn set_fault(&mut self, fault: Option<FaultSpec>) {
+        self.fault = fault;
+        self.odometry_jump = None;
+        self.motion.set_side_gain(1.0, 1.0);
+    }
+
+    /// The fault injected into this mission, in force or not.
+    pub fn fault(&self) -> Option<&FaultSpec> {
+        self.fault.as_ref()
+    }
+
+    /// The fault in force now, if any.
+    pub fn fault_now(&self) -> Option<&FaultSpec> {
+        self.fault.as_ref().filter(|f| f.active(self.t))
+    }
+
+    /// What camera `i` delivers now: a rendered frame, or what the fault in force makes of
+    /// it (nothing, a wrong-sized, black, saturated or late frame).
+    ///
+    /// # Errors
+    /// [`HardwareError::NotReady`] while a `camera_silent` fault is in force.
+    pub fn capture(&mut self, i: usize, frame: &mut RgbImage) -> Result<Exposure, HardwareError> {
+        let Some(f) = self.fault_now().cloned() else {
+            self.render(i, frame);
+            return Ok(Exposure::NOW);
+        };
+        match f.kind {
+            FaultKind::CameraSilent => Err(HardwareError::NotReady),
+            FaultKind::CameraLate => {
+                let lag = f.lag_s.unwrap_or(0.0);
+                let then = self.t - lag;
+                let past = self
+                    .past
+                    .iter()
+                    .rev()
+                    .find(|(t, _)| *t <= then + 1e-9)
+                    .or(self.past.front())
+                    .map_or(self.pose, |p| p.1);
+                let now = std::mem::replace(&mut self.pose, past);
+                self.render(i, frame);
+                self.pose = now;
+                Ok(Exposure::ago(std::time::Duration::from_secs_f64(lag)))
+            }
+            kind => {
+                self.render(i, frame);
+                match kind {
+                    FaultKind::CameraWrongSize => frame.resize(frame.width() / 2, frame.height() / 2),
+                    FaultKind::CameraBlack => frame.as_bytes_mut().fill(0),
+                    FaultKind::CameraSaturated => frame.as_bytes_mut().fill(255),
+                    _ => {}
+                }
+                Ok(Exposure::NOW)
+            }
+        }
+    }
+
+    /// Odometry as the base reports it: [`Sim::odometry`], or what the fault in force
+    /// makes of it.
+    pub fn odometry_reported(&mut self) -> OdometryReading {
+        let mut r = self.odometry();
+        if let Some(f) = self.fault_now() {
+            match f.kind {
+                FaultKind::OdometryNan => r.pose.x = f64::NAN,
+                FaultKind::OdometryInfinite => r.pose.y = f64::INFINITY,
+                FaultKind::OdometryJump => {
+                    let [x, y, deg] = f.jump.unwrap_or_default();
+                    self.odometry_jump.get_or_insert(Pose2::new(x, y, deg.to_radians()));
+                }
+                _ => {}
+            }
+        }
+        if let Some(j) = self.odometry_jump {
+            r.pose = Pose2::new(r.pose.x + j.x, r.pose.y + j.y, r.pose.theta + j.theta);
+        }
+        r
     }
 
     /// The true pose.
@@ -219,6 +317,8 @@ impl Sim {
         self.track.clear();
         self.next_track = 0.0;
         self.safe_stops = 0;
+        self.stale_motion_ticks = 0;
+        self.past.clear();
         let last = self.motion.encoders();
         self.encoder_ref = (last.left, last.right);
         if let Some(t) = &mut self.tether {
@@ -291,6 +391,9 @@ impl Sim {
             self.robot_shadow(&mut light);
             self.light_now = light;
         }
+        if i == 0 && self.fault_now().is_some_and(|f| f.kind == FaultKind::LightsOut) {
+            self.light_now.lights_out();
+        }
         let pose = camera_pose(&self.pose, &spec.mount);
         if self.sensor.motion_blur || self.sensor.rolling_shutter_readout_s > 0.0 {
             let motion = self.camera_motion(&pose);
@@ -341,7 +444,13 @@ impl Sim {
             self.drive_changes += 1;
         }
         self.last_drive = drive;
-        self.motion.command(self.t, drive);
+        match self
+            .fault_now()
+            .and_then(|f| f.latency_s.filter(|_| f.kind == FaultKind::CommandLatency))
+        {
+            Some(latency) => self.motion.command_delayed(self.t, drive, latency),
+            None => self.motion.command(self.t, drive),
+        }
     }
 
     /// Sets the reel's command (kept until the next).
@@ -361,11 +470,25 @@ impl Sim {
         let substeps = ((tick_dt / self.dt).round() as usize).max(1);
         let dt = tick_dt / substeps as f64;
         let (length, width) = (self.profile.body.length_m, self.profile.body.width_m);
+        let (gain, reel) = match self.fault_now().map(|f| (f.kind, f.side)) {
+            Some((FaultKind::TrackStall, Some(Side::Left))) => ((0.0, 1.0), self.reel),
+            Some((FaultKind::TrackStall, _)) => ((1.0, 0.0), self.reel),
+            Some((FaultKind::HalfSpeed, _)) => ((0.5, 0.5), self.reel),
+            Some((FaultKind::ReelJam, _)) => ((1.0, 1.0), self.reel.map(|r| TetherCommand { reel_rate: 0.0, ..r })),
+            _ => ((1.0, 1.0), self.reel),
+        };
+        if self.fault.is_some() {
+            self.motion.set_side_gain(gain.0, gain.1);
+        }
+        if self.past.len() == PAST_CAPACITY {
+            self.past.pop_front();
+        }
+        self.past.push_back((self.t, self.pose));
         for _ in 0..substeps {
             let from = self.pose;
             let mut to = self.motion.step(self.t, dt, &from, &mut self.rng);
             if let Some(t) = &mut self.tether {
-                to = t.step(dt, &to, self.reel);
+                to = t.step(dt, &to, reel);
             }
             if let Some(obstacle) = self.world.obstacles.entered(&from, &to, length, width) {
                 self.motion.halt();

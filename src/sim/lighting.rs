@@ -511,6 +511,16 @@ pub struct LightState {
 }
 
 impl LightState {
+    /// The lights went out (fault injection): the light falls to 0.1 % of what it was (a
+    /// 500 lx lab to a dark room's 0.5 lx), with
+    /// no sun, glare or flashers; the camera's auto-exposure then lifts mostly noise.
+    pub fn lights_out(&mut self) {
+        self.level *= 0.001;
+        self.sun = 0.0;
+        self.glare = 0.0;
+        self.flashers.clear();
+    }
+
     /// Plain uniform light of `level` (for tests).
     pub fn uniform(level: f32) -> Self {
         Self {

@@ -46,6 +46,7 @@ pub mod bins;
 pub mod campaign;
 pub mod dock;
 pub mod engine;
+pub mod faults;
 pub mod motion;
 pub mod obstacles;
 pub mod paper;

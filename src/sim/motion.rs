@@ -94,6 +94,9 @@ pub struct Motion {
     omega: f64,
     travel: WheelTravel,
     track: f64,
+    /// What each side's motor delivers of its command, (left, right): (1, 1) healthy, 0
+    /// a stalled track, 0.5 a motor at half speed (fault injection, [`super::faults`]).
+    side_gain: (f64, f64),
 }
 
 impl Motion {
@@ -125,7 +128,20 @@ impl Motion {
             omega: 0.0,
             travel: WheelTravel::default(),
             track,
+            side_gain: (1.0, 1.0),
         }
+    }
+
+    /// Sets what each side's motor delivers of its command (see `side_gain`).
+    pub fn set_side_gain(&mut self, left: f64, right: f64) {
+        self.side_gain = (left, right);
+    }
+
+    /// Queues a command issued at `t` that reaches the motors `latency_s` later (a
+    /// latency spike), never before a command queued earlier: the bus delivers in order.
+    pub fn command_delayed(&mut self, t: f64, cmd: DriveCommand, latency_s: f64) {
+        let due = self.queue.back().map_or(t + latency_s, |(d, _)| d.max(t + latency_s));
+        self.queue.push_back((due, self.model.realise(&cmd, &self.limits)));
     }
 
     /// Queues a command issued at time `t`; it takes effect `latency_s` later.
@@ -161,20 +177,28 @@ impl Motion {
         let ramp = |cur: f64, want: f64, rate: f64| cur + (want - cur).clamp(-rate * dt, rate * dt);
         self.v = ramp(self.v, target.v, self.accel);
         self.omega = ramp(self.omega, target.omega, self.yaw_accel);
-        // Encoders: wheel surface travel of the commanded motion.
-        let half = self.omega * self.track / 2.0;
-        self.travel.left += (self.v - half) * dt;
-        self.travel.right += (self.v + half) * dt;
+        // What the motors deliver: all of it when healthy (kept apart so healthy runs stay
+        // bit for bit what they were), less on a failing side.
+        let (v, omega) = if self.side_gain == (1.0, 1.0) {
+            (self.v, self.omega)
+        } else {
+            let half = self.omega * self.track / 2.0;
+            let (l, r) = ((self.v - half) * self.side_gain.0, (self.v + half) * self.side_gain.1);
+            ((l + r) / 2.0, (r - l) / self.track)
+        };
+        // Encoders: wheel surface travel of the delivered motion.
+        let half = omega * self.track / 2.0;
+        self.travel.left += (v - half) * dt;
+        self.travel.right += (v + half) * dt;
         // Slip.
         let skid = matches!(self.model, DriveModel::SkidSteer(_) | DriveModel::TurnOrDrive(_));
-        let turn_share =
-            (self.omega.abs() * self.track / 2.0) / (self.v.abs() + self.omega.abs() * self.track / 2.0 + 1e-9);
+        let turn_share = (omega.abs() * self.track / 2.0) / (v.abs() + omega.abs() * self.track / 2.0 + 1e-9);
         let yaw_loss = self.slip.slip_turn * if skid { 0.5 + 0.5 * turn_share } else { 0.2 };
         let n = self.slip.noise;
-        let v_true = self.v * (1.0 - self.slip.slip_straight) * (1.0 + n * rng.normal());
-        let w_true = self.omega * (1.0 - yaw_loss) * (1.0 + n * rng.normal())
-            + self.slip.heading_noise * self.v.abs().sqrt() * rng.normal() * dt.sqrt();
-        let lateral = if skid { 0.02 * self.v.abs() * rng.normal() } else { 0.0 };
+        let v_true = v * (1.0 - self.slip.slip_straight) * (1.0 + n * rng.normal());
+        let w_true = omega * (1.0 - yaw_loss) * (1.0 + n * rng.normal())
+            + self.slip.heading_noise * v.abs().sqrt() * rng.normal() * dt.sqrt();
+        let lateral = if skid { 0.02 * v.abs() * rng.normal() } else { 0.0 };
         integrate_body_velocity(pose, v_true, lateral, w_true, dt)
     }
 }

@@ -222,8 +222,7 @@ impl Camera for SimCamera {
             self.last = Some(t);
         }
         let i = self.index;
-        self.sim.with(|s| s.render(i, frame));
-        Ok(Exposure::NOW)
+        self.sim.with(|s| s.capture(i, frame))
     }
 }
 
@@ -243,7 +242,7 @@ pub struct SimOdometer(SimRobot);
 
 impl Odometer for SimOdometer {
     fn read(&mut self) -> Result<OdometryReading, HardwareError> {
-        Ok(self.0.with(|s| s.odometry()))
+        Ok(self.0.with(|s| s.odometry_reported()))
     }
 }
 

@@ -184,6 +184,13 @@ impl Rig {
             rec.frame(prefix, self.sim.with(|s| s.frame_count()), self.step.frames());
             rec.tick(mission, now, self.lp.root(), &out, &mut nodes);
             rec.mcap_tick(mcap, mission, now, self, &out, &mut nodes);
+            let moving = !out.command.drive.is_stop();
+            let (limit, period) = (self.lp.config().staleness.camera, 1.0 / self.lp.config().rate_hz);
+            self.sim.with(|s| {
+                if moving && s.fault().is_some_and(|f| f.inputs_invalid(now, limit, period)) {
+                    s.stale_motion_ticks += 1;
+                }
+            });
             match out.status {
                 LoopStatus::SafeStop { .. } => self.sim.with(|s| s.safe_stops += 1),
                 LoopStatus::Finished { outcome } => return PhaseEnd::Finished(outcome),
@@ -336,7 +343,10 @@ pub fn run_one(
         length,
         width,
     );
-    rig.sim.with(|sim| sim.place(start, false));
+    rig.sim.with(|sim| {
+        sim.place(start, false);
+        sim.set_fault(spec.fault.and_then(|i| sc.faults.get(i)).cloned());
+    });
     let dock_hint = sc.ballistic.enabled.then(|| {
         // Odometry restarts at the placed pose: the dock's origin seen from there, with
         // the a-priori error (its own stream, so the other draws stay as they were).
@@ -355,6 +365,12 @@ pub fn run_one(
     let end = rig.run("docking", sc.timeout_s, rec, &mut mcap);
     let manoeuvres = rig.lp.root().stats().manoeuvres;
     let mut record = rig.sim.with(|sim| record(spec, sim, end, imprinted, manoeuvres));
+    if let Some(f) = spec.fault.and_then(|i| sc.faults.get(i)) {
+        record.fault = Some(f.name.clone());
+        record.fault_as_expected = Some(f.expect.accepts(&record.outcome));
+        record.stale_motion_ticks = Some(rig.sim.with(|s| s.stale_motion_ticks));
+        record.safe_stop_s = Some(record.safe_stops as f64 / profile.loop_.rate_hz);
+    }
     record.lighting_draw = draw;
     if let Some(mut m) = mcap {
         let t = record.time_s;
@@ -421,6 +437,10 @@ fn record(spec: &RunSpec, sim: &Sim, end: PhaseEnd, imprinted: Option<bool>, man
         imprinted,
         manoeuvres,
         lighting_draw: None,
+        fault: None,
+        fault_as_expected: None,
+        stale_motion_ticks: None,
+        safe_stop_s: None,
         track: sim
             .track
             .iter()

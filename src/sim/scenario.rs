@@ -380,6 +380,10 @@ pub struct Scenario {
     /// A published table to print beside the results.
     #[serde(default)]
     pub compare: Option<super::paper::PaperTable>,
+    /// Faults injected into the docking runs, one per run: an axis ([`super::faults`]).
+    /// Empty: no faults, and the campaign is what it was without the table.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub faults: Vec<super::faults::FaultSpec>,
 }
 
 fn one() -> u32 {
@@ -461,6 +465,7 @@ impl Validate for Scenario {
         ] {
             v.require(n >= 1, field, || "expected at least one value".into());
         }
+        super::faults::validate_all(&self.faults, v);
         if let Some(pairs) = &self.axes.fiducial_colors {
             v.require(!pairs.is_empty(), "axes.fiducial_colors", || {
                 "expected at least one [left, right] pair of colours (leave the axis out to keep the profile's paints)"
@@ -585,6 +590,8 @@ pub struct RunSpec {
     /// The flap's paints `[left, right]` on a `fiducial_colors` axis (`None`: the
     /// profile's).
     pub fiducial_colors: Option<[NamedColor; 2]>,
+    /// The injected fault: an index into the scenario's `faults` (`None`: no fault).
+    pub fault: Option<usize>,
     /// Trial number.
     pub trial: u32,
     /// This run's seed.
@@ -848,23 +855,28 @@ impl Scenario {
                 for (li, lighting) in self.axes.lighting.iter().enumerate() {
                     for seg in &self.axes.segmentation {
                         for (ti, terrain) in self.axes.terrain.iter().enumerate() {
-                            for trial in 0..self.trials {
-                                let index = out.len();
-                                let key =
-                                    ((si as u64) << 40) ^ ((li as u64) << 32) ^ ((ti as u64) << 24) ^ trial as u64;
-                                out.push(RunSpec {
-                                    index,
-                                    start: start.clone(),
-                                    lighting: lighting.clone(),
-                                    segmentation: *seg,
-                                    terrain: *terrain,
-                                    fiducial_colors: *fiducial_colors,
-                                    trial,
-                                    seed: super::rng::splitmix64(self.seed ^ super::rng::splitmix64(index as u64 + 1)),
-                                    pair_seed: super::rng::splitmix64(
-                                        self.seed ^ super::rng::splitmix64(key ^ 0xA11CE),
-                                    ),
-                                });
+                            for fault in self.fault_values() {
+                                for trial in 0..self.trials {
+                                    let index = out.len();
+                                    let key =
+                                        ((si as u64) << 40) ^ ((li as u64) << 32) ^ ((ti as u64) << 24) ^ trial as u64;
+                                    out.push(RunSpec {
+                                        index,
+                                        start: start.clone(),
+                                        lighting: lighting.clone(),
+                                        segmentation: *seg,
+                                        terrain: *terrain,
+                                        fiducial_colors: *fiducial_colors,
+                                        fault,
+                                        trial,
+                                        seed: super::rng::splitmix64(
+                                            self.seed ^ super::rng::splitmix64(index as u64 + 1),
+                                        ),
+                                        pair_seed: super::rng::splitmix64(
+                                            self.seed ^ super::rng::splitmix64(key ^ 0xA11CE),
+                                        ),
+                                    });
+                                }
                             }
                         }
                     }
@@ -872,5 +884,14 @@ impl Scenario {
             }
         }
         out
+    }
+
+    /// The values of the faults axis: each `[[faults]]` index, or one "no fault".
+    fn fault_values(&self) -> Vec<Option<usize>> {
+        if self.faults.is_empty() {
+            vec![None]
+        } else {
+            (0..self.faults.len()).map(Some).collect()
+        }
     }
 }
