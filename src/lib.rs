@@ -50,6 +50,8 @@ pub mod image_io;
 pub mod kinematics;
 pub mod perception;
 pub mod profile;
+#[cfg(feature = "sim")]
+pub mod replay;
 pub mod robot;
 pub mod schemas;
 #[cfg(feature = "sim")]
