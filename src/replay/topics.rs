@@ -90,11 +90,11 @@ pub enum TopicError {
         available: Vec<TopicInfo>,
     },
     /// The topic exists but is not of the kind asked for, or in an encoding not read.
-    #[error("topic `{topic}` cannot be read as {wanted}: {why}")]
+    #[error("topic `{topic}` cannot be read as an {wanted} topic: {why}")]
     WrongKind {
         /// The topic.
         topic: String,
-        /// `camera frames` or `odometry`.
+        /// `image` or `odometry`.
         wanted: &'static str,
         /// Why.
         why: String,
@@ -102,7 +102,7 @@ pub enum TopicError {
     /// No topic of the kind, and none named.
     #[error("no {wanted} topic in the log; its topics: {}", list(available))]
     None {
-        /// `camera frames` or `odometry`.
+        /// `image` or `odometry`.
         wanted: &'static str,
         /// The log's topics.
         available: Vec<TopicInfo>,
@@ -110,7 +110,7 @@ pub enum TopicError {
     /// Several topics of the kind, and none named.
     #[error("several {wanted} topics, choose one with {flag}: {}", list(candidates))]
     Ambiguous {
-        /// `camera frames` or `odometry`.
+        /// `image` or `odometry`.
         wanted: &'static str,
         /// The option that chooses.
         flag: &'static str,
@@ -143,7 +143,7 @@ pub fn choose(
     let (wanted, flag) = if odometry {
         ("odometry", "--odom-topic")
     } else {
-        ("camera frames", "--image-topic")
+        ("image", "--image-topic")
     };
     let fits = |k: TopicKind| if odometry { k.is_odometry() } else { k.is_image() };
     let available = || topics.values().cloned().collect::<Vec<_>>();
