@@ -819,3 +819,69 @@ fn a_frame_of_another_size_stops_the_behavior() {
         "{e:?}"
     );
 }
+
+/// A rosbag2-style log of three 32×24 frames in zstd-compressed chunks
+/// (`tests/fixtures/replay/zstd.mcap`; rewritten by the `compressed-logs` build when
+/// `MARSUPIAL_WRITE_FIXTURES=1`).
+fn zstd_fixture() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/replay/zstd.mcap")
+}
+
+#[cfg(feature = "compressed-logs")]
+fn compressed_bag(path: &Path, compression: mcap::Compression) {
+    let mut w = mcap::WriteOptions::new()
+        .profile("ros2")
+        .compression(Some(compression))
+        .create(std::io::BufWriter::new(std::fs::File::create(path).unwrap()))
+        .unwrap();
+    let s = w
+        .add_schema("sensor_msgs/msg/Image", "ros2msg", image_schema().as_bytes())
+        .unwrap();
+    let c = w.add_channel(s, "/cam", "cdr", &BTreeMap::new()).unwrap();
+    for k in 0..3u64 {
+        let h = mcap::records::MessageHeader {
+            channel_id: c,
+            sequence: k as u32,
+            log_time: T0 + k * DT,
+            publish_time: T0 + k * DT,
+        };
+        w.write_to_known_channel(&h, &good(k)).unwrap();
+    }
+    w.finish().unwrap();
+}
+
+#[cfg(feature = "compressed-logs")]
+#[test]
+fn zstd_and_lz4_chunks_are_read_with_the_feature() {
+    if std::env::var_os("MARSUPIAL_WRITE_FIXTURES").is_some() {
+        std::fs::create_dir_all(zstd_fixture().parent().unwrap()).unwrap();
+        compressed_bag(&zstd_fixture(), mcap::Compression::Zstd);
+    }
+    let d = tmp("compressed");
+    let lz4 = d.join("lz4.mcap");
+    compressed_bag(&lz4, mcap::Compression::Lz4);
+    for bag in [zstd_fixture(), lz4] {
+        let bytes = std::fs::read(&bag).unwrap();
+        let raw: usize = (0..3).map(|k| good(k).len()).sum();
+        assert!(bytes.len() < raw, "{}: the chunks are compressed", bag.display());
+        let (lines, r) = replay(&opts(&bag));
+        r.unwrap();
+        let idx: Vec<u64> = of_kind(&lines, "frame")
+            .iter()
+            .map(|l| l["index"].as_u64().unwrap())
+            .collect();
+        assert_eq!(idx, [0, 1, 2], "{}", bag.display());
+    }
+}
+
+#[cfg(not(feature = "compressed-logs"))]
+#[test]
+fn compressed_chunks_without_the_feature_say_how_to_read_them() {
+    let (lines, e) = replay_err(&zstd_fixture());
+    assert!(
+        matches!(&e, ReplayError::Log { fault: LogFault::Compression { compression, after: None }, .. } if compression == "zstd"),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("--features compressed-logs"), "{e}");
+    assert_eq!(of_kind(&lines, "summary")[0]["frames"], 0);
+}
