@@ -885,3 +885,33 @@ fn compressed_chunks_without_the_feature_say_how_to_read_them() {
     assert!(e.to_string().contains("--features compressed-logs"), "{e}");
     assert_eq!(of_kind(&lines, "summary")[0]["frames"], 0);
 }
+
+proptest::proptest! {
+    /// The decoders are total: any bytes (here the fixtures with bytes overwritten and
+    /// cut short) give a value or an error, never a panic, and a decoded image converts
+    /// or refuses without one either.
+    #[test]
+    fn decoders_never_panic(
+        edits in proptest::collection::vec((0usize..724, proptest::prelude::any::<u8>()), 0..8),
+        cut in 0usize..800,
+    ) {
+        let mut img = IMAGE_FIXTURE.to_vec();
+        let mut odo = odometry_fixture();
+        for (at, b) in &edits {
+            if let Some(x) = img.get_mut(*at) { *x = *b; }
+            if let Some(x) = odo.get_mut(*at) { *x = *b; }
+        }
+        img.truncate(cut);
+        odo.truncate(cut);
+        if let Ok(m) = cdr::decode_image(&img) {
+            let _ = m.to_rgb();
+        }
+        if let Ok(m) = cdr::decode_compressed_image(&img) {
+            let _ = m.to_rgb();
+        }
+        let _ = cdr::decode_odometry(&odo);
+        let _ = cdr::decode_image(&odo);
+        let _ = marsupial::replay::foxglove::decode_raw_image(&img);
+        let _ = marsupial::replay::foxglove::decode_pose_in_frame(&odo);
+    }
+}
