@@ -618,11 +618,7 @@ fn good(k: u64) -> Vec<u8> {
 }
 
 fn replay_err(path: &Path) -> (Vec<serde_json::Value>, ReplayError) {
-    let (lines, r) = replay(&opts(path));
-    match r {
-        Err(ReplayCliError::Replay(e)) => (lines, e),
-        other => panic!("expected a replay error, got {other:?}"),
-    }
+    replay_err_with(&opts(path))
 }
 
 #[test]
@@ -913,5 +909,72 @@ proptest::proptest! {
         let _ = cdr::decode_image(&odo);
         let _ = marsupial::replay::foxglove::decode_raw_image(&img);
         let _ = marsupial::replay::foxglove::decode_pose_in_frame(&odo);
+    }
+}
+
+#[test]
+fn the_pyramid_schema_replays_raposa_frames_and_needs_its_camera_size() {
+    let Some(dir) = photos() else { return };
+    let d = tmp("raposa");
+    let bag = d.join("raposa.mcap");
+    // 160×120 crops of real fruit (orange among them), as bgr8.
+    let crop = |name: &str, x0: usize, y0: usize| {
+        let im = marsupial::image_io::load_rgb(&dir.join(name)).unwrap();
+        let mut out = RgbImage::new(160, 120);
+        for y in 0..120 {
+            for x in 0..160 {
+                out.put(x, y, im.view().get(x0 + x, y0 + y).unwrap());
+            }
+        }
+        out
+    };
+    let frames = [crop("color/orange.jpg", 40, 40), crop("color/fruits.jpg", 100, 60)];
+    let msgs: Vec<Msg> = frames
+        .iter()
+        .enumerate()
+        .map(|(k, im)| {
+            let ns = T0 + k as u64 * DT;
+            ("/rear/image", ns, image_msg(ns, 160, 120, "bgr8", 480, &bgr(im)))
+        })
+        .collect();
+    write_bag(&bag, &[("/rear/image", "sensor_msgs/msg/Image")], &msgs);
+    let mut o = opts(&bag);
+    o.profile = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml");
+    let (lines, r) = replay(&o);
+    r.unwrap();
+    let mut s = marsupial::schemas::PyramidSchema::from_profile(&common::shipped_profile("raposa"), 0).unwrap();
+    let want: Vec<_> = frames
+        .iter()
+        .enumerate()
+        .map(|(k, im)| {
+            let p = s.process(&im.view(), (k as u64 * DT) as f64 / 1e9).unwrap();
+            serde_json::to_value(ObservedPercept::Pyramid(p)).unwrap()
+        })
+        .collect();
+    let got: Vec<_> = of_kind(&lines, "frame").iter().map(|l| l["percept"].clone()).collect();
+    assert_eq!(got, want);
+    assert!(got[0]["pyramid"].is_object(), "{}", got[0]);
+
+    // The Bujold-sized frames of another bag are not this camera's.
+    small_bag(&bag, vec![good(0)]);
+    let (_, e) = replay_err_with(&o);
+    assert!(
+        matches!(
+            &e,
+            ReplayError::FrameSize {
+                got: (32, 24),
+                expected: (160, 120),
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+}
+
+fn replay_err_with(o: &ReplayOptions) -> (Vec<serde_json::Value>, ReplayError) {
+    let (lines, r) = replay(o);
+    match r {
+        Err(ReplayCliError::Replay(e)) => (lines, e),
+        other => panic!("expected a replay error, got {other:?}"),
     }
 }
