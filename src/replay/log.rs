@@ -28,7 +28,7 @@ pub enum LogFault {
     },
     /// Chunks compressed with a codec this build cannot read.
     #[error(
-        "chunks are compressed with `{compression}`{}, which this build cannot read: rebuild with `--features compressed-logs`, or re-write the log uncompressed (`mcap convert`, `ros2 bag convert`)",
+        "chunks compressed with `{compression}` cannot be read by this build (the first comes{}): rebuild with `--features compressed-logs`, or re-write the log uncompressed (`mcap convert`, `ros2 bag convert`)",
         after_text(after)
     )]
     Compression {
