@@ -12,6 +12,8 @@
 //! * [`kinematics`]: differential, skid-steer (effective track), turn-or-drive and
 //!   double-Ackermann models, command realisation and odometry.
 //! * [`profile`]: one TOML file per platform, validated with precise errors.
+//! * `replay` (feature `sim`): a profile's perception or behavior on real logs (ROS 2 bags
+//!   and Foxglove files in MCAP), for `marsupial replay`.
 //!
 //! ## How the parts fit
 //!
@@ -50,6 +52,8 @@ pub mod image_io;
 pub mod kinematics;
 pub mod perception;
 pub mod profile;
+#[cfg(feature = "sim")]
+pub mod replay;
 pub mod robot;
 pub mod schemas;
 #[cfg(feature = "sim")]

@@ -82,6 +82,15 @@ enum Command {
     /// right_px, total_px, ratio, left_centroid, right_centroid, offset_px, mode
     /// (adapted / imprinted / table) and us_per_frame (median over --repeat runs).
     Detect(marsupial::cli::detect::DetectOptions),
+    /// Run a profile's perception, or its whole behavior open-loop, on a real log.
+    ///
+    /// Reads ROS 2 bags in MCAP (CDR `sensor_msgs/msg/Image`, `sensor_msgs/msg/CompressedImage`,
+    /// `nav_msgs/msg/Odometry`) and Foxglove-schema MCAP files (JSON `foxglove.RawImage`,
+    /// `foxglove.CompressedImage`, `foxglove.PoseInFrame`, as `dock --record` writes them).
+    /// Prints one line per frame (the percept, and with --behavior the command the robot
+    /// would have sent), one per message that could not be used (bad CDR, Bayer or 16-bit
+    /// encodings…), and a summary with the skipped counts by topic and reason.
+    Replay(marsupial::cli::replay::ReplayOptions),
     /// Print the phase timeline of a run from its decision trace (`dock --trace`).
     ///
     /// One line per sequencer transition: mission, time, sequencer, from → to and the
@@ -137,6 +146,7 @@ fn main() -> ExitCode {
         }
         Command::Merge(opts) => exit_code(marsupial::cli::merge::run(&opts, &mut std::io::stdout())),
         Command::Detect(opts) => exit_code(marsupial::cli::detect::run(&opts, &mut std::io::stdout())),
+        Command::Replay(opts) => exit_code(marsupial::cli::replay::run(&opts, &mut std::io::stdout())),
         Command::Timeline { trace } => exit_code(marsupial::cli::timeline::run(&trace, &mut std::io::stdout())),
     }
 }

@@ -6,5 +6,6 @@ pub mod calibrate_steering;
 pub mod check;
 pub mod detect;
 pub mod merge;
+pub mod replay;
 pub mod sim_cmds;
 pub mod timeline;

@@ -363,11 +363,39 @@ impl McapRecorder {
                 }
             }
         }
-        for (i, frame) in s.frames.iter().enumerate().take(self.ch.cameras.len()) {
+        self.perception(s.t, s.frames, s.observation.as_ref());
+        self.command(s.t, s.command);
+        self.put_json(self.ch.trace, ns, s.trace);
+        self.odometry(s.t, &s.odometry);
+        self.put_json(
+            self.ch.ground_truth,
+            ns,
+            &PoseInFrame {
+                timestamp: stamp,
+                frame_id: "dock",
+                pose: (&s.truth).into(),
+            },
+        );
+        self.put_json(
+            self.ch.tf,
+            ns,
+            &FrameTransform::planar(stamp, "dock", "base_link", &s.truth),
+        );
+    }
+
+    /// Records the frames of mission time `t` (one per camera, in the order given at
+    /// [`McapRecorder::create`]) and what perception made of them: the annotations, the
+    /// percept and the colour ranges. Part of [`McapRecorder::tick`]; on its own for
+    /// callers without a simulated world (`marsupial replay --record`).
+    pub fn perception(&mut self, t: f64, frames: &[RgbImage], observation: Option<&Observation>) {
+        let ns = self.ns(t);
+        let stamp = Time::from_ns(ns);
+        self.started = true;
+        for (i, frame) in frames.iter().enumerate().take(self.ch.cameras.len()) {
             self.image(i, ns, frame);
             self.calibration(i, ns);
         }
-        if let Some(obs) = &s.observation {
+        if let Some(obs) = observation {
             if let Some(cam) = self.ch.cameras.get(obs.camera) {
                 let id = cam.annotations;
                 self.put_json(id, ns, &annotations::annotate(stamp, obs));
@@ -389,6 +417,11 @@ impl McapRecorder {
                 self.put_json(self.ch.colour_ranges, ns, r);
             }
         }
+    }
+
+    /// Records the command of mission time `t`, with its twist. Part of
+    /// [`McapRecorder::tick`].
+    pub fn command(&mut self, t: f64, command: &MotorOutput) {
         #[derive(Serialize)]
         struct CommandMsg<'a> {
             mission: &'static str,
@@ -397,41 +430,35 @@ impl McapRecorder {
             omega: f64,
             command: &'a MotorOutput,
         }
-        let twist = s.command.drive.to_twist();
+        let ns = self.ns(t);
+        self.started = true;
+        let twist = command.drive.to_twist();
         self.put_json(
             self.ch.command,
             ns,
             &CommandMsg {
                 mission: self.mission,
-                t: s.t,
+                t,
                 v: twist.v,
                 omega: twist.omega,
-                command: s.command,
+                command,
             },
         );
-        self.put_json(self.ch.trace, ns, s.trace);
+    }
+
+    /// Records the odometry pose of mission time `t` (frame `odom`). Part of
+    /// [`McapRecorder::tick`].
+    pub fn odometry(&mut self, t: f64, pose: &Pose2) {
+        let ns = self.ns(t);
+        self.started = true;
         self.put_json(
             self.ch.odometry,
             ns,
             &PoseInFrame {
-                timestamp: stamp,
+                timestamp: Time::from_ns(ns),
                 frame_id: "odom",
-                pose: (&s.odometry).into(),
+                pose: pose.into(),
             },
-        );
-        self.put_json(
-            self.ch.ground_truth,
-            ns,
-            &PoseInFrame {
-                timestamp: stamp,
-                frame_id: "dock",
-                pose: (&s.truth).into(),
-            },
-        );
-        self.put_json(
-            self.ch.tf,
-            ns,
-            &FrameTransform::planar(stamp, "dock", "base_link", &s.truth),
         );
     }
 

@@ -1,0 +1,235 @@
+//! Reading an MCAP log: its topics, then its messages in file order, each numbered within
+//! its topic so errors can name it (`/camera/image_raw` message #12).
+//!
+//! The file is read into memory whole (the `mcap` crate's reader works on a byte slice).
+//! A file that ends early (a robot that lost power while recording) gives every message
+//! before the cut, then [`ReplayError::Log`] with [`LogFault::Truncated`].
+
+use super::ReplayError;
+use super::topics::{TopicInfo, Topics};
+use std::borrow::Cow;
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// What is wrong with the file itself (not with one message in it).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum LogFault {
+    /// Not an MCAP file (no magic at the start).
+    #[error("not an MCAP file ({why})")]
+    NotMcap {
+        /// The reader's message.
+        why: String,
+    },
+    /// The file ends inside a record.
+    #[error("the file is truncated: it ends inside a record{}", after_text(after))]
+    Truncated {
+        /// The last message read before the cut (topic, index), if any.
+        after: Option<(String, u64)>,
+    },
+    /// Chunks compressed with a codec this build cannot read.
+    #[error(
+        "chunks compressed with `{compression}` cannot be read by this build (the first comes{}): rebuild with `--features compressed-logs`, or re-write the log uncompressed (`mcap convert`, `ros2 bag convert`)",
+        after_text(after)
+    )]
+    Compression {
+        /// The chunk compression.
+        compression: String,
+        /// The last message read before it, if any.
+        after: Option<(String, u64)>,
+    },
+    /// Any other malformed record.
+    #[error("malformed record{}: {why}", after_text(after))]
+    Corrupt {
+        /// The reader's message.
+        why: String,
+        /// The last message read before it, if any.
+        after: Option<(String, u64)>,
+    },
+}
+
+fn after_text(after: &Option<(String, u64)>) -> String {
+    match after {
+        Some((t, i)) => format!(" after message #{i} of `{t}`"),
+        None => " before the first message".into(),
+    }
+}
+
+fn fault(e: mcap::McapError, after: Option<(String, u64)>) -> LogFault {
+    match e {
+        mcap::McapError::UnexpectedEof | mcap::McapError::BadFooter => LogFault::Truncated { after },
+        mcap::McapError::UnsupportedCompression(compression) => LogFault::Compression { compression, after },
+        mcap::McapError::BadMagic if after.is_none() => LogFault::NotMcap { why: e.to_string() },
+        e => LogFault::Corrupt {
+            why: e.to_string(),
+            after,
+        },
+    }
+}
+
+/// One message of a topic being read.
+#[derive(Debug)]
+pub struct LogMessage<'a> {
+    /// Its topic.
+    pub topic: &'a str,
+    /// Its index within the topic, from 0.
+    pub index: u64,
+    /// Log time, ns.
+    pub log_time: u64,
+    /// The serialised message.
+    pub data: Cow<'a, [u8]>,
+}
+
+/// An MCAP log in memory, with its topics.
+pub struct Log {
+    path: PathBuf,
+    bytes: Vec<u8>,
+    topics: Topics,
+}
+
+impl Log {
+    /// Reads `path` and lists its topics (from the summary, or by reading the file
+    /// through when it has none, as a truncated file has not).
+    ///
+    /// # Errors
+    /// [`ReplayError::Io`], or [`ReplayError::Log`] when the file is not MCAP.
+    pub fn open(path: &Path) -> Result<Self, ReplayError> {
+        let bytes = std::fs::read(path).map_err(|source| ReplayError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_bytes(path, bytes)
+    }
+
+    /// As [`Log::open`], for bytes already in memory (`path` names them in errors).
+    ///
+    /// # Errors
+    /// [`ReplayError::Log`] when the bytes are not MCAP.
+    pub fn from_bytes(path: &Path, bytes: Vec<u8>) -> Result<Self, ReplayError> {
+        let log_err = |fault| ReplayError::Log {
+            path: path.to_path_buf(),
+            fault,
+        };
+        if !bytes.starts_with(mcap::MAGIC) {
+            return Err(log_err(LogFault::NotMcap {
+                why: "no MCAP magic at the start".into(),
+            }));
+        }
+        let mut topics = Topics::new();
+        let mut add = |c: &mcap::Channel<'_>| {
+            topics.entry(c.topic.clone()).or_insert_with(|| TopicInfo {
+                topic: c.topic.clone(),
+                schema: c.schema.as_ref().map(|s| s.name.clone()).unwrap_or_default(),
+                encoding: c.message_encoding.clone(),
+            });
+        };
+        match mcap::Summary::read(&bytes) {
+            Ok(Some(s)) if !s.channels.is_empty() => {
+                let sorted: BTreeMap<_, _> = s.channels.iter().collect();
+                sorted.values().for_each(|c| add(c));
+            }
+            _ => {
+                // No summary: walk the messages (stopping quietly at a fault, which the
+                // replay itself reports with its position).
+                if let Ok(stream) = mcap::MessageStream::new(&bytes) {
+                    for m in stream.map_while(Result::ok) {
+                        add(&m.channel);
+                    }
+                }
+            }
+        }
+        Ok(Self {
+            path: path.to_path_buf(),
+            bytes,
+            topics,
+        })
+    }
+
+    /// The log's file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The log's topics.
+    pub fn topics(&self) -> &Topics {
+        &self.topics
+    }
+
+    /// The messages of `wanted` topics in file order; a fault in the file ends the
+    /// iteration with one [`ReplayError::Log`].
+    pub fn messages<'a>(&'a self, wanted: &[&str]) -> Messages<'a> {
+        Messages {
+            log: self,
+            stream: mcap::MessageStream::new(&self.bytes).map_err(|e| fault(e, None)),
+            wanted: wanted.iter().map(|s| s.to_string()).collect(),
+            counts: BTreeMap::new(),
+            last: None,
+            done: false,
+        }
+    }
+}
+
+/// Iterator of [`Log::messages`].
+pub struct Messages<'a> {
+    log: &'a Log,
+    stream: Result<mcap::MessageStream<'a>, LogFault>,
+    wanted: BTreeSet<String>,
+    counts: BTreeMap<String, u64>,
+    last: Option<(String, u64)>,
+    done: bool,
+}
+
+impl<'a> Iterator for Messages<'a> {
+    type Item = Result<LogMessage<'a>, ReplayError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.done {
+            return None;
+        }
+        let err = |fault| {
+            Some(Err(ReplayError::Log {
+                path: self.log.path.clone(),
+                fault,
+            }))
+        };
+        let stream = match &mut self.stream {
+            Ok(s) => s,
+            Err(f) => {
+                self.done = true;
+                return err(f.clone());
+            }
+        };
+        loop {
+            match stream.next() {
+                None => {
+                    self.done = true;
+                    return None;
+                }
+                Some(Err(e)) => {
+                    self.done = true;
+                    return err(fault(e, self.last.take()));
+                }
+                Some(Ok(m)) => {
+                    let Some(topic) = self.wanted.get(m.channel.topic.as_str()) else {
+                        continue;
+                    };
+                    let n = self.counts.entry(topic.clone()).or_insert(0);
+                    let index = *n;
+                    *n += 1;
+                    self.last = Some((topic.clone(), index));
+                    let topic: &'a str = self
+                        .log
+                        .topics
+                        .get_key_value(topic.as_str())
+                        .map(|(k, _)| k.as_str())
+                        .unwrap_or("");
+                    return Some(Ok(LogMessage {
+                        topic,
+                        index,
+                        log_time: m.log_time,
+                        data: m.data,
+                    }));
+                }
+            }
+        }
+    }
+}

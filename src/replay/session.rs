@@ -1,0 +1,157 @@
+//! Running a profile on logged frames: its perceptual schema alone, or its whole behavior
+//! open-loop (the commands are computed, never applied: the log's camera moved as it did).
+
+use super::ReplayError;
+use crate::arbiter::{LoopStatus, ReactiveLoop};
+use crate::behaviors::agent_for;
+use crate::perception::{RgbImage, VisionError};
+use crate::profile::Profile;
+use crate::schemas::{
+    Agent, CameraInput, ColourRanges, Inputs, Mission, MotorOutput, ObservedPercept, OdometryReading, PyramidSchema,
+    Stamped, TwoBlockSchema,
+};
+
+/// The profile's perceptual schema, by fiducial.
+enum Perception {
+    TwoBlock(Box<TwoBlockSchema>),
+    Pyramid(Box<PyramidSchema>),
+}
+
+/// What runs on each frame.
+enum Runner {
+    Perception(Perception),
+    Behavior(Box<ReactiveLoop<dyn Agent>>),
+}
+
+/// What one frame gave.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameOutput {
+    /// The percept (`None` only when a behavior exposes none).
+    pub percept: Option<ObservedPercept>,
+    /// The colour ranges that will segment the next frame, when the schema has them.
+    pub ranges: Option<ColourRanges>,
+    /// With the behavior: the command it would have sent and the loop's status.
+    pub command: Option<(MotorOutput, LoopStatus)>,
+}
+
+/// A profile replaying frames of its first camera.
+pub struct Session {
+    runner: Runner,
+    /// The profile camera's size, which the behavior's geometry assumes.
+    camera_size: (usize, usize),
+}
+
+impl Session {
+    /// Builds the profile's perceptual schema for its camera 0 (two-block or pyramid), or
+    /// with `behavior` its whole agent, started on a docking mission. `odometry` says
+    /// whether the log has odometry; without it the loop does not wait for any, and
+    /// inputs the log cannot have (tether, dock switch, other sensors) are never awaited.
+    ///
+    /// # Errors
+    /// [`ReplayError::Setup`] when the profile has no perception a replay runs, or no
+    /// behavior.
+    pub fn new(profile: &Profile, behavior: bool, odometry: bool) -> Result<Self, ReplayError> {
+        let cam = profile
+            .cameras
+            .first()
+            .ok_or_else(|| setup("the profile has no [[cameras]]"))?;
+        let camera_size = (cam.width_px, cam.height_px);
+        let runner = if behavior {
+            let agent = agent_for(profile).map_err(|e| setup(&e.to_string()))?;
+            let mut config = profile.loop_config();
+            config.staleness.tether = None;
+            config.staleness.dock_switch = None;
+            config.staleness.sensors.iter_mut().for_each(|s| *s = None);
+            if !odometry {
+                config.staleness.odometry = None;
+            }
+            let mut lp: ReactiveLoop<dyn Agent> = ReactiveLoop::new(agent, config);
+            lp.begin(&Mission::docking()).map_err(|e| setup(&e.to_string()))?;
+            Runner::Behavior(Box::new(lp))
+        } else if profile.fiducial.two_block.is_some() {
+            Runner::Perception(Perception::TwoBlock(Box::new(
+                TwoBlockSchema::from_profile(profile, 0).map_err(vision)?,
+            )))
+        } else if profile.fiducial.pyramid.is_some() {
+            Runner::Perception(Perception::Pyramid(Box::new(
+                PyramidSchema::from_profile(profile, 0).map_err(vision)?,
+            )))
+        } else {
+            return Err(setup(
+                "replay runs the two-block or pyramid perceptual schema; the profile has neither [fiducial.two_block] nor [fiducial.pyramid] (use --behavior to run its agent)",
+            ));
+        };
+        Ok(Self { runner, camera_size })
+    }
+
+    /// Whether a frame of `size` can be run: any size for the two-block schema alone
+    /// (it has no geometry; its buffers follow the frame, as `marsupial detect`'s do),
+    /// the profile camera's size otherwise (the pyramid's distances and the behavior's
+    /// steering are in that camera's pixels).
+    pub fn accepts(&self, size: (usize, usize)) -> bool {
+        matches!(self.runner, Runner::Perception(Perception::TwoBlock(_))) || size == self.camera_size
+    }
+
+    /// The profile camera's size.
+    pub fn camera_size(&self) -> (usize, usize) {
+        self.camera_size
+    }
+
+    /// Runs one frame taken at `t` (s on the replay's clock) with the latest odometry.
+    ///
+    /// # Errors
+    /// [`ReplayError::Setup`] when the schema refuses the frame (its size; see
+    /// [`Session::accepts`]).
+    pub fn frame(
+        &mut self,
+        t: f64,
+        image: &RgbImage,
+        odometry: Option<Stamped<OdometryReading>>,
+    ) -> Result<FrameOutput, ReplayError> {
+        match &mut self.runner {
+            Runner::Perception(Perception::TwoBlock(s)) => {
+                s.detector_mut().resize(image.width(), image.height());
+                let p = s.process(&image.view(), t).map_err(vision)?;
+                Ok(FrameOutput {
+                    percept: Some(ObservedPercept::TwoBlock(p)),
+                    ranges: Some(ColourRanges::Sct(s.model().ranges())),
+                    command: None,
+                })
+            }
+            Runner::Perception(Perception::Pyramid(s)) => {
+                let p = s.process(&image.view(), t).map_err(vision)?;
+                Ok(FrameOutput {
+                    percept: Some(ObservedPercept::Pyramid(p)),
+                    ranges: Some(ColourRanges::Hsv(s.bands())),
+                    command: None,
+                })
+            }
+            Runner::Behavior(lp) => {
+                let cameras = [Some(CameraInput {
+                    stamp: t,
+                    image: image.view(),
+                })];
+                let inputs = Inputs {
+                    odometry,
+                    cameras: &cameras,
+                    ..Inputs::empty(t)
+                };
+                let out = lp.tick(&inputs);
+                let obs = lp.root().observe();
+                Ok(FrameOutput {
+                    percept: obs.map(|o| o.percept),
+                    ranges: obs.and_then(|o| o.ranges),
+                    command: Some((out.command, out.status)),
+                })
+            }
+        }
+    }
+}
+
+fn setup(why: &str) -> ReplayError {
+    ReplayError::Setup(why.to_string())
+}
+
+fn vision(e: VisionError) -> ReplayError {
+    ReplayError::Setup(e.to_string())
+}
