@@ -35,6 +35,23 @@ pub enum ImageFileError {
         /// Height.
         height: u32,
     },
+    /// Larger than the decoder accepts (a decompression bomb: a few kilobytes of PNG or
+    /// JPEG can declare gigapixels); nothing was decoded.
+    #[error(
+        "{}: image is too large to decode ({width}×{height} = {} pixels; at most {max_pixels})",
+        file.display(),
+        u64::from(*width) * u64::from(*height)
+    )]
+    TooLarge {
+        /// The file.
+        file: PathBuf,
+        /// Width its header declares.
+        width: u32,
+        /// Height its header declares.
+        height: u32,
+        /// The bound it exceeds, pixels.
+        max_pixels: u64,
+    },
     /// Could not be written.
     #[error("{}: cannot write image: {reason}", file.display())]
     Write {
@@ -45,8 +62,13 @@ pub enum ImageFileError {
     },
 }
 
+/// The most pixels [`load_rgb`] decodes: 8192 × 8192 (64 Mpx, 512 MiB as 16-bit RGBA
+/// while decoding). Larger images are refused with [`ImageFileError::TooLarge`] before any
+/// pixel is decoded; [`decode_rgb`] takes another bound.
+pub const DEFAULT_MAX_PIXELS: u64 = 8192 * 8192;
+
 /// Loads a PNG or JPEG as packed RGB8, converting grey, grey+alpha and RGBA (alpha dropped)
-/// and 16-bit images.
+/// and 16-bit images; at most [`DEFAULT_MAX_PIXELS`] pixels.
 ///
 /// # Errors
 /// [`ImageFileError`] naming the file.
@@ -55,20 +77,46 @@ pub fn load_rgb(path: &Path) -> Result<RgbImage, ImageFileError> {
         file: path.to_path_buf(),
         source,
     })?;
+    decode_rgb(&bytes, path, DEFAULT_MAX_PIXELS)
+}
+
+/// Decodes the bytes of a PNG or JPEG file (`file` is used in messages) as [`load_rgb`]
+/// does, refusing an image whose header declares more than `max_pixels` pixels: the guard
+/// against a decompression bomb. The decoder's own allocations are bounded to match
+/// (8 bytes per pixel, 16-bit RGBA).
+///
+/// # Errors
+/// [`ImageFileError::TooLarge`] over the bound, [`ImageFileError::Decode`] for anything
+/// but a valid PNG or JPEG, [`ImageFileError::Empty`] for zero width or height.
+pub fn decode_rgb(bytes: &[u8], file: &Path, max_pixels: u64) -> Result<RgbImage, ImageFileError> {
     let decode = |reason: String| ImageFileError::Decode {
-        file: path.to_path_buf(),
+        file: file.to_path_buf(),
         reason,
     };
-    let format = image::guess_format(&bytes).map_err(|e| decode(e.to_string()))?;
+    let format = image::guess_format(bytes).map_err(|e| decode(e.to_string()))?;
     if !matches!(format, image::ImageFormat::Png | image::ImageFormat::Jpeg) {
         return Err(decode(format!("format {format:?} is not supported")));
     }
-    let img = image::load_from_memory_with_format(&bytes, format).map_err(|e| decode(e.to_string()))?;
+    let reader = || image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
+    let (width, height) = reader().into_dimensions().map_err(|e| decode(e.to_string()))?;
+    if u64::from(width) * u64::from(height) > max_pixels {
+        return Err(ImageFileError::TooLarge {
+            file: file.to_path_buf(),
+            width,
+            height,
+            max_pixels,
+        });
+    }
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(max_pixels.saturating_mul(8).max(1 << 20));
+    let mut r = reader();
+    r.limits(limits);
+    let img = r.decode().map_err(|e| decode(e.to_string()))?;
     let rgb = img.to_rgb8();
     let (w, h) = rgb.dimensions();
     if w == 0 || h == 0 {
         return Err(ImageFileError::Empty {
-            file: path.to_path_buf(),
+            file: file.to_path_buf(),
             width: w,
             height: h,
         });

@@ -494,6 +494,16 @@ pub fn read_resumable(path: &Path, runs: &[RunSpec]) -> Result<Resumable, SimErr
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
         Err(e) => return Err(io(path)(e)),
     };
+    parse_resumable(&bytes, path, runs)
+}
+
+/// The checks of [`read_resumable`] on the bytes of a `runs.jsonl` already read (`path`
+/// is used in messages only): whole lines that are the campaign's runs in order, then at
+/// most a torn last line.
+///
+/// # Errors
+/// As [`read_resumable`], for a line a kill cannot explain.
+pub fn parse_resumable(bytes: &[u8], path: &Path, runs: &[RunSpec]) -> Result<Resumable, SimError> {
     let bad = |line: usize, what: String| SimError::Io {
         path: path.display().to_string(),
         source: std::io::Error::new(
