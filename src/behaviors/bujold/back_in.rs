@@ -1,12 +1,16 @@
 //! `bujold.back_in`: the final zone (seed 004 §V: "lower and back in by dead
 //! reckoning"). Lowered, blind, by odometry: the entrance is about the decided camera
 //! distance less the camera-to-rear arm away, then the pouch, then `margin_m` before the
-//! miss is declared (event `missed`). The dock switch, not this schema, ends it docked.
+//! miss is declared (event `missed`). Blind, it still watches odometry's yaw: a straight
+//! back-in that turns by more than `max_yaw_drift_deg` (a track slipping or stalled) would
+//! reach the entrance askew and catch its edge, so it stops with the event `veered`
+//! (Bujold's profile retries from there: move away, approach again). The dock switch, not
+//! this schema, ends it docked.
 
 use super::memory::{Memory, lowered};
 use super::params::BackInParams;
 use crate::arbiter::Blackboard;
-use crate::geometry::Pose2;
+use crate::geometry::{Pose2, wrap_angle};
 use crate::schemas::{Behavior, DeadReckoning, FailureReason, Inputs, MotorOutput, Step};
 
 /// See the module docs.
@@ -44,6 +48,10 @@ impl Behavior for BackIn {
         let mem = self.mem.clone();
         let mut m = mem.lock();
         let p = self.params;
+        if wrap_angle(m.odo.theta - self.mark.theta).abs() > p.max_yaw_drift_deg.to_radians() {
+            m.failing = Some(FailureReason::FailedToControl);
+            return Some(Step::event("veered", MotorOutput::stop(), m.feedback("back_in")));
+        }
         let est = m.samples_distance.max(p.min_distance_m);
         let dr = DeadReckoning {
             speed: m.geometry.drive_dir * p.speed_mps,

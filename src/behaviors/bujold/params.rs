@@ -167,6 +167,11 @@ pub struct BackInParams {
     pub margin_m: f64,
     /// Smallest camera distance trusted from the decision, m.
     pub min_distance_m: f64,
+    /// Heading change by odometry since the back-in began beyond which the robot is
+    /// veering (a track slipping or stalled) and will miss the entrance, degrees: the
+    /// back-in stops with the event `veered`. Default the dock's ±5° heading tolerance
+    /// (seed 004); a straight back-in changes odometry's yaw by a fraction of a degree.
+    pub max_yaw_drift_deg: f64,
 }
 
 impl Default for BackInParams {
@@ -175,6 +180,7 @@ impl Default for BackInParams {
             speed_mps: 0.04,
             margin_m: 0.15,
             min_distance_m: 0.1,
+            max_yaw_drift_deg: 5.0,
         }
     }
 }
