@@ -115,3 +115,21 @@ fn a_header_too_short_to_declare_a_size_is_a_decode_error() {
         );
     }
 }
+
+#[test]
+fn a_compressed_frame_in_a_replayed_log_is_held_to_the_same_bound() {
+    use marsupial::replay::pixels::{PixelError, rgb_from_compressed};
+    // Within the side limit (16384) but over the pixel bound: refused from the header,
+    // before the decoder allocates; as are sides over 16384.
+    for (w, h) in [(8193, 8192), (16384, 16384), (20000, 1)] {
+        match rgb_from_compressed("png", &png_declaring(w, h)) {
+            Err(PixelError::Size { width, height }) => assert_eq!((width, height), (w, h)),
+            other => panic!("{w}×{h}: {other:?}"),
+        }
+    }
+    // At the bound the header passes and the empty pixel stream fails to decode.
+    assert!(matches!(
+        rgb_from_compressed("png", &png_declaring(8192, 8192)),
+        Err(PixelError::Decode { .. })
+    ));
+}

@@ -20,8 +20,11 @@ pub enum PixelError {
         /// What kind of data it is.
         why: &'static str,
     },
-    /// Width or height 0, or larger than 16384.
-    #[error("image size {width}×{height} is empty or larger than 16384")]
+    /// Width or height 0, a side larger than 16384, or (compressed) more pixels than
+    /// [`crate::image_io::DEFAULT_MAX_PIXELS`] (the decompression-bomb guard).
+    #[error(
+        "image size {width}×{height} is empty or too large (sides up to 16384; compressed frames up to 8192×8192 pixels)"
+    )]
     Size {
         /// Columns.
         width: u32,
@@ -159,7 +162,20 @@ pub fn rgb_from_compressed(format: &str, data: &[u8]) -> Result<RgbImage, PixelE
     if !matches!(kind, image::ImageFormat::Png | image::ImageFormat::Jpeg) {
         return Err(unsupported("a codec other than JPEG or PNG"));
     }
-    let img = image::load_from_memory_with_format(data, kind).map_err(|e| decode(e.to_string()))?;
+    // The header's size first, so a small message declaring a huge image (a
+    // decompression bomb) is refused before anything is allocated; the decoder's own
+    // allocations are bounded to match (16-bit RGBA, 8 bytes a pixel).
+    let reader = || image::ImageReader::with_format(std::io::Cursor::new(data), kind);
+    let (w, h) = reader().into_dimensions().map_err(|e| decode(e.to_string()))?;
+    let pixels = u64::from(w) * u64::from(h);
+    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE || pixels > crate::image_io::DEFAULT_MAX_PIXELS {
+        return Err(PixelError::Size { width: w, height: h });
+    }
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(pixels.saturating_mul(8).max(1 << 20));
+    let mut r = reader();
+    r.limits(limits);
+    let img = r.decode().map_err(|e| decode(e.to_string()))?;
     use image::ColorType as C;
     if matches!(
         img.color(),
