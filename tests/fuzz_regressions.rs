@@ -133,3 +133,33 @@ fn a_compressed_frame_in_a_replayed_log_is_held_to_the_same_bound() {
         Err(PixelError::Decode { .. })
     ));
 }
+
+#[test]
+fn a_malformed_log_that_panics_the_mcap_reader_is_a_typed_error() {
+    use marsupial::replay::ReplayError;
+    use marsupial::replay::log::{Log, LogFault};
+    // Found by fuzzing the replay's decoding: the `mcap` reader (0.26) overflows a
+    // subtraction on this 1 KB file; `replay::log` contains it as a corrupt-log error.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fuzz/replay-mcap-sub-overflow.mcap");
+    let bytes = std::fs::read(&path).unwrap();
+    let log = match Log::from_bytes(&path, bytes) {
+        Ok(log) => log,
+        Err(e) => {
+            assert!(matches!(e, ReplayError::Log { .. }), "{e}");
+            return;
+        }
+    };
+    let topics: Vec<String> = log.topics().keys().cloned().collect();
+    let names: Vec<&str> = topics.iter().map(String::as_str).collect();
+    let faults: Vec<ReplayError> = log.messages(&names).filter_map(Result::err).collect();
+    assert!(
+        faults.iter().any(|e| matches!(
+            e,
+            ReplayError::Log {
+                fault: LogFault::Corrupt { .. },
+                ..
+            }
+        )),
+        "{faults:?}"
+    );
+}

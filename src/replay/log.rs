@@ -54,6 +54,24 @@ fn after_text(after: &Option<(String, u64)>) -> String {
     }
 }
 
+/// Runs a call into the `mcap` reader, turning a panic inside it into
+/// [`LogFault::Corrupt`]: the reader (0.26) has arithmetic that overflows on some
+/// malformed records (found by fuzzing, `fuzz/fuzz_targets/replay.rs`), and a malformed
+/// file must give an error naming where it broke, never a panic.
+fn contained<T>(after: &Option<(String, u64)>, f: impl FnOnce() -> T) -> Result<T, LogFault> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).map_err(|payload| {
+        let why = payload
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_owned())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "the MCAP reader failed".into());
+        LogFault::Corrupt {
+            why: format!("the MCAP reader gave up on it ({why})"),
+            after: after.clone(),
+        }
+    })
+}
+
 fn fault(e: mcap::McapError, after: Option<(String, u64)>) -> LogFault {
     match e {
         mcap::McapError::UnexpectedEof | mcap::McapError::BadFooter => LogFault::Truncated { after },
@@ -122,7 +140,7 @@ impl Log {
                 encoding: c.message_encoding.clone(),
             });
         };
-        match mcap::Summary::read(&bytes) {
+        match contained(&None, || mcap::Summary::read(&bytes)).map_err(log_err)? {
             Ok(Some(s)) if !s.channels.is_empty() => {
                 let sorted: BTreeMap<_, _> = s.channels.iter().collect();
                 sorted.values().for_each(|c| add(c));
@@ -130,8 +148,8 @@ impl Log {
             _ => {
                 // No summary: walk the messages (stopping quietly at a fault, which the
                 // replay itself reports with its position).
-                if let Ok(stream) = mcap::MessageStream::new(&bytes) {
-                    for m in stream.map_while(Result::ok) {
+                if let Ok(Ok(mut stream)) = contained(&None, || mcap::MessageStream::new(&bytes)) {
+                    while let Ok(Some(Ok(m))) = contained(&None, || stream.next()) {
                         add(&m.channel);
                     }
                 }
@@ -199,7 +217,14 @@ impl<'a> Iterator for Messages<'a> {
             }
         };
         loop {
-            match stream.next() {
+            let next = match contained(&self.last, || stream.next()) {
+                Ok(next) => next,
+                Err(f) => {
+                    self.done = true;
+                    return err(f);
+                }
+            };
+            match next {
                 None => {
                     self.done = true;
                     return None;
