@@ -87,6 +87,7 @@ fn config(sensor_stale: Option<f64>) -> LoopConfig {
             tether: None,
             dock_switch: None,
             sensors: vec![sensor_stale],
+            camera_repeats_stale: true,
         },
         frame_sizes: vec![(4, 3)],
         drive: DriveModel::Differential(Differential { track: 0.3 }),

@@ -109,6 +109,7 @@ fn the_threaded_runtime_does_not_allocate_per_tick() {
             tether: None,
             dock_switch: None,
             sensors: vec![Some(0.2)],
+            camera_repeats_stale: true,
         },
         frame_sizes: vec![(32, 24)],
         drive: DriveModel::Differential(Differential { track: 0.3 }),

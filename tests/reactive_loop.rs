@@ -148,6 +148,7 @@ fn run(seed: u64) -> String {
         tether: None,
         dock_switch: None,
         sensors: Vec::new(),
+        camera_repeats_stale: false,
     });
     let mut log = String::new();
     for (k, f) in fs.iter().enumerate() {
@@ -222,6 +223,7 @@ fn stale_missing_and_bad_inputs_stop_then_resume() {
         tether: None,
         dock_switch: None,
         sensors: Vec::new(),
+        camera_repeats_stale: false,
     });
     assert_eq!(
         one_tick(&mut lp, 0.0, None, None),
@@ -307,6 +309,7 @@ fn required_odometry_must_be_fresh() {
         tether: None,
         dock_switch: None,
         sensors: Vec::new(),
+        camera_repeats_stale: false,
     });
     assert_eq!(
         one_tick(&mut lp, 0.0, Some((&f, 0.0)), None),
@@ -318,6 +321,112 @@ fn required_odometry_must_be_fresh() {
     );
     assert!(matches!(
         one_tick(&mut lp, 0.1, Some((&f, 0.1)), Some(OdometryReading::default())),
+        LoopStatus::Running { .. }
+    ));
+}
+
+#[test]
+fn a_frame_re_sent_as_new_ages_from_its_first_arrival() {
+    let fs = frames(3, 2);
+    let staleness = |repeats| Staleness {
+        camera: Some(0.5),
+        camera_repeats_stale: repeats,
+        ..Staleness::default()
+    };
+    // The driver froze at 0.0: the same frame, stamped fresh every tick.
+    let mut lp = make_loop(staleness(true));
+    let mut statuses = Vec::new();
+    for k in 0..10 {
+        let t = k as f64 * 0.1;
+        statuses.push(one_tick(&mut lp, t, Some((&fs[0], t)), None));
+    }
+    assert!(statuses[..6].iter().all(|s| matches!(s, LoopStatus::Running { .. })));
+    for s in &statuses[6..] {
+        match s {
+            LoopStatus::SafeStop {
+                reason:
+                    StopReason::Frozen {
+                        input: InputKind::Camera(0),
+                        age_s,
+                        limit_s,
+                    },
+            } => assert!(*age_s > 0.5 && *limit_s == 0.5, "{s:?}"),
+            other => panic!("expected a frozen camera, got {other:?}"),
+        }
+    }
+    // A new exposure ends it at once.
+    assert!(matches!(
+        one_tick(&mut lp, 1.0, Some((&fs[1], 1.0)), None),
+        LoopStatus::Running { .. }
+    ));
+    // The same frame handed over again with its own stamp is not a repeat (the threaded
+    // runtime shows the loop the latest frame every tick); it ages by its stamp.
+    assert!(matches!(
+        one_tick(&mut lp, 1.3, Some((&fs[1], 1.0)), None),
+        LoopStatus::Running { .. }
+    ));
+    // With the check off (a noiseless synthetic camera), repeats are fresh frames.
+    let mut lp = make_loop(staleness(false));
+    for k in 0..10 {
+        let t = k as f64 * 0.1;
+        assert!(matches!(
+            one_tick(&mut lp, t, Some((&fs[0], t)), None),
+            LoopStatus::Running { .. }
+        ));
+    }
+}
+
+#[test]
+fn odometry_that_moves_without_moving_is_frozen() {
+    let f = frames(1, 1).remove(0);
+    let mut lp = make_loop(Staleness {
+        odometry: Some(0.2),
+        ..Staleness::default()
+    });
+    let moving = OdometryReading {
+        pose: Pose2::new(1.0, 2.0, 0.3),
+        twist: Twist { v: 0.2, omega: 0.0 },
+    };
+    let still = OdometryReading {
+        twist: Twist::ZERO,
+        ..moving
+    };
+    // A still base reports one pose over and over: that is fine.
+    for k in 0..6 {
+        let t = k as f64 * 0.1;
+        assert!(matches!(
+            one_tick(&mut lp, t, Some((&f, t)), Some(still)),
+            LoopStatus::Running { .. }
+        ));
+    }
+    // One that says it moves but never gets anywhere is a frozen odometer.
+    let mut last = None;
+    for k in 6..12 {
+        let t = k as f64 * 0.1;
+        last = Some(one_tick(&mut lp, t, Some((&f, t)), Some(moving)));
+        if k <= 8 {
+            assert!(matches!(last, Some(LoopStatus::Running { .. })), "{k}: {last:?}");
+        }
+    }
+    assert!(
+        matches!(
+            last,
+            Some(LoopStatus::SafeStop {
+                reason: StopReason::Frozen {
+                    input: InputKind::Odometry,
+                    ..
+                }
+            })
+        ),
+        "{last:?}"
+    );
+    // Progress ends it.
+    let on = OdometryReading {
+        pose: Pose2::new(1.02, 2.0, 0.3),
+        ..moving
+    };
+    assert!(matches!(
+        one_tick(&mut lp, 1.2, Some((&f, 1.2)), Some(on)),
         LoopStatus::Running { .. }
     ));
 }

@@ -77,6 +77,7 @@ fn loop_config() -> LoopConfig {
             tether: None,
             dock_switch: None,
             sensors: Vec::new(),
+            camera_repeats_stale: true,
         },
         frame_sizes: vec![(8, 6)],
         drive: DriveModel::Differential(Differential { track: 0.3 }),

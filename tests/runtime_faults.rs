@@ -156,6 +156,8 @@ fn loop_config(odometry: bool) -> LoopConfig {
             tether: None,
             dock_switch: None,
             sensors: Vec::new(),
+            // The fakes deliver blank frames: repeats are not faults here.
+            camera_repeats_stale: false,
         },
         frame_sizes: vec![(8, 6)],
         drive: DriveModel::Differential(Differential { track: 0.3 }),

@@ -1,7 +1,8 @@
 //! Faults injected into closed-loop docking runs (`[[faults]]`, `sim::faults`): from the
 //! three starts of `scenarios/bujold-faults.toml`, a camera that goes silent, frames that
-//! arrive late, wrong-sized frames, odometry that reads NaN and a latency
-//! spike each end in a dock after the fault passes, with no motion commanded while an
+//! arrive late, wrong-sized frames, a camera driver and an odometer that re-send one
+//! reading as new, odometry that reads NaN, a latency spike and a person standing in the
+//! line of sight each end in a dock after the fault passes, with no motion commanded while an
 //! input was invalid; the per-fault summary counts them. The full campaign (every kind at
 //! two phases) is `marsupial trials scenarios/bujold-faults.toml`.
 
@@ -19,8 +20,11 @@ fn transient_faults_end_in_a_recovered_dock_with_no_motion_on_invalid_input() {
         "camera_silent@3s",
         "odometry_nan@3s",
         "command_latency@3s",
+        "camera_frozen@3s",
+        "odometry_frozen@3s",
         "camera_late@12s",
         "camera_wrong_size@12s",
+        "occluder@12s",
     ];
     loaded.scenario.faults.retain(|f| keep.contains(&f.name.as_str()));
     assert_eq!(loaded.scenario.faults.len(), keep.len());
@@ -38,12 +42,13 @@ fn transient_faults_end_in_a_recovered_dock_with_no_motion_on_invalid_input() {
         );
         assert_eq!(r.stale_motion_ticks, Some(0), "start {} with {fault}", r.start);
         // The faults that leave an input invalid stop the robot for about their length
-        // (a silent camera's last frame stays usable for the 0.5 s staleness limit).
+        // (a silent or frozen camera's last frame, and frozen odometry, stay usable for
+        // the 0.5 s staleness limit).
         let stop = r.safe_stop_s.unwrap();
         match fault {
-            "camera_silent@3s" => assert!((1.3..=1.7).contains(&stop), "{fault}: {stop} s"),
+            "camera_silent@3s" | "camera_frozen@3s" => assert!((1.3..=1.7).contains(&stop), "{fault}: {stop} s"),
             "camera_late@12s" => assert!((2.3..=2.7).contains(&stop), "{fault}: {stop} s"),
-            "camera_wrong_size@12s" | "odometry_nan@3s" => {
+            "camera_wrong_size@12s" | "odometry_nan@3s" | "odometry_frozen@3s" => {
                 assert!((1.8..=2.2).contains(&stop), "{fault}: {stop} s")
             }
             _ => assert!(stop < 0.2, "{fault}: {stop} s"),

@@ -11,6 +11,7 @@ pub mod decision;
 pub mod lockstep;
 pub mod priority;
 pub mod reactive_loop;
+mod repeats;
 pub mod runtime;
 pub mod sequencer;
 pub mod trace;

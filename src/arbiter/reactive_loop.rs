@@ -6,6 +6,7 @@
 //! missing, stale, the wrong size or not finite, the loop commands a safe stop, reports
 //! why in [`LoopStatus::SafeStop`], and resumes on the first tick whose inputs are good.
 
+use super::repeats::Repeats;
 use crate::kinematics::{DriveLimits, DriveModel};
 use crate::robot::DeviceId;
 use crate::schemas::{
@@ -64,6 +65,17 @@ pub enum StopReason {
         /// The limit, s.
         limit_s: f64,
     },
+    /// A driver keeps re-sending one reading as new (the same frame, or odometry that
+    /// reports motion with an unchanged pose) for longer than the input's staleness limit
+    /// ([`Staleness::camera_repeats_stale`]).
+    Frozen {
+        /// The input.
+        input: InputKind,
+        /// How long the reading has been re-sent (since it first arrived), s.
+        age_s: f64,
+        /// The limit, s.
+        limit_s: f64,
+    },
     /// A frame does not have the size the profile declares.
     BadFrameSize {
         /// The camera.
@@ -112,6 +124,7 @@ impl StopReason {
         match (self, other) {
             (Missing { input: a }, Missing { input: b })
             | (Stale { input: a, .. }, Stale { input: b, .. })
+            | (Frozen { input: a, .. }, Frozen { input: b, .. })
             | (NonFinite { input: a }, NonFinite { input: b }) => a == b,
             (BadFrameSize { camera: a, .. }, BadFrameSize { camera: b, .. }) => a == b,
             (BadClock { .. }, BadClock { .. })
@@ -129,6 +142,12 @@ impl fmt::Display for StopReason {
             StopReason::Missing { input } => write!(f, "{input}: no data yet"),
             StopReason::Stale { input, age_s, limit_s } => {
                 write!(f, "{input}: last data {age_s:.3} s old (limit {limit_s:.3} s)")
+            }
+            StopReason::Frozen { input, age_s, limit_s } => {
+                write!(
+                    f,
+                    "{input}: the same reading re-sent for {age_s:.3} s (limit {limit_s:.3} s)"
+                )
             }
             StopReason::BadFrameSize { camera, expected, got } => write!(
                 f,
@@ -162,6 +181,12 @@ pub struct Staleness {
     pub dock_switch: Option<f64>,
     /// Limit per `[[sensors]]` entry (profile order).
     pub sensors: Vec<Option<f64>>,
+    /// Date a frame bit-identical to its camera's last one from when that content first
+    /// arrived, so a driver re-sending one frame as new turns stale like a silent camera
+    /// ([`StopReason::Frozen`]). On for real cameras (sensor noise makes every exposure
+    /// differ); off for noiseless synthetic cameras, whose frames of a still scene repeat.
+    /// Odometry that reports motion with an unchanged pose is always dated so.
+    pub camera_repeats_stale: bool,
 }
 
 /// Static configuration of a loop (built from a profile by
@@ -227,11 +252,30 @@ pub struct ReactiveLoop<B: Behavior + ?Sized = dyn Behavior> {
 /// behavior, for callers that own the behavior themselves.
 pub struct LoopCore {
     config: LoopConfig,
+    repeats: Repeats,
     last_now: Option<f64>,
     finished: Option<Outcome>,
     stopped: Option<StopReason>,
     ticks: u64,
     safe_stop_ticks: u64,
+}
+
+/// The stop an input stamped `stamp` calls for at `now`, if any: [`StopReason::Stale`]
+/// when the reading itself is too old, [`StopReason::Frozen`] when it is new but repeats
+/// content that arrived at `since`, too long ago.
+fn aged(input: InputKind, now: f64, stamp: f64, since: f64, limit: f64) -> Option<StopReason> {
+    if !is_fresh(now - stamp, limit) {
+        return Some(StopReason::Stale {
+            input,
+            age_s: now - stamp,
+            limit_s: limit,
+        });
+    }
+    (!is_fresh(now - since, limit)).then_some(StopReason::Frozen {
+        input,
+        age_s: now - since,
+        limit_s: limit,
+    })
 }
 
 /// True when an input of age `age` (s) is within `limit`; NaN ages are never fresh.
@@ -316,6 +360,7 @@ impl LoopCore {
     /// Fresh loop state.
     pub fn new(config: LoopConfig) -> Self {
         Self {
+            repeats: Repeats::new(config.frame_sizes.len()),
             config,
             last_now: None,
             finished: None,
@@ -334,6 +379,7 @@ impl LoopCore {
     pub fn restart(&mut self) {
         self.finished = None;
         self.last_now = None;
+        self.repeats.clear();
     }
 
     /// Ticks so far.
@@ -376,13 +422,9 @@ impl LoopCore {
                         });
                     }
                     if let Some(limit) = self.config.staleness.camera {
-                        let age = now - c.stamp;
-                        if !is_fresh(age, limit) {
-                            return Some(StopReason::Stale {
-                                input: InputKind::Camera(i),
-                                age_s: age,
-                                limit_s: limit,
-                            });
+                        let since = self.repeats.camera_since(i).unwrap_or(c.stamp);
+                        if let Some(reason) = aged(InputKind::Camera(i), now, c.stamp, since, limit) {
+                            return Some(reason);
                         }
                     }
                 }
@@ -413,17 +455,19 @@ impl LoopCore {
             (
                 InputKind::Odometry,
                 self.config.staleness.odometry,
-                inputs.odometry.map(|o| o.stamp),
+                inputs
+                    .odometry
+                    .map(|o| (o.stamp, self.repeats.odometry_since().unwrap_or(o.stamp))),
             ),
             (
                 InputKind::Tether,
                 self.config.staleness.tether,
-                inputs.tether.map(|t| t.stamp),
+                inputs.tether.map(|t| (t.stamp, t.stamp)),
             ),
             (
                 InputKind::DockSwitch,
                 self.config.staleness.dock_switch,
-                inputs.dock_contact.map(|d| d.stamp),
+                inputs.dock_contact.map(|d| (d.stamp, d.stamp)),
             ),
         ];
         for (i, limit) in self.config.staleness.sensors.iter().enumerate() {
@@ -447,14 +491,11 @@ impl LoopCore {
             if let Some(limit) = limit {
                 match stamp {
                     None => return Some(StopReason::Missing { input }),
-                    Some(s) if !is_fresh(now - s, limit) => {
-                        return Some(StopReason::Stale {
-                            input,
-                            age_s: now - s,
-                            limit_s: limit,
-                        });
+                    Some((stamp, since)) => {
+                        if let Some(reason) = aged(input, now, stamp, since, limit) {
+                            return Some(reason);
+                        }
                     }
-                    _ => {}
                 }
             }
         }
@@ -482,6 +523,7 @@ impl LoopCore {
                 status: LoopStatus::Finished { outcome },
             };
         }
+        self.repeats.observe(inputs, self.config.staleness.camera_repeats_stale);
         if let Some(reason) = self.check_inputs(inputs) {
             return self.enter_stop(reason, inputs.now);
         }

@@ -253,6 +253,15 @@ pub struct LoopSpec {
     /// docking that ends on the switch must not trust a switch that stopped answering).
     #[serde(default)]
     pub dock_switch_stale_s: Option<f64>,
+    /// A frame bit-identical to its camera's last one is the same exposure re-sent by a
+    /// frozen driver, and ages from when it first arrived (default true: a real sensor's
+    /// noise makes every exposure differ). Set false for a noiseless synthetic camera.
+    #[serde(default = "yes")]
+    pub camera_repeats_stale: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 pub(crate) fn validate_behavior(b: &BehaviorSpec, v: &mut Validator<'_>) {

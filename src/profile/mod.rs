@@ -186,6 +186,7 @@ impl Profile {
                 tether: self.loop_.tether_stale_s,
                 dock_switch: self.loop_.dock_switch_stale_s,
                 sensors: self.sensors.iter().map(|s| s.stale_s).collect(),
+                camera_repeats_stale: self.loop_.camera_repeats_stale,
             },
             frame_sizes: self.cameras.iter().map(|c| (c.width_px, c.height_px)).collect(),
             drive: self.drive.model(),

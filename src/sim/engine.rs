@@ -9,7 +9,7 @@
 
 use super::camera::camera_pose;
 use super::dock::{Contact, judge};
-use super::faults::{FaultKind, FaultSpec, Side};
+use super::faults::{self, FaultKind, FaultSpec, Latched, Side};
 use super::lighting::{LightState, LightingRun, ShadowBand};
 use super::motion::Motion;
 use super::render::{CameraMotion, Renderer, SensorParams};
@@ -105,8 +105,8 @@ pub struct Sim {
     encoder_ref: (f64, f64),
     /// The fault injected into this mission, if any ([`super::faults`]).
     fault: Option<FaultSpec>,
-    /// The odometry offset of an `odometry_jump` once it struck (x, y, θ).
-    odometry_jump: Option<Pose2>,
+    /// What the fault latched when it struck.
+    latched: Latched,
     /// The true pose at each of the last ticks (for late frames), oldest first.
     past: VecDeque<(f64, Pose2)>,
 }
@@ -186,7 +186,7 @@ impl Sim {
             stale_motion_ticks: 0,
             encoder_ref: (0.0, 0.0),
             fault: None,
-            odometry_jump: None,
+            latched: Latched::default(),
             past: VecDeque::with_capacity(PAST_CAPACITY),
         }
     }
@@ -195,7 +195,7 @@ impl Sim {
     /// [`Sim::place`] restarts), or clears it.
     pub fn set_fault(&mut self, fault: Option<FaultSpec>) {
         self.fault = fault;
-        self.odometry_jump = None;
+        self.latched = Latched::default();
         self.motion.set_side_gain(1.0, 1.0);
     }
 
@@ -210,7 +210,7 @@ impl Sim {
     }
 
     /// What camera `i` delivers now: a rendered frame, or what the fault in force makes of
-    /// it (nothing, a wrong-sized, black, saturated or late frame).
+    /// it (nothing, a wrong-sized, black, saturated, late or frozen frame).
     ///
     /// # Errors
     /// [`HardwareError::NotReady`] while a `camera_silent` fault is in force.
@@ -236,6 +236,18 @@ impl Sim {
                 self.pose = now;
                 Ok(Exposure::ago(std::time::Duration::from_secs_f64(lag)))
             }
+            FaultKind::CameraFrozen => {
+                let frozen = &mut self.latched.frames;
+                frozen.resize_with(self.renderers.len(), || None);
+                match frozen.get(i).and_then(Option::as_ref) {
+                    Some(f) => frame.clone_from(f),
+                    None => {
+                        self.render(i, frame);
+                        self.latched.frames[i] = Some(frame.clone());
+                    }
+                }
+                Ok(Exposure::NOW)
+            }
             kind => {
                 self.render(i, frame);
                 match kind {
@@ -259,12 +271,13 @@ impl Sim {
                 FaultKind::OdometryInfinite => r.pose.y = f64::INFINITY,
                 FaultKind::OdometryJump => {
                     let [x, y, deg] = f.jump.unwrap_or_default();
-                    self.odometry_jump.get_or_insert(Pose2::new(x, y, deg.to_radians()));
+                    self.latched.jump.get_or_insert(Pose2::new(x, y, deg.to_radians()));
                 }
+                FaultKind::OdometryFrozen => r = *self.latched.odometry.get_or_insert(r),
                 _ => {}
             }
         }
-        if let Some(j) = self.odometry_jump {
+        if let Some(j) = self.latched.jump {
             r.pose = Pose2::new(r.pose.x + j.x, r.pose.y + j.y, r.pose.theta + j.theta);
         }
         r
@@ -401,10 +414,38 @@ impl Sim {
         }
         frame.resize(spec.width_px, spec.height_px);
         let seed = self.rng.next_u64() ^ self.frame_count;
-        self.renderers[i].render(&self.world.scene, &pose, &self.light_now, &self.sensor, seed, frame);
+        let occluded = self.occluded_scene();
+        let scene = occluded.as_deref().unwrap_or(&self.world.scene);
+        self.renderers[i].render(scene, &pose, &self.light_now, &self.sensor, seed, frame);
         if i + 1 == self.profile.cameras.len() {
             self.frame_count += 1;
         }
+    }
+
+    /// The scene with the occluder in it while an `occluder` fault is in force (built
+    /// when it strikes, where the first camera then looks at the target from).
+    fn occluded_scene(&mut self) -> Option<Arc<super::scene::Scene>> {
+        if !self.fault_now().is_some_and(|f| f.kind == FaultKind::Occluder) {
+            return None;
+        }
+        if self.latched.scene.is_none() {
+            let world = &self.world;
+            let n = world.target_prims.len().max(1) as f64;
+            let target = world
+                .target_prims
+                .iter()
+                .filter_map(|&k| world.scene.prims.get(k))
+                .fold(nalgebra::Point3::origin(), |c, p| c + p.shape.centre().coords / n);
+            let camera = self
+                .profile
+                .cameras
+                .first()
+                .map_or(nalgebra::Point3::new(self.pose.x, self.pose.y, 0.3), |c| {
+                    camera_pose(&self.pose, &c.mount).position
+                });
+            self.latched.scene = Some(Arc::new(faults::occluded(&world.scene, camera, target)));
+        }
+        self.latched.scene.clone()
     }
 
     /// The motion of a camera at `pose` (on the robot) during this frame, in the camera

@@ -4,21 +4,28 @@
 //! run once per fault. The fault strikes `at_s` seconds into the docking mission (the
 //! clock restarts when the proctor places the robot) and lasts `duration_s`. The
 //! simulator applies it behind the hardware traits, where a real robot's part would fail:
-//! the camera delivers nothing, a wrong-sized, black or saturated frame, or a late one;
-//! odometry reads NaN or infinity or jumps; a track stalls or runs at half speed; commands
-//! reach the motors late; the lights go out; the tether reel jams.
+//! the camera delivers nothing, a wrong-sized, black or saturated frame, a late one, or
+//! the same frame again as new (a frozen driver); odometry reads NaN or infinity, jumps,
+//! or freezes; a track stalls or runs at half speed; commands reach the motors late; the
+//! lights go out; the tether reel jams; a person steps between the robot and its target.
 //!
 //! `expect` states how the run must end, and `trials` reports, per fault, the runs that
 //! ended that way, the ones that did not (each a bug), the time in safe stop, and the
 //! ticks the robot was commanded to move while an input was stale or invalid, which must
 //! be zero.
 //!
-//! Not yet simulated (the list, item 1): a frozen camera driver re-delivering the
-//! same frame and frozen odometry (neither is detectable from stamps alone; both need a
-//! frozen-data check in the loop first), and an occluder in front of the fiducial.
+//! Simplified: the occluder is seen, not touched (the robot's body passes through it),
+//! and it stands still where it stepped in until it leaves.
 
+use super::scene::{Material, Prim, Scene, Shape, Tag};
+use crate::arbiter::Staleness;
 use crate::config::Validator;
+use crate::geometry::Pose2;
+use crate::perception::RgbImage;
+use crate::schemas::OdometryReading;
+use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// What fails.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -35,12 +42,17 @@ pub enum FaultKind {
     /// Every camera delivers frames `lag_s` old (rendered at the pose of then, and stamped
     /// so by the driver).
     CameraLate,
+    /// Every camera re-delivers the frame it took when the fault struck, stamped as new
+    /// (a driver stuck re-publishing its buffer).
+    CameraFrozen,
     /// Odometry reads NaN.
     OdometryNan,
     /// Odometry reads infinity.
     OdometryInfinite,
     /// Odometry jumps by `jump` (x m, y m, θ deg) at `at_s` and keeps the offset.
     OdometryJump,
+    /// Odometry re-delivers the reading it had when the fault struck, stamped as new.
+    OdometryFrozen,
     /// One track (`side`) stalls: its motor turns nothing, and its encoder reads still.
     TrackStall,
     /// Both motors deliver half their commanded speed.
@@ -51,6 +63,10 @@ pub enum FaultKind {
     LightsOut,
     /// The tether reel jams: it neither reels in nor pays out.
     ReelJam,
+    /// A person steps into the line of sight: a 0.45 × 1.7 m dark figure standing halfway
+    /// between the robot's first camera and the target's centre (0.15–1.5 m from the
+    /// camera), seen for `duration_s`, then gone.
+    Occluder,
 }
 
 /// Which track.
@@ -169,20 +185,76 @@ impl FaultSpec {
 impl FaultSpec {
     /// True when, at docking time `t`, the fault has left an input the loop must not act
     /// on (stale, missing, the wrong size, or not finite), so any motion commanded then is
-    /// a bug. `camera_limit_s` is the profile's camera staleness limit and `tick_s` the
-    /// loop period: a silent camera's last frame goes stale one limit after the fault
-    /// struck, and the tick that notices may be one period later.
-    pub fn inputs_invalid(&self, t: f64, camera_limit_s: Option<f64>, tick_s: f64) -> bool {
+    /// a bug. `limits` are the loop's staleness limits and `tick_s` its period: a silent
+    /// or frozen device's last reading goes stale one limit after the fault struck, and
+    /// the tick that notices may be one period later. (Frozen odometry is invalid once
+    /// stale even when it froze on a still base, which the loop cannot tell from a stall:
+    /// such a run would count motion here, and show it.)
+    pub fn inputs_invalid(&self, t: f64, limits: &Staleness, tick_s: f64) -> bool {
         if !self.active(t) {
             return false;
         }
+        let outlived = |limit: Option<f64>| limit.is_some_and(|l| t >= self.at_s + l + tick_s + 1e-9);
         match self.kind {
-            FaultKind::CameraSilent => camera_limit_s.is_some_and(|l| t >= self.at_s + l + tick_s + 1e-9),
-            FaultKind::CameraLate => camera_limit_s.is_some_and(|l| self.lag_s.unwrap_or(0.0) > l),
+            FaultKind::CameraSilent => outlived(limits.camera),
+            FaultKind::CameraFrozen => limits.camera_repeats_stale && outlived(limits.camera),
+            FaultKind::OdometryFrozen => outlived(limits.odometry),
+            FaultKind::CameraLate => limits.camera.is_some_and(|l| self.lag_s.unwrap_or(0.0) > l),
             FaultKind::CameraWrongSize | FaultKind::OdometryNan | FaultKind::OdometryInfinite => true,
             _ => false,
         }
     }
+}
+
+/// What a fault latched when it struck, for the rest of the mission: the frames and the
+/// odometry a frozen driver re-sends, the offset of a jump, the scene with the occluder.
+#[derive(Debug, Default)]
+pub struct Latched {
+    /// Per camera, the frame it froze on.
+    pub frames: Vec<Option<RgbImage>>,
+    /// The odometry reading it froze on.
+    pub odometry: Option<OdometryReading>,
+    /// The odometry offset of an `odometry_jump` (x, y, θ).
+    pub jump: Option<Pose2>,
+    /// The world's scene with the occluder standing in it.
+    pub scene: Option<Arc<Scene>>,
+}
+
+/// The occluder's half width and height, m: a person.
+const OCCLUDER_HALF_WIDTH_M: f64 = 0.225;
+const OCCLUDER_HEIGHT_M: f64 = 1.7;
+
+/// `scene` with a person standing between `camera` (its optical centre) and `target`
+/// (the target's centre): halfway, 0.15–1.5 m from the camera, facing it, in dark
+/// clothing (8 % reflectance, slightly blue: denim). A clone of the scene, once per fault.
+///
+/// The figure is a column of ten tiles: the renderer draws primitives front to back by
+/// the distance of their centres, so one 1.7 m panel, whose centre is high above the
+/// camera's line of sight, would be drawn after a target it stands in front of.
+pub fn occluded(scene: &Scene, camera: Point3<f64>, target: Point3<f64>) -> Scene {
+    const TILES: usize = 10;
+    let mut flat = target - camera;
+    flat.z = 0.0;
+    let range = flat.norm();
+    let toward = if range > 1e-6 { flat / range } else { Vector3::x() };
+    let at = camera.coords + toward * (range / 2.0).clamp(0.15, 1.5);
+    let tile = OCCLUDER_HEIGHT_M / TILES as f64;
+    let mut out = scene.clone();
+    for k in 0..TILES {
+        let mut part = Prim::new(
+            Shape::Rect {
+                centre: Point3::new(at.x, at.y, tile * (k as f64 + 0.5)),
+                u: Vector3::new(-toward.y, toward.x, 0.0),
+                v: Vector3::z(),
+                half: [OCCLUDER_HALF_WIDTH_M, tile / 2.0],
+            },
+            Material::Solid([0.06, 0.07, 0.09]),
+            Tag::Clutter,
+        );
+        part.two_sided = true;
+        out.prims.push(part);
+    }
+    out
 }
 
 /// The TOML spelling of `kind`.

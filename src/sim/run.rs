@@ -185,9 +185,9 @@ impl Rig {
             rec.tick(mission, now, self.lp.root(), &out, &mut nodes);
             rec.mcap_tick(mcap, mission, now, self, &out, &mut nodes);
             let moving = !out.command.drive.is_stop();
-            let (limit, period) = (self.lp.config().staleness.camera, 1.0 / self.lp.config().rate_hz);
+            let (limits, period) = (&self.lp.config().staleness, 1.0 / self.lp.config().rate_hz);
             self.sim.with(|s| {
-                if moving && s.fault().is_some_and(|f| f.inputs_invalid(now, limit, period)) {
+                if moving && s.fault().is_some_and(|f| f.inputs_invalid(now, limits, period)) {
                     s.stale_motion_ticks += 1;
                 }
             });
