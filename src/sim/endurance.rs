@@ -117,11 +117,7 @@ pub fn summarise(records: &[RunRecord]) -> Option<EnduranceSummary> {
         first_quarter_mean_s: mean_docked(&cycles[..quarter]),
         last_quarter_mean_s: mean_docked(&cycles[n - quarter..]),
         slope_s_per_cycle: slope,
-        odometry_error_m: [
-            odo[0],
-            odo[n - 1],
-            odo.iter().copied().fold(0.0, f64::max),
-        ],
+        odometry_error_m: [odo[0], odo[n - 1], odo.iter().copied().fold(0.0, f64::max)],
     })
 }
 
@@ -188,7 +184,11 @@ pub fn excursion(sim: &mut Sim, goal: Pose2, speed: f64, max_s: f64) -> Result<b
         } else if !at_position {
             let a = ly.atan2(lx);
             let reverse = a.abs() > std::f64::consts::FRAC_PI_2;
-            let e = if reverse { wrap_angle(a - std::f64::consts::PI) } else { a };
+            let e = if reverse {
+                wrap_angle(a - std::f64::consts::PI)
+            } else {
+                a
+            };
             if e.abs() > 0.35 {
                 DriveCommand::Turn {
                     omega: (2.0 * e).clamp(-max_w, max_w),
@@ -223,10 +223,7 @@ pub fn excursion(sim: &mut Sim, goal: Pose2, speed: f64, max_s: f64) -> Result<b
 fn odometry_error(sim: &Sim, origin: &Pose2) -> (f64, f64) {
     let truth = origin.relative(&sim.pose());
     let odo = sim.odometry().pose;
-    (
-        truth.distance(&odo),
-        wrap_angle(odo.theta - truth.theta).to_degrees(),
-    )
+    (truth.distance(&odo), wrap_angle(odo.theta - truth.theta).to_degrees())
 }
 
 /// Runs an endurance outing's cycles `0..=last` (see the module docs), handing each
@@ -329,7 +326,10 @@ pub fn run_outing(
             m.log(
                 record.time_s,
                 if record.success { 2 } else { 4 },
-                &format!("cycle {} ends: {} after {:.1} s", record.index, record.outcome, record.time_s),
+                &format!(
+                    "cycle {} ends: {} after {:.1} s",
+                    record.index, record.outcome, record.time_s
+                ),
             );
             m.finish()?;
         }

@@ -701,3 +701,40 @@ impl LightState {
         self.level
     }
 }
+
+#[cfg(test)]
+mod drift_tests {
+    use super::*;
+
+    fn preset(p: LightingPreset) -> Lighting {
+        LightingSpec {
+            preset: Some(p),
+            ..Default::default()
+        }
+        .resolve()
+    }
+
+    #[test]
+    fn drift_passes_through_its_keyframes_and_interpolates_between() {
+        let keys = vec![
+            preset(LightingPreset::Dawn),
+            preset(LightingPreset::Noon),
+            preset(LightingPreset::Dusk),
+        ];
+        let run = LightingRun::drifting(keys.clone(), 1000.0);
+        let level = |t: f64| f64::from(run.at(t).level());
+        for (t, k) in [(0.0, 0), (500.0, 1), (1000.0, 2), (5000.0, 2)] {
+            assert!((level(t) - keys[k].intensity).abs() < 1e-6, "t {t}: {}", level(t));
+        }
+        // Geometric between dawn (0.4) and noon (3.0): their geometric mean halfway.
+        assert!((level(250.0) - (0.4f64 * 3.0).sqrt()).abs() < 1e-6);
+        // The sun direction stays a unit vector, between the two keyframes' elevations.
+        let (dir, _) = run.at(250.0).sun();
+        assert!((dir.norm() - 1.0).abs() < 1e-9);
+        assert!(dir.z > keys[0].sun_dir.z && dir.z < keys[1].sun_dir.z);
+        // Noon's shadow band fades in: half strength a quarter of the way.
+        let s = run.at(250.0);
+        assert_eq!(s.shadows_for(super::super::scene::Tag::Target).len(), 1);
+        assert!((s.shadows_for(super::super::scene::Tag::Target)[0].strength - 0.35).abs() < 1e-6);
+    }
+}

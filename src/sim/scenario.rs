@@ -711,7 +711,10 @@ impl Scenario {
             });
         }
         v.require(self.trials == 1, "trials", || {
-            format!("an endurance outing runs `endurance.cycles` cycles: expected trials = 1, got {}", self.trials)
+            format!(
+                "an endurance outing runs `endurance.cycles` cycles: expected trials = 1, got {}",
+                self.trials
+            )
         });
         v.require(self.axes.lighting == default_lighting(), "axes.lighting", || {
             "an endurance outing is lit by `endurance.lighting`: leave axes.lighting out".into()
@@ -1001,7 +1004,12 @@ impl Scenario {
         }
         let mut rng = Rng::named(self.seed, "endurance_starts");
         let lighting = e.lighting.join("→");
-        let segmentation = self.axes.segmentation.first().copied().unwrap_or(SegmentationMode::Adaptive);
+        let segmentation = self
+            .axes
+            .segmentation
+            .first()
+            .copied()
+            .unwrap_or(SegmentationMode::Adaptive);
         let terrain = self.axes.terrain.first().copied().unwrap_or(Terrain::LabFloor);
         (0..e.cycles)
             .map(|index| {
