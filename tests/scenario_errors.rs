@@ -446,13 +446,17 @@ fn mutated_scenarios_never_panic() {
     );
 }
 
+/// A file, the text of a valid outing to replace and its replacement, and the expected
+/// problem: path, line, part of the message.
+type Case<'a> = (&'a str, &'a str, &'a str, &'a str, Option<usize>, &'a str);
+
 #[test]
 fn bad_endurance_tables_are_reported_precisely() {
     // A valid outing (lines 3–8 after the name and profile), then one change each.
     let base =
         "[starts]\ngrid = \"paper16\"\n[endurance]\ncycles = 3\nlighting = [\"dawn\", \"dusk\"]\nday_s = 100.0\n";
     Scenario::load(&write("endurance_ok.toml", base)).unwrap();
-    let cases: &[(&str, &str, &str, &str, Option<usize>, &str)] = &[
+    let cases: &[Case] = &[
         (
             "e_cycles.toml",
             "cycles = 3",

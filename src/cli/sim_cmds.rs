@@ -24,7 +24,9 @@ pub struct DockOptions {
     pub at: Option<(f64, f64, f64)>,
     /// Run exactly run N of the scenario's campaign (the `index` field of `trials`'
     /// runs.jsonl): same start, trial, lighting, segmentation, terrain and seeds, so a
-    /// failed campaign run can be replayed with --out and logging.
+    /// failed campaign run can be replayed with --out and logging. For an endurance
+    /// scenario N is a cycle: the outing runs through cycle N (every cycle depends on the
+    /// ones before it) and only cycle N is traced, recorded and saved.
     #[arg(long, value_name = "N", conflicts_with_all = ["start", "at", "seed"])]
     pub index: Option<usize>,
     /// Seed (default: the scenario's).
