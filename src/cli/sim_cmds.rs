@@ -311,10 +311,12 @@ fn print_endurance(e: &crate::sim::endurance::EnduranceSummary, out: &mut dyn Wr
     )?;
     writeln!(
         out,
-        "time to dock: first {q} cycles {} s, last {q} cycles {} s; trend {} s per cycle (least squares over docked cycles)",
+        "time to dock: first {q} cycles {} s, last {q} cycles {} s; trend {} s per cycle over docked cycles, {} within starts",
         cell(e.first_quarter_mean_s, 1),
         cell(e.last_quarter_mean_s, 1),
         e.slope_s_per_cycle.map_or("–".into(), |v| format!("{v:+.3}")),
+        e.slope_within_starts_s_per_cycle
+            .map_or("–".into(), |v| format!("{v:+.3}")),
         q = e.quarter
     )?;
     writeln!(

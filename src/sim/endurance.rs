@@ -74,6 +74,12 @@ pub struct EnduranceSummary {
     /// Least-squares slope of time to dock against the cycle index over the docked
     /// cycles, s per cycle (positive: docking slows as the outing goes on).
     pub slope_s_per_cycle: Option<f64>,
+    /// The same slope within starts: each docked cycle's time and index less the means
+    /// of the docked cycles from its start (starts docked from only once are left out),
+    /// so the drift is not confounded with which starts the later cycles drew, s per
+    /// cycle.
+    #[serde(default)]
+    pub slope_within_starts_s_per_cycle: Option<f64>,
     /// Odometry's position error at the start of docking: [first cycle, last cycle,
     /// largest], m.
     pub odometry_error_m: [f64; 3],
@@ -91,21 +97,23 @@ pub fn summarise(records: &[RunRecord]) -> Option<EnduranceSummary> {
         let ok: Vec<f64> = rs.iter().filter(|r| r.success).map(|r| r.time_s).collect();
         (!ok.is_empty()).then(|| ok.iter().sum::<f64>() / ok.len() as f64)
     };
-    let pts: Vec<(f64, f64)> = cycles
-        .iter()
-        .filter(|r| r.success)
-        .map(|r| (r.cycle.unwrap_or(r.index) as f64, r.time_s))
-        .collect();
-    let slope = (pts.len() >= 2).then(|| {
-        let k = pts.len() as f64;
-        let (mx, my) = (
-            pts.iter().map(|p| p.0).sum::<f64>() / k,
-            pts.iter().map(|p| p.1).sum::<f64>() / k,
-        );
-        let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-        let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-        if sxx > 0.0 { sxy / sxx } else { 0.0 }
-    });
+    let docked: Vec<&&RunRecord> = cycles.iter().filter(|r| r.success).collect();
+    let point = |r: &RunRecord| (r.cycle.unwrap_or(r.index) as f64, r.time_s);
+    let pts: Vec<(f64, f64)> = docked.iter().map(|r| point(r)).collect();
+    let slope = least_squares(&pts, (mean(pts.iter().map(|p| p.0)), mean(pts.iter().map(|p| p.1))));
+    // Within starts: centred on each start's own means.
+    let mut starts: Vec<&str> = docked.iter().map(|r| r.start.as_str()).collect();
+    starts.sort_unstable();
+    starts.dedup();
+    let mut centred = Vec::new();
+    for s in starts {
+        let g: Vec<(f64, f64)> = docked.iter().filter(|r| r.start == s).map(|r| point(r)).collect();
+        if g.len() >= 2 {
+            let (mx, my) = (mean(g.iter().map(|p| p.0)), mean(g.iter().map(|p| p.1)));
+            centred.extend(g.iter().map(|p| (p.0 - mx, p.1 - my)));
+        }
+    }
+    let within = least_squares(&centred, (0.0, 0.0));
     let odo: Vec<f64> = cycles.iter().map(|r| r.odometry_error_m.unwrap_or(0.0)).collect();
     Some(EnduranceSummary {
         cycles: n,
@@ -117,8 +125,26 @@ pub fn summarise(records: &[RunRecord]) -> Option<EnduranceSummary> {
         first_quarter_mean_s: mean_docked(&cycles[..quarter]),
         last_quarter_mean_s: mean_docked(&cycles[n - quarter..]),
         slope_s_per_cycle: slope,
+        slope_within_starts_s_per_cycle: within,
         odometry_error_m: [odo[0], odo[n - 1], odo.iter().copied().fold(0.0, f64::max)],
     })
+}
+
+fn mean(xs: impl Iterator<Item = f64>) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for x in xs {
+        sum += x;
+        n += 1;
+    }
+    if n == 0 { 0.0 } else { sum / n as f64 }
+}
+
+/// The least-squares slope of `pts` about the centre `(mx, my)`; `None` for fewer than
+/// two points or no spread in x.
+fn least_squares(pts: &[(f64, f64)], (mx, my): (f64, f64)) -> Option<f64> {
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (pts.len() >= 2 && sxx > 0.0).then(|| sxy / sxx)
 }
 
 /// How an outing records its cycles besides their records.
