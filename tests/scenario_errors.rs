@@ -445,3 +445,168 @@ fn mutated_scenarios_never_panic() {
         bad.join("\n")
     );
 }
+
+/// A file, the text of a valid outing to replace and its replacement, and the expected
+/// problem: path, line, part of the message.
+type Case<'a> = (&'a str, &'a str, &'a str, &'a str, Option<usize>, &'a str);
+
+#[test]
+fn bad_endurance_tables_are_reported_precisely() {
+    // A valid outing (lines 3–8 after the name and profile), then one change each.
+    let base =
+        "[starts]\ngrid = \"paper16\"\n[endurance]\ncycles = 3\nlighting = [\"dawn\", \"dusk\"]\nday_s = 100.0\n";
+    Scenario::load(&write("endurance_ok.toml", base)).unwrap();
+    let cases: &[Case] = &[
+        (
+            "e_cycles.toml",
+            "cycles = 3",
+            "cycles = 0",
+            "endurance.cycles",
+            Some(6),
+            "expected 1 to 10000 cycles, got 0",
+        ),
+        (
+            "e_day.toml",
+            "day_s = 100.0",
+            "day_s = 0.0",
+            "endurance.day_s",
+            Some(8),
+            "expected a positive number, got 0",
+        ),
+        (
+            "e_speed.toml",
+            "day_s = 100.0",
+            "day_s = 100.0\nexcursion_speed_mps = -0.1",
+            "endurance.excursion_speed_mps",
+            Some(9),
+            "expected a positive number, got -0.1",
+        ),
+        (
+            "e_timeout.toml",
+            "day_s = 100.0",
+            "day_s = 100.0\nexcursion_timeout_s = nan",
+            "endurance.excursion_timeout_s",
+            Some(9),
+            "expected a positive number, got NaN",
+        ),
+        (
+            "e_nolight.toml",
+            "[\"dawn\", \"dusk\"]",
+            "[]",
+            "endurance.lighting",
+            Some(7),
+            "expected at least one lighting programme",
+        ),
+        (
+            "e_unknown_light.toml",
+            "\"dusk\"]",
+            "\"sunset\"]",
+            "endurance.lighting[1]",
+            Some(7),
+            "unknown lighting `sunset`",
+        ),
+        (
+            "e_flashers.toml",
+            "\"dusk\"]",
+            "\"flashers\"]",
+            "endurance.lighting[1]",
+            Some(7),
+            "`flashers` has flashers or clouds",
+        ),
+        (
+            "e_missing.toml",
+            "day_s = 100.0\n",
+            "",
+            "endurance",
+            Some(5),
+            "missing field `day_s`",
+        ),
+        (
+            "e_trials.toml",
+            "[starts]",
+            "trials = 2\n[starts]",
+            "trials",
+            Some(3),
+            "expected trials = 1, got 2",
+        ),
+        (
+            "e_axes_lighting.toml",
+            "[starts]",
+            "[axes]\nlighting = [\"noon\"]\n[starts]",
+            "axes.lighting",
+            Some(4),
+            "leave axes.lighting out",
+        ),
+        (
+            "e_segmentation.toml",
+            "[starts]",
+            "[axes]\nsegmentation = [\"adaptive\", \"static\"]\n[starts]",
+            "axes.segmentation",
+            Some(4),
+            "expected one value, got 2",
+        ),
+        (
+            "e_terrain.toml",
+            "[starts]",
+            "[axes]\nterrain = [\"lab_floor\", \"grass\"]\n[starts]",
+            "axes.terrain",
+            Some(4),
+            "expected one value, got 2",
+        ),
+        (
+            "e_colours.toml",
+            "[starts]",
+            "[axes]\nfiducial_colors = [[\"cyan\", \"magenta\"]]\n[starts]",
+            "axes.fiducial_colors",
+            Some(4),
+            "leave axes.fiducial_colors out",
+        ),
+        (
+            "e_faults.toml",
+            "[starts]",
+            "[[faults]]\nname = \"x\"\nkind = \"camera_silent\"\nat_s = 1.0\nduration_s = 1.0\nexpect = \"dock\"\n[starts]",
+            "faults",
+            Some(3),
+            "faults are not injected into endurance outings",
+        ),
+        (
+            "e_ballistic.toml",
+            "[starts]",
+            "[ballistic]\nenabled = true\n[starts]",
+            "ballistic.enabled",
+            Some(4),
+            "without an a-priori dock pose",
+        ),
+        (
+            "e_imprint.toml",
+            "[starts]",
+            "[imprint]\nenabled = false\n[starts]",
+            "imprint.enabled",
+            Some(4),
+            "each endurance cycle starts with the departure",
+        ),
+        (
+            "e_imprint_light.toml",
+            "[starts]",
+            "[imprint]\nlighting = \"lab\"\n[starts]",
+            "imprint.lighting",
+            Some(4),
+            "departs under the outing's light",
+        ),
+        (
+            "e_sleep.toml",
+            "[starts]",
+            "[imprint]\nsleep_s = 60.0\n[starts]",
+            "imprint.sleep_s",
+            Some(4),
+            "expected 0",
+        ),
+    ];
+    for (file, from, to, path, line, text) in cases {
+        assert!(base.contains(from), "{file}");
+        let (p, l, m) = problem(&write(file, &base.replacen(from, to, 1)));
+        assert_eq!(&p, path, "{file}: {m}");
+        assert_eq!(l, *line, "{file}: {m}");
+        assert!(m.contains(text), "{file}: {m}");
+    }
+}

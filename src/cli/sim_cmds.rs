@@ -24,7 +24,9 @@ pub struct DockOptions {
     pub at: Option<(f64, f64, f64)>,
     /// Run exactly run N of the scenario's campaign (the `index` field of `trials`'
     /// runs.jsonl): same start, trial, lighting, segmentation, terrain and seeds, so a
-    /// failed campaign run can be replayed with --out and logging.
+    /// failed campaign run can be replayed with --out and logging. For an endurance
+    /// scenario N is a cycle: the outing runs through cycle N (every cycle depends on the
+    /// ones before it) and only cycle N is traced, recorded and saved.
     #[arg(long, value_name = "N", conflicts_with_all = ["start", "at", "seed"])]
     pub index: Option<usize>,
     /// Seed (default: the scenario's).
@@ -144,7 +146,32 @@ pub fn dock(opts: &DockOptions, out: &mut dyn Write) -> Result<RunRecord, SimErr
             )
         }),
     };
-    let rec = campaign::run_one(&prepared, &spec, &agent_for, &mut recording)?;
+    let rec = if prepared.loaded.scenario.endurance.is_some() {
+        // An outing's cycle depends on every cycle before it: run the outing through it,
+        // recording and tracing that cycle only.
+        let mcap = recording.mcap.take().map(|(p, o)| (p.to_path_buf(), o));
+        let mcap_for = |i: usize| mcap.clone().filter(|_| i == spec.index);
+        let mut found = None;
+        crate::sim::endurance::run_outing(
+            &prepared,
+            &agent_for,
+            spec.index,
+            crate::sim::endurance::OutingRecording {
+                traced: Some(spec.index),
+                recording: &mut recording,
+                mcap_for: &mcap_for,
+            },
+            &mut |r| {
+                if r.index == spec.index {
+                    found = Some(r);
+                }
+                Ok(())
+            },
+        )?;
+        found.ok_or_else(|| SimError::Unsupported(format!("the outing ended before cycle {}", spec.index)))?
+    } else {
+        campaign::run_one(&prepared, &spec, &agent_for, &mut recording)?
+    };
     if let (Some(w), Some(path)) = (trace.as_mut(), &opts.trace) {
         w.flush().map_err(|source| SimError::Io {
             path: path.display().to_string(),
@@ -239,6 +266,9 @@ pub fn print_table(s: &Summary, out: &mut dyn Write) -> std::io::Result<()> {
         writeln!(out, "\nby fiducial colours, over all starts")?;
         print_groups(&s.by_colors, None, out)?;
     }
+    if let Some(e) = &s.endurance {
+        print_endurance(e, out)?;
+    }
     if !s.by_fault.is_empty() {
         let w = s
             .by_fault
@@ -269,6 +299,31 @@ pub fn print_table(s: &Summary, out: &mut dyn Write) -> std::io::Result<()> {
         }
     }
     Ok(())
+}
+
+/// The endurance lines of [`print_table`]: cycles docked, the proctor's carries, and
+/// the drift in time to dock and odometry's error over the outing.
+fn print_endurance(e: &crate::sim::endurance::EnduranceSummary, out: &mut dyn Write) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "\nendurance: {}/{} cycles docked in one outing ({} carried back by the proctor, {} excursions short of their start); last cycle began at {:.2} h",
+        e.docked, e.cycles, e.carried_back, e.excursions_short, e.last_cycle_at_h
+    )?;
+    writeln!(
+        out,
+        "time to dock: first {q} cycles {} s, last {q} cycles {} s; trend {} s per cycle over docked cycles, {} within starts",
+        cell(e.first_quarter_mean_s, 1),
+        cell(e.last_quarter_mean_s, 1),
+        e.slope_s_per_cycle.map_or("–".into(), |v| format!("{v:+.3}")),
+        e.slope_within_starts_s_per_cycle
+            .map_or("–".into(), |v| format!("{v:+.3}")),
+        q = e.quarter
+    )?;
+    writeln!(
+        out,
+        "odometry error at the start of docking: first cycle {:.2} m, last {:.2} m, largest {:.2} m",
+        e.odometry_error_m[0], e.odometry_error_m[1], e.odometry_error_m[2]
+    )
 }
 
 /// The rows of [`print_table`]: a column for the start and for each axis that varies
@@ -357,6 +412,12 @@ pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimE
     if !bins.is_empty() && !sc.axes.lighting.iter().any(|l| sc.lighting_random.contains_key(l)) {
         return Err(SimError::InvalidArgument(format!(
             "--bin: no lighting on {}'s lighting axis is drawn; name a [lighting_random.NAME] there",
+            opts.scenario.display()
+        )));
+    }
+    if sc.endurance.is_some() && opts.shard.is_some() {
+        return Err(SimError::InvalidArgument(format!(
+            "--shard: {} is an endurance outing, one continuous run of one robot, which cannot be split across machines; run it whole",
             opts.scenario.display()
         )));
     }

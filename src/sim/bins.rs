@@ -180,6 +180,12 @@ mod tests {
                 spec: Default::default(),
                 params,
             }),
+            cycle: None,
+            outing_clock_s: None,
+            odometry_error_m: None,
+            odometry_error_deg: None,
+            excursion_reached: None,
+            carried_back: None,
             track: vec![],
         }
     }

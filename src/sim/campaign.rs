@@ -109,6 +109,26 @@ pub struct RunRecord {
     /// Time in safe stop, s (with a fault).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub safe_stop_s: Option<f64>,
+    /// The cycle of an endurance outing this record is (absent outside outings,
+    /// [`super::endurance`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycle: Option<usize>,
+    /// The outing's clock when the cycle began (its departure), s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outing_clock_s: Option<f64>,
+    /// How far odometry's position was from the truth when the cycle's docking began, m
+    /// (odometry's frame is the docked pose the outing began at; it is never reset).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub odometry_error_m: Option<f64>,
+    /// Odometry's heading error then, degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub odometry_error_deg: Option<f64>,
+    /// The excursion reached the cycle's start (within 3 cm and 2°) before its time limit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub excursion_reached: Option<bool>,
+    /// The cycle failed and the proctor carried the robot back into the dock.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub carried_back: Option<bool>,
     /// True path, [x, y] in mm every 0.5 s.
     pub track: Vec<[i32; 2]>,
 }
@@ -311,6 +331,9 @@ pub struct Summary {
     /// order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub by_fault: Vec<FaultSummary>,
+    /// With `[endurance]`: success and drift over the outing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub endurance: Option<super::endurance::EnduranceSummary>,
 }
 
 /// How the runs with one injected fault ended (`summary.json`'s `by_fault`).
@@ -450,6 +473,7 @@ pub fn summary(name: &str, records: &[RunRecord]) -> Summary {
         groups: grouped(true),
         by_colors,
         by_fault: fault_summaries(records),
+        endurance: super::endurance::summarise(records),
     }
 }
 
@@ -608,6 +632,9 @@ pub fn run_campaign(
     make_agent: &AgentFactory,
     opts: &CampaignOptions,
 ) -> Result<(Vec<RunRecord>, Summary), SimError> {
+    if p.loaded.scenario.endurance.is_some() {
+        return super::endurance::run_campaign(p, make_agent, opts);
+    }
     // Fail early if the profile has no behavior.
     make_agent(&p.loaded.profile).map_err(|e| SimError::Unsupported(e.to_string()))?;
     let mut done: BTreeMap<usize, RunRecord> = BTreeMap::new();
@@ -786,7 +813,7 @@ pub fn run_campaign(
 }
 
 /// [`Progress::Lines`]: a line on stderr each time another tenth of the campaign is done.
-struct ProgressLines {
+pub(super) struct ProgressLines {
     name: String,
     total: usize,
     done: usize,
@@ -798,7 +825,7 @@ struct ProgressLines {
 }
 
 impl ProgressLines {
-    fn new<'a>(p: &Prepared, kept: impl Iterator<Item = &'a RunRecord>) -> Self {
+    pub(super) fn new<'a>(p: &Prepared, kept: impl Iterator<Item = &'a RunRecord>) -> Self {
         let (mut done, mut docked) = (0, 0);
         for r in kept {
             done += 1;
@@ -816,7 +843,7 @@ impl ProgressLines {
         }
     }
 
-    fn record(&mut self, success: bool) {
+    pub(super) fn record(&mut self, success: bool) {
         self.done += 1;
         self.fresh += 1;
         self.docked += usize::from(success);

@@ -109,6 +109,12 @@ pub struct Sim {
     latched: Latched,
     /// The true pose at each of the last ticks (for late frames), oldest first.
     past: VecDeque<(f64, Pose2)>,
+    /// When the current mission began, s of simulation time: 0 after [`Sim::place`],
+    /// the clock's reading at [`Sim::begin_leg`] in an endurance outing.
+    mission_start: f64,
+    /// The dock has let go ([`Sim::release`]): contact with the dock's socket does not
+    /// hold or judge the robot until it is clear of the dock.
+    releasing: bool,
 }
 
 /// Ticks of pose history kept for `camera_late` frames.
@@ -188,6 +194,8 @@ impl Sim {
             fault: None,
             latched: Latched::default(),
             past: VecDeque::with_capacity(PAST_CAPACITY),
+            mission_start: 0.0,
+            releasing: false,
         }
     }
 
@@ -332,8 +340,61 @@ impl Sim {
         self.safe_stops = 0;
         self.stale_motion_ticks = 0;
         self.past.clear();
+        self.mission_start = 0.0;
+        self.releasing = false;
         let last = self.motion.encoders();
         self.encoder_ref = (last.left, last.right);
+        if let Some(t) = &mut self.tether {
+            t.length = t.distance(&pose);
+        }
+    }
+
+    /// Starts a new mission of an endurance outing where the robot is, without touching
+    /// it: the clock, odometry (with its accumulated error), motors, posture, tether and
+    /// cameras go on as they were; only the mission's own tallies restart (path, command
+    /// changes, entrance errors, track, safe-stop ticks, the docked flag) and
+    /// [`Sim::mission_time`] counts from now.
+    pub fn begin_leg(&mut self) {
+        self.mission_start = self.t;
+        self.path_m = 0.0;
+        self.drive_changes = 0;
+        self.entrance = None;
+        self.track.clear();
+        self.next_track = self.t;
+        self.safe_stops = 0;
+        self.stale_motion_ticks = 0;
+        self.docked = false;
+    }
+
+    /// Time since the current mission began, s ([`Sim::place`] or [`Sim::begin_leg`]).
+    pub fn mission_time(&self) -> f64 {
+        self.t - self.mission_start
+    }
+
+    /// The dock lets a docked robot go, as the mother's latch would before the daughter
+    /// departs: until the robot is clear of the dock, touching its socket neither holds
+    /// it (an open dock's socket judges a robot in its mouth docked and stops it) nor
+    /// catches it. A closed dock's pouch still guides it out.
+    pub fn release(&mut self) {
+        self.releasing = true;
+    }
+
+    /// The robot is inside a closed dock's pouch.
+    pub fn inside(&self) -> bool {
+        self.inside
+    }
+
+    /// A proctor carries the robot to `pose` (`inside` the pouch or not) and sets it
+    /// down, stopped. Unlike [`Sim::place`] nothing else restarts: the wheels did not
+    /// turn, so odometry still reads where the robot was, and the clock runs on.
+    pub fn carry(&mut self, pose: Pose2, inside: bool) {
+        self.pose = pose;
+        self.body_velocity = [0.0; 3];
+        self.motion.halt();
+        self.inside = inside;
+        self.docked = false;
+        self.pouch_lateral = 0.0;
+        self.past.clear();
         if let Some(t) = &mut self.tether {
             t.length = t.distance(&pose);
         }
@@ -344,7 +405,7 @@ impl Sim {
             return;
         };
         let (s, level) = light.sun();
-        if level <= 0.0 || s.x <= 0.05 || !self.light.self_shadow() {
+        if level <= 0.0 || s.x <= 0.05 || !self.light.self_shadow_at(self.t) {
             return;
         }
         // The robot's top edge casts a horizontal shadow edge on the plane x = 0.
@@ -540,6 +601,11 @@ impl Sim {
                 Contact::Free => {
                     self.pose = to;
                     self.inside = false;
+                    self.releasing = false;
+                }
+                // Released ([`Sim::release`]): the socket lets the robot drive out.
+                Contact::Docked | Contact::Stuck { .. } if self.releasing => {
+                    self.pose = to;
                 }
                 Contact::Blocked => {}
                 Contact::Inside => {

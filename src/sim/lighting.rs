@@ -404,12 +404,21 @@ pub struct ShadowBand {
 }
 
 /// One run's lighting: the programme plus its seeded randomness (start time in the
-/// session, cloud switching instants).
+/// session, cloud switching instants), or a drift through several programmes over an
+/// endurance outing ([`LightingRun::drifting`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightingRun {
     lighting: Lighting,
     start_s: f64,
     cloud_switches: Vec<f64>,
+    drift: Option<Drift>,
+}
+
+/// Keyframe programmes spread evenly over `span_s` of simulation time.
+#[derive(Debug, Clone, PartialEq)]
+struct Drift {
+    keys: Vec<Lighting>,
+    span_s: f64,
 }
 
 impl LightingRun {
@@ -428,7 +437,79 @@ impl LightingRun {
             lighting,
             start_s,
             cloud_switches,
+            drift: None,
         }
+    }
+
+    /// Light that drifts through the programmes `keys` (at least one), spread evenly
+    /// over `span_s` seconds of simulation time from time 0: the first holds at 0, the
+    /// last from `span_s` on, and between two neighbours every quantity is interpolated
+    /// with the fraction `f` of the way from one to the next: the light level
+    /// geometrically (`a^(1−f)·b^f`, as daylight changes by factors), the illuminant's
+    /// colour, ambient, sun and glare linearly, the sun's direction along the great circle
+    /// (normalised linear interpolation), and each programme's shadow bands fade out and
+    /// in with its weight. Each programme's own session clock (`change_per_hour`,
+    /// `session_s`) does not apply: the drift is the clock. Flashers and clouds are not
+    /// drifted (a scenario's `[endurance]` refuses programmes with them).
+    ///
+    /// # Panics
+    /// Never; `keys` empty is treated as the `lab` programme.
+    pub fn drifting(keys: Vec<Lighting>, span_s: f64) -> Self {
+        let keys = if keys.is_empty() {
+            vec![LightingSpec::default().resolve()]
+        } else {
+            keys
+        };
+        Self {
+            lighting: keys[0].clone(),
+            start_s: 0.0,
+            cloud_switches: Vec::new(),
+            drift: Some(Drift {
+                keys,
+                span_s: span_s.max(1e-9),
+            }),
+        }
+    }
+
+    /// The drift's neighbouring keyframes at time `t` and the fraction between them.
+    fn drift_at(d: &Drift, t: f64) -> (&Lighting, &Lighting, f64) {
+        let n = d.keys.len();
+        if n == 1 {
+            return (&d.keys[0], &d.keys[0], 0.0);
+        }
+        let u = (t / d.span_s).clamp(0.0, 1.0) * (n - 1) as f64;
+        let i = (u.floor() as usize).min(n - 2);
+        (&d.keys[i], &d.keys[i + 1], u - i as f64)
+    }
+
+    fn fill_drift(d: &Drift, t: f64, state: &mut LightState) {
+        let (a, b, f) = Self::drift_at(d, t);
+        let lerp = |x: f64, y: f64| x + (y - x) * f;
+        let level = (a.intensity.ln() * (1.0 - f) + b.intensity.ln() * f).exp();
+        let (ca, cb) = (a.illuminant.rgb(), b.illuminant.rgb());
+        let sun = lerp(a.sun, b.sun);
+        let dir = a.sun_dir * (1.0 - f) + b.sun_dir * f;
+        state.illum = [0, 1, 2].map(|c| lerp(f64::from(ca[c]), f64::from(cb[c])) as f32);
+        state.level = level as f32;
+        state.ambient = lerp(a.ambient, b.ambient) as f32;
+        state.sun = sun as f32;
+        state.sun_dir = if dir.norm() > 1e-9 { dir.normalize() } else { a.sun_dir };
+        state.glare = (lerp(a.glare, b.glare) * sun.max(0.3)) as f32;
+        state.shadows.clear();
+        for (l, w) in [(a, 1.0 - f), (b, f)] {
+            state.shadows.extend(l.shadows.iter().filter(|_| w > 0.0).map(|s| {
+                let off = s.offset_m + s.amplitude_m * (std::f64::consts::TAU * t / s.period_s).sin();
+                let ang = s.angle_deg.to_radians();
+                ShadowBand {
+                    cos: ang.cos() as f32,
+                    sin: ang.sin() as f32,
+                    offset: off as f32,
+                    softness: s.softness_m as f32,
+                    strength: (s.strength * w) as f32,
+                }
+            }));
+        }
+        state.flashers.clear();
     }
 
     /// Delays the session clock by `s` seconds (e.g. hours asleep between imprint and dock).
@@ -451,6 +532,10 @@ impl LightingRun {
     /// Writes the state at run time `t` (s) into `state`, reusing its lists (the
     /// simulator calls this every tick without allocating).
     pub fn fill(&self, t: f64, state: &mut LightState) {
+        if let Some(d) = &self.drift {
+            Self::fill_drift(d, t, state);
+            return;
+        }
         let l = &self.lighting;
         let hours = (self.start_s + t) / 3600.0;
         let level = (l.intensity * (1.0 + l.change_per_hour * hours)).max(0.02 * l.intensity);
@@ -494,6 +579,18 @@ impl LightingRun {
     /// True when the robot's own shadow should be cast on the target.
     pub fn self_shadow(&self) -> bool {
         self.lighting.self_shadow
+    }
+
+    /// True when the robot's own shadow should be cast on the target at time `t`: the
+    /// programme's setting, or, drifting, the nearer keyframe's.
+    pub fn self_shadow_at(&self, t: f64) -> bool {
+        match &self.drift {
+            None => self.lighting.self_shadow,
+            Some(d) => {
+                let (a, b, f) = Self::drift_at(d, t);
+                if f < 0.5 { a.self_shadow } else { b.self_shadow }
+            }
+        }
     }
 }
 
@@ -602,5 +699,42 @@ impl LightState {
     /// Mean scene level (for tests).
     pub fn level(&self) -> f32 {
         self.level
+    }
+}
+
+#[cfg(test)]
+mod drift_tests {
+    use super::*;
+
+    fn preset(p: LightingPreset) -> Lighting {
+        LightingSpec {
+            preset: Some(p),
+            ..Default::default()
+        }
+        .resolve()
+    }
+
+    #[test]
+    fn drift_passes_through_its_keyframes_and_interpolates_between() {
+        let keys = vec![
+            preset(LightingPreset::Dawn),
+            preset(LightingPreset::Noon),
+            preset(LightingPreset::Dusk),
+        ];
+        let run = LightingRun::drifting(keys.clone(), 1000.0);
+        let level = |t: f64| f64::from(run.at(t).level());
+        for (t, k) in [(0.0, 0), (500.0, 1), (1000.0, 2), (5000.0, 2)] {
+            assert!((level(t) - keys[k].intensity).abs() < 1e-6, "t {t}: {}", level(t));
+        }
+        // Geometric between dawn (0.4) and noon (3.0): their geometric mean halfway.
+        assert!((level(250.0) - (0.4f64 * 3.0).sqrt()).abs() < 1e-6);
+        // The sun direction stays a unit vector, between the two keyframes' elevations.
+        let (dir, _) = run.at(250.0).sun();
+        assert!((dir.norm() - 1.0).abs() < 1e-9);
+        assert!(dir.z > keys[0].sun_dir.z && dir.z < keys[1].sun_dir.z);
+        // Noon's shadow band fades in: half strength a quarter of the way.
+        let s = run.at(250.0);
+        assert_eq!(s.shadows_for(super::super::scene::Tag::Target).len(), 1);
+        assert!((s.shadows_for(super::super::scene::Tag::Target)[0].strength - 0.35).abs() < 1e-6);
     }
 }

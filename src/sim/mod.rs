@@ -45,6 +45,7 @@ pub enum SimError {
 pub mod bins;
 pub mod campaign;
 pub mod dock;
+pub mod endurance;
 pub mod engine;
 pub mod faults;
 pub mod motion;

@@ -61,7 +61,7 @@ impl Recording<'_> {
     /// A last trace line when the simulator, not the behavior, ended the mission: the
     /// plates closed (`docked`), the robot caught the entrance (`stuck_contact`), or time
     /// ran out (`timeout`), or it drove into an obstacle (`collision`).
-    fn end(&mut self, mission: &'static str, t: f64, end: &PhaseEnd, mcap: &mut Option<McapRecorder>) {
+    pub(super) fn end(&mut self, mission: &'static str, t: f64, end: &PhaseEnd, mcap: &mut Option<McapRecorder>) {
         let what = match end {
             PhaseEnd::Docked => "docked",
             PhaseEnd::Stuck { .. } => "stuck_contact",
@@ -145,17 +145,17 @@ impl Recording<'_> {
 }
 
 /// The simulated robot and the loop that drives it through one run.
-struct Rig {
-    sim: SimRobot,
-    robot: Robot,
-    lp: ReactiveLoop<dyn Agent>,
-    step: Lockstep,
+pub(super) struct Rig {
+    pub(super) sim: SimRobot,
+    pub(super) robot: Robot,
+    pub(super) lp: ReactiveLoop<dyn Agent>,
+    pub(super) step: Lockstep,
 }
 
 impl Rig {
     /// Runs the mission just begun until the behavior reports an outcome, the robot docks
     /// or catches the entrance edge, or `max_s` of simulated time pass.
-    fn run(
+    pub(super) fn run(
         &mut self,
         mission: &'static str,
         max_s: f64,
@@ -238,7 +238,10 @@ fn simulation(p: &Prepared, spec: &RunSpec, pair: &mut Rng) -> (Sim, LightingRun
 /// Puts the robot where a departure starts: in the dock, or, for an open dock (a target
 /// on the ground), 1 cm outside the socket's mouth zone, where the dock judge would count
 /// it as docked again.
-fn place_docked(s: &mut Sim) {
+/// Where a robot sits docked, and whether that is inside a closed dock's pouch: in the
+/// dock, or, for an open dock (a target on the ground), 1 cm outside the socket's mouth
+/// zone, where the dock judge would count it as docked again.
+pub(super) fn docked_pose(s: &Sim) -> (Pose2, bool) {
     let dock = s.world().dock;
     let length = s.profile().body.length_m;
     let at = if dock.open {
@@ -246,7 +249,13 @@ fn place_docked(s: &mut Sim) {
     } else {
         Pose2::new(-dock.depth + length / 2.0, 0.0, 0.0)
     };
-    s.place(at, !dock.open);
+    (at, !dock.open)
+}
+
+/// Puts the robot where a departure starts ([`docked_pose`]).
+pub(super) fn place_docked(s: &mut Sim) {
+    let (at, inside) = docked_pose(s);
+    s.place(at, inside);
 }
 
 /// The simulated robot of run `spec` (its lighting, sensor, terrain and seed), docked and
@@ -392,7 +401,7 @@ pub fn run_one(
 }
 
 /// The run's `runs.jsonl` line, from the simulator's ground truth.
-fn record(spec: &RunSpec, sim: &Sim, end: PhaseEnd, imprinted: Option<bool>, manoeuvres: u32) -> RunRecord {
+pub(super) fn record(spec: &RunSpec, sim: &Sim, end: PhaseEnd, imprinted: Option<bool>, manoeuvres: u32) -> RunRecord {
     let s = &spec.start;
     let success = sim.docked();
     let outcome = match end {
@@ -404,7 +413,7 @@ fn record(spec: &RunSpec, sim: &Sim, end: PhaseEnd, imprinted: Option<bool>, man
         PhaseEnd::Collision { .. } => "collision".to_string(),
         PhaseEnd::Timeout => "timeout".to_string(),
     };
-    let time_s = sim.time();
+    let time_s = sim.mission_time();
     let path_m = sim.path_m;
     RunRecord {
         index: spec.index,
@@ -441,6 +450,12 @@ fn record(spec: &RunSpec, sim: &Sim, end: PhaseEnd, imprinted: Option<bool>, man
         fault_as_expected: None,
         stale_motion_ticks: None,
         safe_stop_s: None,
+        cycle: None,
+        outing_clock_s: None,
+        odometry_error_m: None,
+        odometry_error_deg: None,
+        excursion_reached: None,
+        carried_back: None,
         track: sim
             .track
             .iter()

@@ -307,6 +307,41 @@ pub struct BallisticSpec {
     pub heading_error_deg: f64,
 }
 
+/// `[endurance]`: the campaign is one continuous outing of `cycles` departure → dock
+/// cycles with one robot, nothing reset between them ([`super::endurance`]). Each cycle
+/// the robot departs from the dock (undocking and imprinting, as a campaign run's
+/// departure), drives itself to a start drawn from `[starts]` (the excursion: a simple
+/// waypoint driver standing in for the daughter's own mission away from the mother),
+/// then docks from there. The light drifts through `lighting` over `day_s` of the
+/// outing's clock.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnduranceSpec {
+    /// Departure → dock cycles in the outing.
+    pub cycles: usize,
+    /// Lighting programmes the outing's light drifts through, evenly spaced over `day_s`
+    /// (preset names or keys of `[lighting.NAME]`, without flashers or clouds): e.g.
+    /// `["dawn", "noon", "dusk"]`. Replaces the `axes.lighting` axis.
+    pub lighting: Vec<String>,
+    /// Simulated seconds over which the light goes from the first programme to the last
+    /// (it stays at the last after): set it near the outing's length.
+    pub day_s: f64,
+    /// The excursion driver's cruising speed, m/s (default 0.15).
+    #[serde(default = "default_excursion_speed")]
+    pub excursion_speed_mps: f64,
+    /// Longest excursion, s (default 120): a robot not at its start by then docks from
+    /// where it is.
+    #[serde(default = "default_excursion_timeout")]
+    pub excursion_timeout_s: f64,
+}
+
+fn default_excursion_speed() -> f64 {
+    0.15
+}
+fn default_excursion_timeout() -> f64 {
+    120.0
+}
+
 /// `[record]`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
@@ -384,6 +419,10 @@ pub struct Scenario {
     /// Empty: no faults, and the campaign is what it was without the table.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub faults: Vec<super::faults::FaultSpec>,
+    /// An endurance outing instead of independent runs ([`EnduranceSpec`]). Absent: the
+    /// campaign is what it was without the table.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub endurance: Option<EnduranceSpec>,
 }
 
 fn one() -> u32 {
@@ -549,6 +588,9 @@ impl Validate for Scenario {
         v.positive("motion.accel_mps2", self.motion.accel_mps2);
         v.positive("motion.yaw_accel_dps2", self.motion.yaw_accel_dps2);
         v.non_negative("motion.slip_scale", self.motion.slip_scale);
+        if let Some(e) = &self.endurance {
+            self.validate_endurance(e, v);
+        }
         for (i, c) in self.clutter.iter().enumerate() {
             v.finite(&format!("clutter[{i}].x_m"), c.x_m);
             v.finite(&format!("clutter[{i}].y_m"), c.y_m);
@@ -642,6 +684,69 @@ fn load_patched(profile_file: &Path, patch: &toml::Table, scenario_file: &Path) 
 }
 
 impl Scenario {
+    /// The checks of an `[endurance]` table: one outing needs one robot under one set of
+    /// conditions, so every campaign axis has a single value.
+    fn validate_endurance(&self, e: &EnduranceSpec, v: &mut Validator<'_>) {
+        v.require((1..=10_000).contains(&e.cycles), "endurance.cycles", || {
+            format!("expected 1 to 10000 cycles, got {}", e.cycles)
+        });
+        v.positive("endurance.day_s", e.day_s);
+        v.positive("endurance.excursion_speed_mps", e.excursion_speed_mps);
+        v.positive("endurance.excursion_timeout_s", e.excursion_timeout_s);
+        v.require(!e.lighting.is_empty(), "endurance.lighting", || {
+            "expected at least one lighting programme, e.g. [\"dawn\", \"noon\", \"dusk\"]".into()
+        });
+        for (i, name) in e.lighting.iter().enumerate() {
+            let path = format!("endurance.lighting[{i}]");
+            if !(self.lighting.contains_key(name) || preset_named(name).is_some()) {
+                v.problem(
+                    &path,
+                    format!("unknown lighting `{name}`: expected a preset (lab, noon, dusk, dawn) or a [lighting.{name}] table"),
+                );
+                continue;
+            }
+            let l = self.lighting_named(name);
+            v.require(l.flashers.is_empty() && l.clouds.is_none(), &path, || {
+                format!("`{name}` has flashers or clouds, which an outing's light cannot drift: expected a programme without them")
+            });
+        }
+        v.require(self.trials == 1, "trials", || {
+            format!(
+                "an endurance outing runs `endurance.cycles` cycles: expected trials = 1, got {}",
+                self.trials
+            )
+        });
+        v.require(self.axes.lighting == default_lighting(), "axes.lighting", || {
+            "an endurance outing is lit by `endurance.lighting`: leave axes.lighting out".into()
+        });
+        for (field, n) in [
+            ("axes.segmentation", self.axes.segmentation.len()),
+            ("axes.terrain", self.axes.terrain.len()),
+        ] {
+            v.require(n == 1, field, || {
+                format!("one robot makes an endurance outing: expected one value, got {n}")
+            });
+        }
+        v.require(self.axes.fiducial_colors.is_none(), "axes.fiducial_colors", || {
+            "one robot makes an endurance outing under one paint: leave axes.fiducial_colors out".into()
+        });
+        v.require(self.faults.is_empty(), "faults", || {
+            "faults are not injected into endurance outings: leave [[faults]] out".into()
+        });
+        v.require(!self.ballistic.enabled, "ballistic.enabled", || {
+            "an endurance outing docks from its excursion without an a-priori dock pose: expected false".into()
+        });
+        v.require(self.imprint.enabled, "imprint.enabled", || {
+            "each endurance cycle starts with the departure: expected true".into()
+        });
+        v.require(self.imprint.lighting.is_none(), "imprint.lighting", || {
+            "an endurance outing departs under the outing's light: leave imprint.lighting out".into()
+        });
+        v.require(self.imprint.sleep_s == 0.0, "imprint.sleep_s", || {
+            "an endurance outing's clock is its own: expected 0".into()
+        });
+    }
+
     /// Loads and validates a scenario and the profile it names (with its
     /// `[profile_patch]`, if any).
     ///
@@ -848,6 +953,9 @@ impl Scenario {
     /// seed (the same placement error and lighting draw), so colour pairs are compared
     /// on the same runs, as segmentation modes are.
     pub fn runs(&self, profile: &Profile) -> Vec<RunSpec> {
+        if let Some(e) = &self.endurance {
+            return self.cycles(e, profile);
+        }
         let mut out = Vec::new();
         let colours = self.fiducial_color_values();
         for (si, start) in self.starts(profile).into_iter().enumerate() {
@@ -884,6 +992,49 @@ impl Scenario {
             }
         }
         out
+    }
+
+    /// The cycles of an endurance outing, as runs: cycle `i` is run `i`, its start drawn
+    /// uniformly from the scenario's starts (seeded by the scenario's seed), its lighting
+    /// label the drift's programmes joined by `→`.
+    fn cycles(&self, e: &EnduranceSpec, profile: &Profile) -> Vec<RunSpec> {
+        let starts = self.starts(profile);
+        if starts.is_empty() {
+            return Vec::new();
+        }
+        let mut rng = Rng::named(self.seed, "endurance_starts");
+        let lighting = e.lighting.join("→");
+        let segmentation = self
+            .axes
+            .segmentation
+            .first()
+            .copied()
+            .unwrap_or(SegmentationMode::Adaptive);
+        let terrain = self.axes.terrain.first().copied().unwrap_or(Terrain::LabFloor);
+        (0..e.cycles)
+            .map(|index| {
+                let k = ((rng.uniform() * starts.len() as f64) as usize).min(starts.len() - 1);
+                let seed = super::rng::splitmix64(self.seed ^ super::rng::splitmix64(index as u64 + 1));
+                RunSpec {
+                    index,
+                    start: starts[k].clone(),
+                    lighting: lighting.clone(),
+                    segmentation,
+                    terrain,
+                    fiducial_colors: None,
+                    fault: None,
+                    trial: 0,
+                    seed,
+                    pair_seed: seed,
+                }
+            })
+            .collect()
+    }
+
+    /// The seed of an endurance outing's one simulation (its physics, rendering and
+    /// odometry noise).
+    pub fn outing_seed(&self) -> u64 {
+        super::rng::splitmix64(self.seed ^ 0xE4D0_2A4C)
     }
 
     /// The values of the faults axis: each `[[faults]]` index, or one "no fault".

@@ -10,14 +10,18 @@
 
 use super::memory::Memory;
 use crate::arbiter::Blackboard;
+use crate::geometry::Pose2;
 use crate::schemas::{Behavior, Inputs, Step};
 
 /// `raposa.depart`: see the module docs.
 pub struct Depart {
     name: String,
     mem: Blackboard<Memory>,
-    /// Where to stop, odometry frame (odometry starts at the docked pose).
-    target: (f64, f64),
+    /// Where to stop, straight ahead of where the departure began: m along the body.
+    travel: f64,
+    /// Odometry where the departure began (odometry is not reset between missions: on
+    /// a real robot, or an endurance outing, it reads wherever the last mission left it).
+    from: Pose2,
 }
 
 impl Depart {
@@ -33,7 +37,8 @@ impl Depart {
         Self {
             name: name.into(),
             mem,
-            target: (travel, 0.0),
+            travel,
+            from: Pose2::default(),
         }
     }
 }
@@ -43,11 +48,14 @@ impl Behavior for Depart {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+    fn enter(&mut self, _inputs: &Inputs<'_>) {
+        self.from = self.mem.lock().odo;
+    }
 
     fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
         let m = self.mem.lock();
-        Some(match m.ctrl.travel(&m.odo, self.target, false) {
+        let target = self.from.to_world(self.travel, 0.0);
+        Some(match m.ctrl.travel(&m.odo, target, false) {
             Some(t) => m.drive(t, "depart"),
             None => m.hold("depart").with_event("stopped"),
         })
