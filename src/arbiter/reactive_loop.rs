@@ -523,7 +523,9 @@ impl LoopCore {
                 status: LoopStatus::Finished { outcome },
             };
         }
-        self.repeats.observe(inputs, self.config.staleness.camera_repeats_stale);
+        // Frames are fingerprinted only where a repeat could stop the robot.
+        let frames = self.config.staleness.camera_repeats_stale && self.config.staleness.camera.is_some();
+        self.repeats.observe(inputs, frames);
         if let Some(reason) = self.check_inputs(inputs) {
             return self.enter_stop(reason, inputs.now);
         }

@@ -39,10 +39,9 @@ use super::SimError;
 use super::campaign::{self, AgentFactory, CampaignOptions, Prepared, RunRecord, Summary};
 use super::engine::{PhaseEnd, Sim};
 use super::lighting::LightingRun;
-use super::motion::Motion;
 use super::record::{McapRecorder, RecordOptions};
 use super::robot::SimRobot;
-use super::run::{Recording, Rig, docked_pose, record};
+use super::run::{Recording, Rig, docked_pose, jittered_start, motion_for, record};
 use super::scenario::{EnduranceSpec, RunSpec};
 use crate::arbiter::{Lockstep, ReactiveLoop};
 use crate::geometry::{Pose2, Twist, wrap_angle};
@@ -278,14 +277,7 @@ pub fn run_outing(
     let keys: Vec<_> = e.lighting.iter().map(|n| sc.lighting_named(n)).collect();
     let sensor = sc.sensor_params(&keys[0]);
     let light = LightingRun::drifting(keys, e.day_s);
-    let motion = Motion::new(
-        profile.drive.model(),
-        profile.drive.limits(),
-        sc.slip(first.terrain),
-        sc.motion.latency_s,
-        sc.motion.accel_mps2,
-        sc.motion.yaw_accel_dps2.to_radians(),
-    );
+    let motion = motion_for(sc, &profile, first.terrain);
     let (length, width) = (profile.body.length_m, profile.body.width_m);
     let config = profile.loop_config();
     let cameras = profile.cameras.clone();
@@ -393,17 +385,7 @@ fn cycle(
     };
     // 2. Excursion to the cycle's start, with the proctor's jitter as its spread.
     let mut draws = super::rng::Rng::named(spec.seed, "excursion");
-    let s = &spec.start;
-    let jx = draws.normal() * sc.starts.position_jitter_m;
-    let jy = draws.normal() * sc.starts.position_jitter_m;
-    let jt = draws.normal() * sc.starts.heading_jitter_deg.to_radians();
-    let dock = p.world_for(spec).dock;
-    let goal = super::dock::slid_clear(
-        &dock,
-        Pose2::new(s.pose.x + jx, s.pose.y + jy, s.pose.theta + jt),
-        length,
-        width,
-    );
+    let goal = jittered_start(sc, spec, &mut draws, &p.world_for(spec).dock, (length, width));
     let went = rig
         .sim
         .with(|sim| excursion(sim, goal, e.excursion_speed_mps, e.excursion_timeout_s));

@@ -294,6 +294,33 @@ mod tests {
     }
 
     #[test]
+    fn the_occluder_stands_in_the_line_of_sight() {
+        let scene = Scene::on_floor(Vec::new());
+        let camera = Point3::new(2.0, 1.0, 0.3);
+        let target = Point3::new(0.0, 0.0, 0.3);
+        let out = occluded(&scene, camera, target);
+        assert_eq!(out.prims.len(), 10);
+        // The tile at the camera's height holds the midpoint of the sight line, and
+        // its plane faces the camera.
+        let mid = Point3::from((camera.coords + target.coords) / 2.0);
+        let tile = out
+            .prims
+            .iter()
+            .find(|p| (p.shape.centre().z - 0.3).abs() <= 0.085)
+            .expect("a tile at eye height");
+        let Shape::Rect { centre, u, half, .. } = &tile.shape else {
+            panic!("tiles are rectangles")
+        };
+        let d = mid - centre;
+        assert!(d.dot(u).abs() < half[0] && d.z.abs() <= half[1] + 1e-9, "{d:?}");
+        assert!(u.dot(&(target - camera)).abs() < 1e-9, "faces the camera");
+        // 0.15–1.5 m from the camera, however far the target is.
+        let far = occluded(&scene, camera, Point3::new(-20.0, 1.0, 0.3));
+        let c = far.prims[0].shape.centre();
+        assert!(((c.x - camera.x).hypot(c.y - camera.y) - 1.5).abs() < 1e-9);
+    }
+
+    #[test]
     fn a_jump_stays_and_other_faults_end() {
         let mut f = FaultSpec {
             name: "x".into(),

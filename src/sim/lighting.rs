@@ -101,6 +101,23 @@ pub struct ShadowSpec {
     pub softness_m: f64,
 }
 
+impl ShadowSpec {
+    /// The band this shadow casts at session time `t` (its edge swung along its sine),
+    /// its strength scaled by `weight` (1 in a steady light; a keyframe's share in a
+    /// drifting one).
+    fn band_at(&self, t: f64, weight: f64) -> ShadowBand {
+        let off = self.offset_m + self.amplitude_m * (std::f64::consts::TAU * t / self.period_s).sin();
+        let a = self.angle_deg.to_radians();
+        ShadowBand {
+            cos: a.cos() as f32,
+            sin: a.sin() as f32,
+            offset: off as f32,
+            softness: self.softness_m as f32,
+            strength: (self.strength * weight) as f32,
+        }
+    }
+}
+
 /// Random cloud cover.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -497,17 +514,9 @@ impl LightingRun {
         state.glare = (lerp(a.glare, b.glare) * sun.max(0.3)) as f32;
         state.shadows.clear();
         for (l, w) in [(a, 1.0 - f), (b, f)] {
-            state.shadows.extend(l.shadows.iter().filter(|_| w > 0.0).map(|s| {
-                let off = s.offset_m + s.amplitude_m * (std::f64::consts::TAU * t / s.period_s).sin();
-                let ang = s.angle_deg.to_radians();
-                ShadowBand {
-                    cos: ang.cos() as f32,
-                    sin: ang.sin() as f32,
-                    offset: off as f32,
-                    softness: s.softness_m as f32,
-                    strength: (s.strength * w) as f32,
-                }
-            }));
+            state
+                .shadows
+                .extend(l.shadows.iter().filter(|_| w > 0.0).map(|s| s.band_at(t, w)));
         }
         state.flashers.clear();
     }
@@ -553,17 +562,7 @@ impl LightingRun {
         state.sun_dir = l.sun_dir;
         state.glare = (l.glare * sun.max(0.3)) as f32;
         state.shadows.clear();
-        state.shadows.extend(l.shadows.iter().map(|s| {
-            let off = s.offset_m + s.amplitude_m * (std::f64::consts::TAU * t / s.period_s).sin();
-            let a = s.angle_deg.to_radians();
-            ShadowBand {
-                cos: a.cos() as f32,
-                sin: a.sin() as f32,
-                offset: off as f32,
-                softness: s.softness_m as f32,
-                strength: s.strength as f32,
-            }
-        }));
+        state.shadows.extend(l.shadows.iter().map(|s| s.band_at(t, 1.0)));
         state.flashers.clear();
         state.flashers.extend(l.flashers.iter().map(|f| {
             let angle = std::f64::consts::TAU * t / f.period_s;

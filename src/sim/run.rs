@@ -204,6 +204,41 @@ impl Rig {
     }
 }
 
+/// The base's motion model on `terrain`: the profile's drive and limits, with the
+/// scenario's slip, latency and acceleration limits.
+pub(super) fn motion_for(sc: &Scenario, profile: &crate::profile::Profile, terrain: super::motion::Terrain) -> Motion {
+    Motion::new(
+        profile.drive.model(),
+        profile.drive.limits(),
+        sc.slip(terrain),
+        sc.motion.latency_s,
+        sc.motion.accel_mps2,
+        sc.motion.yaw_accel_dps2.to_radians(),
+    )
+}
+
+/// Where the robot really starts for `spec`: the nominal start plus the proctor's
+/// placement error (position and heading jitter drawn from `draws`), slid clear of the
+/// dock's body if the jitter pushed it in.
+pub(super) fn jittered_start(
+    sc: &Scenario,
+    spec: &RunSpec,
+    draws: &mut Rng,
+    dock: &super::world::DockGeometry,
+    (length, width): (f64, f64),
+) -> Pose2 {
+    let s = &spec.start;
+    let jx = draws.normal() * sc.starts.position_jitter_m;
+    let jy = draws.normal() * sc.starts.position_jitter_m;
+    let jt = draws.normal() * sc.starts.heading_jitter_deg.to_radians();
+    super::dock::slid_clear(
+        dock,
+        Pose2::new(s.pose.x + jx, s.pose.y + jy, s.pose.theta + jt),
+        length,
+        width,
+    )
+}
+
 /// The simulated world of run `spec`: its lighting (drawn from `pair`, the stream paired
 /// runs share), sensor, terrain, paints and seed, with the run's profile (its
 /// segmentation mode and paints).
@@ -215,14 +250,7 @@ fn simulation(p: &Prepared, spec: &RunSpec, pair: &mut Rng) -> (Sim, LightingRun
     let (lighting, draw) = sc.lighting_for_run(&spec.lighting, spec.pair_seed);
     let run_light = LightingRun::new(lighting.clone(), pair, sc.timeout_s + 120.0);
     let sensor = sc.sensor_params(&lighting);
-    let motion = Motion::new(
-        profile.drive.model(),
-        profile.drive.limits(),
-        sc.slip(spec.terrain),
-        sc.motion.latency_s,
-        sc.motion.accel_mps2,
-        sc.motion.yaw_accel_dps2.to_radians(),
-    );
+    let motion = motion_for(sc, &profile, spec.terrain);
     let sim = Sim::new(
         Arc::new(profile),
         Arc::clone(p.world_for(spec)),
@@ -341,17 +369,8 @@ pub fn run_one(
         rig.sim.with(|s| s.set_lighting(light, sensor));
     }
     // Placement with the proctor's error.
-    let s = &spec.start;
-    let jx = pair.normal() * sc.starts.position_jitter_m;
-    let jy = pair.normal() * sc.starts.position_jitter_m;
-    let jt = pair.normal() * sc.starts.heading_jitter_deg.to_radians();
     // `prepare` refused nominal starts inside the body; the jitter may still push one in.
-    let start = super::dock::slid_clear(
-        &dock,
-        Pose2::new(s.pose.x + jx, s.pose.y + jy, s.pose.theta + jt),
-        length,
-        width,
-    );
+    let start = jittered_start(sc, spec, &mut pair, &dock, (length, width));
     rig.sim.with(|sim| {
         sim.place(start, false);
         sim.set_fault(spec.fault.and_then(|i| sc.faults.get(i)).cloned());
