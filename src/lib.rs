@@ -50,6 +50,7 @@ pub mod geometry;
 #[cfg(feature = "image-io")]
 pub mod image_io;
 pub mod kinematics;
+mod panics;
 pub mod perception;
 pub mod profile;
 #[cfg(feature = "sim")]

@@ -1,10 +1,15 @@
 //! Regression inputs of the fuzzing work (`fuzz/`, issue 21 item 3), each pinned to the
 //! typed error (never a panic) the library gives for it. Crashing inputs the fuzz targets
-//! find go here. So far none has crashed (README, "Fuzzing"); what is here is the
-//! decompression-bomb guard that the image target's size bound is: before it, `load_rgb`
-//! had no bound of its own (only the `image` crate's 512 MiB allocation limit, reported as
-//! a decode error), so a 68-byte PNG declaring 8193 × 8192 pixels (200 MB as RGB8) went
-//! to the decoder.
+//! find go here:
+//! * an indexed PNG whose palette is not a whole number of RGB entries, which panicked
+//!   inside the `png` decoder (found by the image target in a 30 s CI run);
+//! * two MCAP files the replay target found: a record running past its chunk (a
+//!   subtraction overflow in the `mcap` reader) and a string declared longer than its
+//!   record (a 1.3 GB reservation), both now refused by `replay::preflight`;
+//! * the decompression-bomb guard that the image target's size bound is: before it,
+//!   `load_rgb` had no bound of its own (only the `image` crate's 512 MiB allocation
+//!   limit, reported as a decode error), so a 68-byte PNG declaring 8193 × 8192 pixels
+//!   (200 MB as RGB8) went to the decoder.
 
 mod common;
 
@@ -52,6 +57,61 @@ fn png_declaring(width: u32, height: u32) -> Vec<u8> {
     );
     chunk(&mut png, b"IEND", &[]);
     png
+}
+
+/// Adler-32, as zlib streams end with.
+fn adler32(bytes: &[u8]) -> u32 {
+    let (mut a, mut b) = (1u32, 0u32);
+    for &x in bytes {
+        a = (a + u32::from(x)) % 65_521;
+        b = (b + a) % 65_521;
+    }
+    (b << 16) | a
+}
+
+/// A 2 × 1 indexed (8-bit palette) PNG with the given `PLTE` bytes and pixel indices 0, 1;
+/// the pixel stream is one stored zlib block.
+fn indexed_png(palette: &[u8]) -> Vec<u8> {
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = Vec::new();
+    ihdr.extend_from_slice(&2u32.to_be_bytes());
+    ihdr.extend_from_slice(&1u32.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 3, 0, 0, 0]);
+    chunk(&mut png, b"IHDR", &ihdr);
+    chunk(&mut png, b"PLTE", palette);
+    let raw = [0u8, 0, 1]; // filter "none", then the two indices
+    let mut idat = vec![0x78, 0x01, 0x01, 3, 0, !3, 0xff];
+    idat.extend_from_slice(&raw);
+    idat.extend_from_slice(&adler32(&raw).to_be_bytes());
+    chunk(&mut png, b"IDAT", &idat);
+    chunk(&mut png, b"IEND", &[]);
+    png
+}
+
+#[test]
+fn a_palette_of_partial_entries_is_a_decode_error_not_a_decoder_panic() {
+    use marsupial::replay::pixels::{PixelError, rgb_from_compressed};
+    // Whole entries decode, through both decoders.
+    let good = indexed_png(&[10, 20, 30, 200, 150, 100]);
+    let im = decode_rgb(&good, Path::new("good.png"), DEFAULT_MAX_PIXELS).unwrap();
+    assert_eq!(im.as_bytes(), &[10, 20, 30, 200, 150, 100]);
+    assert_eq!(rgb_from_compressed("png", &good).unwrap().as_bytes(), im.as_bytes());
+    // 4, 5, 7 and 767 bytes: the decoder checks only 3..=768, then expanded the indices
+    // past the partial last entry.
+    for len in [4usize, 5, 7, 767] {
+        let palette: Vec<u8> = (0..len).map(|i| (i * 7) as u8).collect();
+        let png = indexed_png(&palette);
+        match decode_rgb(&png, Path::new("partial.png"), DEFAULT_MAX_PIXELS) {
+            Err(ImageFileError::Decode { reason, .. }) => {
+                assert!(reason.contains(&format!("PLTE chunk is {len} bytes")), "{reason}");
+            }
+            other => panic!("PLTE of {len} bytes: expected a decode error, got {other:?}"),
+        }
+        assert!(
+            matches!(rgb_from_compressed("png", &png), Err(PixelError::Decode { .. })),
+            "PLTE of {len} bytes through replay"
+        );
+    }
 }
 
 #[test]
@@ -134,32 +194,78 @@ fn a_compressed_frame_in_a_replayed_log_is_held_to_the_same_bound() {
     ));
 }
 
-#[test]
-fn a_malformed_log_that_panics_the_mcap_reader_is_a_typed_error() {
+/// Reads a replay fixture found by fuzzing and returns why `Log::from_bytes` refused it.
+fn refused_log(name: &str) -> marsupial::replay::preflight::Flaw {
     use marsupial::replay::ReplayError;
     use marsupial::replay::log::{Log, LogFault};
-    // Found by fuzzing the replay's decoding: the `mcap` reader (0.26) overflows a
-    // subtraction on this 1 KB file; `replay::log` contains it as a corrupt-log error.
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fuzz/replay-mcap-sub-overflow.mcap");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/fuzz")
+        .join(name);
     let bytes = std::fs::read(&path).unwrap();
-    let log = match Log::from_bytes(&path, bytes) {
-        Ok(log) => log,
-        Err(e) => {
-            assert!(matches!(e, ReplayError::Log { .. }), "{e}");
-            return;
+    match Log::from_bytes(&path, bytes) {
+        Err(ReplayError::Log {
+            fault: LogFault::Malformed(flaw),
+            ..
+        }) => flaw,
+        Err(e) => panic!("{name}: {e}"),
+        Ok(_) => panic!("{name}: read as a log"),
+    }
+}
+
+#[test]
+fn a_record_running_past_its_chunk_is_refused_before_the_mcap_reader_sees_it() {
+    use marsupial::replay::preflight::Flaw;
+    // Found by fuzzing the replay: on this 4.5 KB file the `mcap` reader (0.26) subtracts
+    // past zero (a panic with overflow checks, a wrapped count without them). It was
+    // first contained as a panic; the preflight now refuses the file by name.
+    let flaw = refused_log("replay-mcap-sub-overflow.mcap");
+    assert_eq!(
+        flaw,
+        Flaw::ChunkOverrun {
+            chunk: 33,
+            offset: 2867
         }
-    };
-    let topics: Vec<String> = log.topics().keys().cloned().collect();
-    let names: Vec<&str> = topics.iter().map(String::as_str).collect();
-    let faults: Vec<ReplayError> = log.messages(&names).filter_map(Result::err).collect();
-    assert!(
-        faults.iter().any(|e| matches!(
-            e,
-            ReplayError::Log {
-                fault: LogFault::Corrupt { .. },
-                ..
-            }
-        )),
-        "{faults:?}"
     );
+    assert!(flaw.to_string().contains("runs past the end of the chunk"), "{flaw}");
+}
+
+#[test]
+fn a_string_longer_than_its_record_is_refused_before_the_reader_reserves_it() {
+    use marsupial::replay::preflight::Flaw;
+    // Found by fuzzing the replay, each a schema record declaring a name of over 1 GB,
+    // which the reader reserved before finding the record too short: in the data
+    // section; inside a chunk the file ends in (the reader streams a chunk's records);
+    // in a summary behind a footer whose length field is garbage (the reader ignores it).
+    for (name, at, declared) in [
+        ("replay-mcap-string-reservation.mcap", 566, 1_347_440_720),
+        ("replay-mcap-string-in-cut-chunk.mcap", 78, 1_948_416_768),
+        ("replay-mcap-summary-behind-odd-footer.mcap", 986, 1_879_048_216),
+    ] {
+        match refused_log(name) {
+            Flaw::LongString {
+                offset,
+                opcode,
+                declared: d,
+                ..
+            } => assert_eq!((offset, opcode, d), (at, 0x03, declared), "{name}"),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn records_the_mcap_reader_would_overflow_or_slice_past_are_refused() {
+    use marsupial::replay::preflight::Flaw;
+    // Found by fuzzing the replay: a record length of u64::MAX (the reader adds the
+    // header's 9 bytes to it) and an attachment with no room for its CRC (the reader
+    // slices to 4 bytes before the end).
+    assert_eq!(
+        refused_log("replay-mcap-huge-record.mcap"),
+        Flaw::HugeRecord {
+            offset: 921,
+            declared: u64::MAX
+        }
+    );
+    let flaw = refused_log("replay-mcap-attachment-without-crc.mcap");
+    assert!(matches!(flaw, Flaw::ShortRecord { opcode: 0x09, .. }), "{flaw:?}");
 }

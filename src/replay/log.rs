@@ -3,7 +3,9 @@
 //!
 //! The file is read into memory whole (the `mcap` crate's reader works on a byte slice).
 //! A file that ends early (a robot that lost power while recording) gives every message
-//! before the cut, then [`ReplayError::Log`] with [`LogFault::Truncated`].
+//! before the cut, then [`ReplayError::Log`] with [`LogFault::Truncated`]. A record that
+//! declares a string longer than itself is refused before the reader sees the file
+//! ([`super::preflight`]), wherever it is.
 
 use super::ReplayError;
 use super::topics::{TopicInfo, Topics};
@@ -37,6 +39,10 @@ pub enum LogFault {
         /// The last message read before it, if any.
         after: Option<(String, u64)>,
     },
+    /// A record the reader must not be given (a string longer than its record, a record
+    /// running past its chunk), found before reading anything.
+    #[error("malformed file: {0}")]
+    Malformed(super::preflight::Flaw),
     /// Any other malformed record.
     #[error("malformed record{}: {why}", after_text(after))]
     Corrupt {
@@ -59,16 +65,9 @@ fn after_text(after: &Option<(String, u64)>) -> String {
 /// malformed records (found by fuzzing, `fuzz/fuzz_targets/replay.rs`), and a malformed
 /// file must give an error naming where it broke, never a panic.
 fn contained<T>(after: &Option<(String, u64)>, f: impl FnOnce() -> T) -> Result<T, LogFault> {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).map_err(|payload| {
-        let why = payload
-            .downcast_ref::<&str>()
-            .map(|s| (*s).to_owned())
-            .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "the MCAP reader failed".into());
-        LogFault::Corrupt {
-            why: format!("the MCAP reader gave up on it ({why})"),
-            after: after.clone(),
-        }
+    crate::panics::contain("the MCAP reader failed", f).map_err(|why| LogFault::Corrupt {
+        why: format!("the MCAP reader gave up on it ({why})"),
+        after: after.clone(),
     })
 }
 
@@ -131,6 +130,9 @@ impl Log {
             return Err(log_err(LogFault::NotMcap {
                 why: "no MCAP magic at the start".into(),
             }));
+        }
+        if let Some(flaw) = super::preflight::first_flaw(&bytes) {
+            return Err(log_err(LogFault::Malformed(flaw)));
         }
         let mut topics = Topics::new();
         let mut add = |c: &mcap::Channel<'_>| {

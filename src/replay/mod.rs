@@ -28,6 +28,7 @@ pub mod decode;
 pub mod foxglove;
 pub mod log;
 pub mod pixels;
+pub mod preflight;
 pub mod ros;
 pub mod session;
 pub mod topics;

@@ -162,6 +162,11 @@ pub fn rgb_from_compressed(format: &str, data: &[u8]) -> Result<RgbImage, PixelE
     if !matches!(kind, image::ImageFormat::Png | image::ImageFormat::Jpeg) {
         return Err(unsupported("a codec other than JPEG or PNG"));
     }
+    if kind == image::ImageFormat::Png
+        && let Some(why) = crate::image_io::png_palette_fault(data)
+    {
+        return Err(decode(why));
+    }
     // The header's size first, so a small message declaring a huge image (a
     // decompression bomb) is refused before anything is allocated; the decoder's own
     // allocations are bounded to match (16-bit RGBA, 8 bytes a pixel).
@@ -175,7 +180,9 @@ pub fn rgb_from_compressed(format: &str, data: &[u8]) -> Result<RgbImage, PixelE
     limits.max_alloc = Some(pixels.saturating_mul(8).max(1 << 20));
     let mut r = reader();
     r.limits(limits);
-    let img = r.decode().map_err(|e| decode(e.to_string()))?;
+    let img = crate::panics::contain("no message", || r.decode())
+        .map_err(|why| decode(format!("the decoder failed on it ({why})")))?
+        .map_err(|e| decode(e.to_string()))?;
     use image::ColorType as C;
     if matches!(
         img.color(),

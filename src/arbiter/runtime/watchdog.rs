@@ -2,7 +2,6 @@
 //! rejecting commands, without the device threads allocating or the loop blocking.
 
 use crate::robot::DeviceId;
-use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Mutex;
 
 /// The call a device thread is inside, if any: which device and since when (run time, s).
@@ -43,13 +42,7 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
 
 /// Runs a device call, turning a panic inside the driver into its message.
 pub(super) fn guarded<R>(f: impl FnOnce() -> R) -> Result<R, String> {
-    catch_unwind(AssertUnwindSafe(f)).map_err(|payload| {
-        payload
-            .downcast_ref::<&str>()
-            .map(|s| (*s).to_owned())
-            .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "a panic with no message".to_owned())
-    })
+    crate::panics::contain("a panic with no message", f)
 }
 
 /// The actuators' record of rejected commands, kept by the actuator thread and read by the
