@@ -126,6 +126,33 @@ fn a_run_records_every_channel_and_the_frames_byte_for_byte() {
         .collect();
     assert!(log[0].starts_with("run 0 of short"), "{log:?}");
     assert!(log.last().unwrap().contains(&record.outcome), "{log:?}");
+    // And the library's own `tracing` events of the run (the arbiters' and the loop's),
+    // under their targets, at debug level and above.
+    let traced: Vec<(String, u64, String)> = topics["/log"]
+        .2
+        .iter()
+        .map(|b| json(b))
+        .filter(|l| l["name"] != "marsupial::sim")
+        .map(|l| {
+            (
+                l["name"].as_str().unwrap().to_string(),
+                l["level"].as_u64().unwrap(),
+                l["message"].as_str().unwrap().to_string(),
+            )
+        })
+        .collect();
+    assert!(
+        traced.iter().any(|(name, level, message)| name == "marsupial::arbiter"
+            && *level == 1
+            && message.starts_with("sequencer transition arbiter=close_dock from=search to=approach")),
+        "{traced:?}"
+    );
+    assert!(
+        traced
+            .iter()
+            .all(|(name, level, _)| name.starts_with("marsupial::") && (1..=4).contains(level)),
+        "{traced:?}"
+    );
     // The trace is the --trace line; the command carries its twist.
     let first = json(&topics["/trace"].2[0]);
     assert_eq!(first["mission"], "docking");

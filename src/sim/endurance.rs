@@ -328,6 +328,8 @@ pub fn run_outing(
             }
             None => None,
         };
+        // The cycle's `tracing` events go to its recording's `/log` too.
+        let _tracing = mcap.as_ref().map(McapRecorder::capture_tracing);
         let cycle = cycle(&mut rig, p, spec, e, origin, (length, width), r, &mut mcap)?;
         let mut record = cycle;
         if !record.success {

@@ -345,6 +345,8 @@ pub fn run_one(
         }
         None => None,
     };
+    // The run's `tracing` events go to the recording's `/log` too, until the run returns.
+    let _tracing = mcap.as_ref().map(McapRecorder::capture_tracing);
     // Departure: undock and imprint (paired runs share it through `pair`).
     let mut imprinted = None;
     if sc.imprint.enabled && rig.lp.begin(&Mission::Departure).is_ok() {

@@ -17,7 +17,7 @@
 //! | `/odometry` | `foxglove.PoseInFrame` | the odometry pose, frame `odom` |
 //! | `/ground_truth` | `foxglove.PoseInFrame` | the true pose, frame `dock` |
 //! | `/tf` | `foxglove.FrameTransform` | `dock`→`base_link` (truth) each tick; `dock`→`odom` and `base_link`→`camI` when a mission starts |
-//! | `/log` | `foxglove.Log` | the run's start, missions, the world's verdicts, device faults and the outcome |
+//! | `/log` | `foxglove.Log` | the run's start, missions, the world's verdicts, device faults and the outcome; and, while [`McapRecorder::capture_tracing`]'s guard lives, every `tracing` event at debug level or above on the run's thread ([`tracing_log`]), at the time of the tick it happened in |
 //!
 //! The `dock` frame is the dock's: origin at the entrance, +x out of it. The percept and
 //! colour ranges are recorded only when the agent exposes them ([`Agent::observe`]).
@@ -31,6 +31,7 @@ pub mod annotations;
 pub mod base64;
 pub mod messages;
 pub mod schemas;
+pub mod tracing_log;
 
 use super::run::TraceLine;
 use crate::geometry::Pose2;
@@ -161,6 +162,8 @@ pub struct McapRecorder {
     /// The image message being built (see [`McapRecorder::image`]).
     image: Vec<u8>,
     jpeg: Vec<u8>,
+    /// `tracing` events not yet written ([`McapRecorder::capture_tracing`]).
+    captured: tracing_log::Captures,
     error: Option<RecordError>,
 }
 
@@ -255,8 +258,35 @@ impl McapRecorder {
             buf: Vec::with_capacity(1 << 16),
             image: Vec::new(),
             jpeg: Vec::new(),
+            captured: tracing_log::Captures::default(),
             error: None,
         })
+    }
+
+    /// Copies the `tracing` events of this thread (debug level and above) to `/log` until
+    /// the guard drops, while still handing them to the subscriber that was current.
+    /// Each is written at the time of the next tick recorded (or at the end).
+    pub fn capture_tracing(&self) -> tracing::dispatcher::DefaultGuard {
+        tracing_log::Capture::install(self.captured.clone())
+    }
+
+    /// Writes the captured `tracing` events at `ns`.
+    fn flush_captured(&mut self, ns: u64) {
+        let lines = std::mem::take(&mut *self.captured.lock().unwrap_or_else(|e| e.into_inner()));
+        for c in &lines {
+            self.put_json(
+                self.ch.log,
+                ns,
+                &Log {
+                    timestamp: Time::from_ns(ns),
+                    level: c.level,
+                    message: &c.message,
+                    name: &c.target,
+                    file: "",
+                    line: 0,
+                },
+            );
+        }
     }
 
     /// The file being written.
@@ -325,6 +355,7 @@ impl McapRecorder {
     /// Records one tick.
     pub fn tick(&mut self, s: &TickSample<'_>) {
         let ns = self.ns(s.t);
+        self.flush_captured(ns);
         let stamp = Time::from_ns(ns);
         self.started = true;
         if std::mem::take(&mut self.mission_start) {
@@ -547,6 +578,7 @@ impl McapRecorder {
     /// # Errors
     /// The first [`RecordError`] met while recording, or one closing the file.
     pub fn finish(mut self) -> Result<(), RecordError> {
+        self.flush_captured(self.last_ns);
         if let Some(e) = self.error.take() {
             return Err(e);
         }
