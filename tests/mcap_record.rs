@@ -40,7 +40,13 @@ fn read(path: &Path) -> Topics {
         );
         last = last.max(m.log_time);
         let schema = m.channel.schema.as_ref().unwrap();
-        assert_eq!(schema.encoding, "jsonschema");
+        // Raw frames are ROS 2 CDR; everything else is JSON.
+        let expected = if schema.name == "sensor_msgs/msg/Image" {
+            "ros2msg"
+        } else {
+            "jsonschema"
+        };
+        assert_eq!(schema.encoding, expected);
         let e = topics
             .entry(m.channel.topic.clone())
             .or_insert_with(|| (schema.name.clone(), m.channel.message_encoding.clone(), Vec::new()));
@@ -79,7 +85,7 @@ fn a_run_records_every_channel_and_the_frames_byte_for_byte() {
         [
             ("/cam0/annotations", "foxglove.ImageAnnotations"),
             ("/cam0/calibration", "foxglove.CameraCalibration"),
-            ("/cam0/image", "foxglove.RawImage"),
+            ("/cam0/image", "sensor_msgs/msg/Image"),
             ("/colour_ranges", "marsupial.ColourRanges"),
             ("/command", "marsupial.MotorCommand"),
             ("/ground_truth", "foxglove.PoseInFrame"),
@@ -90,7 +96,9 @@ fn a_run_records_every_channel_and_the_frames_byte_for_byte() {
             ("/trace", "marsupial.TraceLine"),
         ]
     );
-    assert!(topics.values().all(|(_, enc, _)| enc == "json"));
+    for (topic, (_, enc, _)) in &topics {
+        assert_eq!(enc, if topic == "/cam0/image" { "cdr" } else { "json" }, "{topic}");
+    }
     // The summary a viewer seeks with: statistics, channels and chunk indexes.
     let bytes = std::fs::read(&file).unwrap();
     let summary = mcap::Summary::read(&bytes).unwrap().expect("a summary section");
@@ -167,28 +175,23 @@ fn a_run_records_every_channel_and_the_frames_byte_for_byte() {
             .as_array()
             .is_some_and(|r| r.len() == 2)
     );
-    // Frames: base64 rgb8, equal to the PNG the simulator saved for that tick.
+    // Frames: CDR rgb8, equal to the PNG the simulator saved for that tick, decoded by
+    // the replay's CDR reader (as a ROS 2 tool or Foxglove would read it).
     for k in [0, ticks / 2, ticks - 1] {
-        let im = json(&topics["/cam0/image"].2[k]);
-        assert_eq!(im["encoding"], "rgb8");
-        let (w, h) = (im["width"].as_u64().unwrap(), im["height"].as_u64().unwrap());
-        assert_eq!(im["step"].as_u64().unwrap(), w * 3);
-        let data = base64::engine::general_purpose::STANDARD
-            .decode(im["data"].as_str().unwrap())
-            .unwrap();
+        let im = marsupial::replay::cdr::decode_image(&topics["/cam0/image"].2[k]).unwrap();
+        assert_eq!((im.encoding, im.is_bigendian, im.header.frame_id), ("rgb8", 0, "cam0"));
+        let (w, h) = (u64::from(im.width), u64::from(im.height));
+        assert_eq!(u64::from(im.step), w * 3);
         let png = marsupial::image_io::load_rgb(&frames.join(format!("frame-{:05}-cam0.png", k + 1))).unwrap();
         assert_eq!((png.width() as u64, png.height() as u64), (w, h));
         assert!(
-            data == png.as_bytes(),
+            im.data == png.as_bytes(),
             "tick {k}: the recorded frame differs from the simulator's"
         );
     }
     // Timestamps: the simulation clock, 0.1 s per tick.
-    let im = json(&topics["/cam0/image"].2[3]);
-    assert_eq!(
-        (im["timestamp"]["sec"].as_u64(), im["timestamp"]["nsec"].as_u64()),
-        (Some(0), Some(300_000_000))
-    );
+    let im = marsupial::replay::cdr::decode_image(&topics["/cam0/image"].2[3]).unwrap();
+    assert_eq!(im.header.stamp.ns(), Some(300_000_000));
     // Calibration: the profile's pin-hole intrinsics.
     let cal = json(&topics["/cam0/calibration"].2[0]);
     assert_eq!(cal["K"].as_array().unwrap().len(), 9);

@@ -454,7 +454,7 @@ fn the_behavior_runs_open_loop_and_the_record_replays_the_same() {
         "the agent's own schema sees the painted flap"
     );
 
-    // The recording holds the frames, percepts and commands, in Foxglove's schemas …
+    // The recording holds the frames, percepts and commands …
     let bytes = std::fs::read(d.join("out.mcap")).unwrap();
     let mut counts = BTreeMap::<String, usize>::new();
     for m in mcap::MessageStream::new(&bytes).unwrap() {
@@ -465,7 +465,8 @@ fn the_behavior_runs_open_loop_and_the_record_replays_the_same() {
     assert_eq!(counts["/command"], 4);
     assert_eq!(counts["/odometry"], 4);
 
-    // … and replaying it (the Foxglove JSON path) gives the schema's percepts again.
+    // … and replaying it (frames as ROS 2 CDR, poses as Foxglove JSON) gives the schema's
+    // percepts again.
     // Its /ground_truth is a pose too: the odometry topic must be named.
     let mut o2 = opts(&d.join("out.mcap"));
     let e = run(&o2, &mut Vec::new()).unwrap_err().to_string();
@@ -480,7 +481,7 @@ fn the_behavior_runs_open_loop_and_the_record_replays_the_same() {
     let got: Vec<_> = of_kind(&lines, "frame").iter().map(|l| l["percept"].clone()).collect();
     // The recording's clock starts at its first frame, as the bag's did.
     assert_eq!(got, expected(&frames));
-    assert_eq!(of_kind(&lines, "summary")[0]["image_kind"], "foxglove_raw_image");
+    assert_eq!(of_kind(&lines, "summary")[0]["image_kind"], "ros_image");
 }
 
 /// `sensor_msgs/msg/Image`, 2×1 rgb8, assembled byte by byte (offsets from the start of

@@ -3,13 +3,13 @@
 //! [`EnduranceSpec`]).
 //!
 //! A campaign's runs each build a fresh robot and have the proctor place it; an outing
-//! builds one [`Sim`], one agent and one [`ReactiveLoop`] and keeps them. Odometry
-//! integrates from the docked pose the outing began at, with its slip error, for the
-//! whole outing; the agent keeps whatever it keeps across missions (the colour model's
-//! adaptation, the behavior's memory); the simulation's clock runs on, and the light
-//! drifts with it through the `[endurance] lighting` programmes
+//! builds one [`Sim`], one agent and one [`ReactiveLoop`](crate::arbiter::ReactiveLoop) and
+//! keeps them. Odometry integrates from the docked pose the outing began at, with its slip
+//! error, for the whole outing; the agent keeps whatever it keeps across missions (the
+//! colour model's adaptation, the behavior's memory); the simulation's clock runs on, and
+//! the light drifts with it through the `[endurance] lighting` programmes
 //! ([`LightingRun::drifting`]). Each mission is started the way a real robot's is,
-//! [`ReactiveLoop::begin`]. Each cycle:
+//! [`ReactiveLoop::begin`](crate::arbiter::ReactiveLoop::begin). Each cycle:
 //!
 //! 1. **Departure**: the dock lets go ([`Sim::release`]) and the robot undocks and
 //!    imprints, as a campaign run's departure does.
@@ -40,10 +40,8 @@ use super::campaign::{self, AgentFactory, CampaignOptions, Prepared, RunRecord, 
 use super::engine::{PhaseEnd, Sim};
 use super::lighting::LightingRun;
 use super::record::{McapRecorder, RecordOptions};
-use super::robot::SimRobot;
 use super::run::{Recording, Rig, docked_pose, jittered_start, motion_for, record};
 use super::scenario::{EnduranceSpec, RunSpec};
-use crate::arbiter::{Lockstep, ReactiveLoop};
 use crate::geometry::{Pose2, Twist, wrap_angle};
 use crate::schemas::{DriveCommand, Mission, Outcome, TetherCommand};
 use serde::{Deserialize, Serialize};
@@ -294,14 +292,7 @@ pub fn run_outing(
     let (home, inside) = docked_pose(&sim);
     sim.place(home, inside);
     let origin = home;
-    let sim = SimRobot::new(sim);
-    let robot = sim.robot(&p.devices).map_err(SimError::Unsupported)?;
-    let mut rig = Rig {
-        step: Lockstep::new(&robot, &config),
-        lp: ReactiveLoop::new(agent, config),
-        sim,
-        robot,
-    };
+    let mut rig = Rig::new(sim, p, agent, config)?;
     let rec_all = rec.recording;
     for spec in p.runs.iter().take(last.saturating_add(1)) {
         let mut blank = Recording::default();

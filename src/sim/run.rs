@@ -153,6 +153,27 @@ pub(super) struct Rig {
 }
 
 impl Rig {
+    /// The simulated robot behind the scenario's devices, driven by `agent` in a loop
+    /// of `config`, ticked in lockstep.
+    ///
+    /// # Errors
+    /// [`SimError::Unsupported`] when a device kind cannot be simulated.
+    pub(super) fn new(
+        sim: Sim,
+        p: &Prepared,
+        agent: Box<dyn Agent>,
+        config: crate::arbiter::LoopConfig,
+    ) -> Result<Self, SimError> {
+        let sim = SimRobot::new(sim);
+        let robot = sim.robot(&p.devices).map_err(SimError::Unsupported)?;
+        Ok(Self {
+            step: Lockstep::new(&robot, &config),
+            lp: ReactiveLoop::new(agent, config),
+            sim,
+            robot,
+        })
+    }
+
     /// Runs the mission just begun until the behavior reports an outcome, the robot docks
     /// or catches the entrance edge, or `max_s` of simulated time pass.
     pub(super) fn run(
@@ -311,15 +332,7 @@ pub fn run_one(
     let mut pair = Rng::new(spec.pair_seed);
     let (sim, run_light, sensor, draw) = simulation(p, spec, &mut pair);
     let (length, width) = (profile.body.length_m, profile.body.width_m);
-    let config = profile.loop_config();
-    let sim = SimRobot::new(sim);
-    let robot = sim.robot(&p.devices).map_err(SimError::Unsupported)?;
-    let mut rig = Rig {
-        step: Lockstep::new(&robot, &config),
-        lp: ReactiveLoop::new(agent, config),
-        sim,
-        robot,
-    };
+    let mut rig = Rig::new(sim, p, agent, profile.loop_config())?;
     let dock = p.world_for(spec).dock;
     let mut mcap = match rec.mcap {
         Some((path, opts)) => {

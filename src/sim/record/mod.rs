@@ -7,7 +7,7 @@
 //!
 //! | topic | schema | what |
 //! | --- | --- | --- |
-//! | `/camI/image` | `foxglove.RawImage` (`rgb8`), or `foxglove.CompressedImage` (JPEG) with [`RecordOptions::jpeg`] | every frame camera I delivered |
+//! | `/camI/image` | `sensor_msgs/msg/Image` (`rgb8`, ROS 2 CDR), or `foxglove.CompressedImage` (JPEG, JSON) with [`RecordOptions::jpeg`] | every frame camera I delivered |
 //! | `/camI/calibration` | `foxglove.CameraCalibration` | its pin-hole intrinsics, with each frame (pin-hole cameras only) |
 //! | `/camI/annotations` | `foxglove.ImageAnnotations` | the percept drawn over the frame: block boxes, centroids, pair box ([`annotations`]) |
 //! | `/percept` | `marsupial.Percept` (JSON) | the percept ([`Observation`]) |
@@ -133,9 +133,6 @@ struct Channels {
     log: u16,
 }
 
-/// Room for an image message's JSON header (it is right-aligned in it, after spaces).
-const IMAGE_HEADER: usize = 192;
-
 /// Gap between the departure's last message and the docking mission's clock, ns.
 const MISSION_GAP_NS: u64 = 100_000_000;
 
@@ -159,8 +156,6 @@ pub struct McapRecorder {
     mission_start: bool,
     mission: &'static str,
     buf: Vec<u8>,
-    /// The image message being built (see [`McapRecorder::image`]).
-    image: Vec<u8>,
     jpeg: Vec<u8>,
     /// `tracing` events not yet written ([`McapRecorder::capture_tracing`]).
     captured: tracing_log::Captures,
@@ -202,16 +197,22 @@ impl McapRecorder {
             let id = json(w, name, schema).map_err(&e)?;
             w.add_channel(id, topic, "json", &none).map_err(&e)
         };
-        let (image_name, image_schema) = if opts.jpeg {
-            ("foxglove.CompressedImage", schemas::COMPRESSED_IMAGE)
+        // Raw frames as ROS 2 `sensor_msgs/msg/Image` in CDR (no base64); JPEG frames as
+        // JSON `foxglove.CompressedImage`.
+        let image_schema = if opts.jpeg {
+            json(&mut w, "foxglove.CompressedImage", schemas::COMPRESSED_IMAGE)
         } else {
-            ("foxglove.RawImage", schemas::RAW_IMAGE)
-        };
+            w.add_schema("sensor_msgs/msg/Image", "ros2msg", schemas::ROS2_IMAGE.as_bytes())
+        }
+        .map_err(&e)?;
+        let image_encoding = if opts.jpeg { "json" } else { "cdr" };
         let mut cams = Vec::with_capacity(cameras.len());
         for (i, spec) in cameras.iter().enumerate() {
             let frame_id = format!("cam{i}");
             cams.push(CameraChannels {
-                image: channel(&mut w, &format!("/{frame_id}/image"), image_name, image_schema)?,
+                image: w
+                    .add_channel(image_schema, &format!("/{frame_id}/image"), image_encoding, &none)
+                    .map_err(&e)?,
                 calibration: channel(
                     &mut w,
                     &format!("/{frame_id}/calibration"),
@@ -256,7 +257,6 @@ impl McapRecorder {
             mission_start: true,
             mission: "",
             buf: Vec::with_capacity(1 << 16),
-            image: Vec::new(),
             jpeg: Vec::new(),
             captured: tracing_log::Captures::default(),
             error: None,
@@ -496,57 +496,66 @@ impl McapRecorder {
     /// Camera `i`'s frame as `foxglove.RawImage` or `foxglove.CompressedImage`, written
     /// by hand: the pixels go base64 straight into the reused buffer.
     fn image(&mut self, i: usize, ns: u64, frame: &RgbImage) {
+        if self.opts.jpeg {
+            self.jpeg_image(i, ns, frame);
+        } else {
+            self.raw_image(i, ns, frame);
+        }
+    }
+
+    /// A raw frame as a CDR `sensor_msgs/msg/Image` (`rgb8`): the pixels are copied once,
+    /// behind a header of a few dozen bytes.
+    fn raw_image(&mut self, i: usize, ns: u64, frame: &RgbImage) {
+        let t = Time::from_ns(ns);
+        let (w, h) = (frame.width(), frame.height());
+        let cam = &self.ch.cameras[i];
+        let id = cam.image;
+        let mut cdr = CdrWriter(std::mem::take(&mut self.buf));
+        cdr.0.clear();
+        cdr.0.extend_from_slice(&[0, 1, 0, 0]); // CDR, little-endian
+        cdr.u32(t.sec);
+        cdr.u32(t.nsec);
+        cdr.string(&cam.frame_id);
+        cdr.u32(h as u32);
+        cdr.u32(w as u32);
+        cdr.string("rgb8");
+        cdr.0.push(0); // is_bigendian
+        cdr.u32(3 * w as u32);
+        cdr.u32(frame.as_bytes().len() as u32);
+        cdr.0.extend_from_slice(frame.as_bytes());
+        self.buf = cdr.0;
+        self.put(id, ns);
+    }
+
+    fn jpeg_image(&mut self, i: usize, ns: u64, frame: &RgbImage) {
         use std::io::Write as _;
         let t = Time::from_ns(ns);
         let (w, h) = (frame.width(), frame.height());
         let cam = &self.ch.cameras[i];
         let id = cam.image;
         self.buf.clear();
-        let pixels: &[u8] = if self.opts.jpeg {
-            self.jpeg.clear();
-            let mut enc = image::codecs::jpeg::JpegEncoder::new_with_quality(
-                &mut self.jpeg,
-                self.opts.jpeg_quality.clamp(1, 100),
-            );
-            if let Err(e) = enc.encode(frame.as_bytes(), w as u32, h as u32, image::ExtendedColorType::Rgb8) {
-                self.error.get_or_insert(RecordError::Jpeg {
-                    path: self.path.clone(),
-                    why: e.to_string(),
-                });
-                self.writer = None;
-                return;
-            }
-            let _ = write!(
-                self.buf,
-                r#"{{"timestamp":{{"sec":{},"nsec":{}}},"frame_id":"{}","format":"jpeg","data":""#,
-                t.sec, t.nsec, cam.frame_id
-            );
-            &self.jpeg
-        } else {
-            let _ = write!(
-                self.buf,
-                r#"{{"timestamp":{{"sec":{},"nsec":{}}},"frame_id":"{}","width":{w},"height":{h},"encoding":"rgb8","step":{},"data":""#,
-                t.sec,
-                t.nsec,
-                cam.frame_id,
-                w * 3
-            );
-            frame.as_bytes()
-        };
-        // The message is [spaces | header | base64 | "}] in a buffer that keeps its length
-        // from frame to frame (JSON allows leading whitespace), so the base64 is encoded in
-        // place without zeroing 250 kB first.
-        let n = base64::encoded_len(pixels.len());
+        self.jpeg.clear();
+        let mut enc =
+            image::codecs::jpeg::JpegEncoder::new_with_quality(&mut self.jpeg, self.opts.jpeg_quality.clamp(1, 100));
+        if let Err(e) = enc.encode(frame.as_bytes(), w as u32, h as u32, image::ExtendedColorType::Rgb8) {
+            self.error.get_or_insert(RecordError::Jpeg {
+                path: self.path.clone(),
+                why: e.to_string(),
+            });
+            self.writer = None;
+            return;
+        }
+        let _ = write!(
+            self.buf,
+            r#"{{"timestamp":{{"sec":{},"nsec":{}}},"frame_id":"{}","format":"jpeg","data":""#,
+            t.sec, t.nsec, cam.frame_id
+        );
         let head = self.buf.len();
-        let pad = IMAGE_HEADER.max(head);
-        self.image.resize(pad + n + 2, b' ');
-        self.image[..pad - head].fill(b' ');
-        self.image[pad - head..pad].copy_from_slice(&self.buf);
-        let _ = base64::encode_into(pixels, &mut self.image[pad..pad + n]);
-        self.image[pad + n..].copy_from_slice(b"\"}");
-        std::mem::swap(&mut self.buf, &mut self.image);
+        let n = base64::encoded_len(self.jpeg.len());
+        self.buf.resize(head + n, 0);
+        let _ = base64::encode_into(&self.jpeg, &mut self.buf[head..]);
+        self.buf.extend_from_slice(b"\"}");
         self.put(id, ns);
-        std::mem::swap(&mut self.buf, &mut self.image);
     }
 
     /// Camera `i`'s pin-hole calibration (none for a fisheye camera).
@@ -597,4 +606,24 @@ impl McapRecorder {
 /// The inverse of a planar pose.
 fn inverse(p: &Pose2) -> Pose2 {
     p.relative(&Pose2::default())
+}
+
+/// Little-endian CDR (the encapsulation header written by the caller), aligned from the
+/// first byte after that header as ROS 2 aligns it.
+struct CdrWriter(Vec<u8>);
+
+impl CdrWriter {
+    fn u32(&mut self, v: u32) {
+        while !(self.0.len() - 4).is_multiple_of(4) {
+            self.0.push(0);
+        }
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+
+    /// A length (counting the NUL), the bytes and a NUL.
+    fn string(&mut self, s: &str) {
+        self.u32(s.len() as u32 + 1);
+        self.0.extend_from_slice(s.as_bytes());
+        self.0.push(0);
+    }
 }

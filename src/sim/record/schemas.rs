@@ -37,11 +37,16 @@ macro_rules! pose_schema {
     };
 }
 
-/// `foxglove.RawImage`: an uncompressed frame (`rgb8`).
-pub const RAW_IMAGE: &str = concat!(
-    r#"{"title":"foxglove.RawImage","type":"object","properties":{"timestamp":"#,
-    time_schema!(),
-    r#","frame_id":{"type":"string"},"width":{"type":"integer"},"height":{"type":"integer"},"encoding":{"type":"string"},"step":{"type":"integer"},"data":{"type":"string","contentEncoding":"base64"}}}"#
+/// `sensor_msgs/msg/Image` in ROS 2's message-definition format (`ros2msg`), with the
+/// definitions it uses after it as rosbag2 writes them: the raw frames' schema. Raw
+/// frames are CDR, not JSON: a JSON `foxglove.RawImage` carries its pixels as base64,
+/// a third larger and encoded every frame, which was most of what recording cost.
+pub const ROS2_IMAGE: &str = concat!(
+    "std_msgs/Header header\nuint32 height\nuint32 width\nstring encoding\nuint8 is_bigendian\nuint32 step\nuint8[] data\n",
+    "================================================================================\n",
+    "MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n",
+    "================================================================================\n",
+    "MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n",
 );
 
 /// `foxglove.CompressedImage`: a JPEG frame.
@@ -135,11 +140,20 @@ pub const COLOUR_RANGES: &str = r#"{"title":"marsupial.ColourRanges","type":"obj
 
 #[cfg(test)]
 mod tests {
+    /// The ROS 2 definition lists every type it uses, as rosbag2 writes them.
+    #[test]
+    fn the_image_definition_carries_its_dependencies() {
+        let parts: Vec<&str> = super::ROS2_IMAGE.split(&format!("{}\n", "=".repeat(80))).collect();
+        assert_eq!(parts.len(), 3);
+        assert!(parts[0].starts_with("std_msgs/Header header\n") && parts[0].ends_with("uint8[] data\n"));
+        assert!(parts[1].starts_with("MSG: std_msgs/Header\n"));
+        assert!(parts[2].starts_with("MSG: builtin_interfaces/Time\n"));
+    }
+
     /// Every schema is valid JSON with an object type.
     #[test]
     fn schemas_parse() {
         for s in [
-            super::RAW_IMAGE,
             super::COMPRESSED_IMAGE,
             super::CAMERA_CALIBRATION,
             super::IMAGE_ANNOTATIONS,
