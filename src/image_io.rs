@@ -93,30 +93,16 @@ pub fn decode_rgb(bytes: &[u8], file: &Path, max_pixels: u64) -> Result<RgbImage
         file: file.to_path_buf(),
         reason,
     };
-    let format = image::guess_format(bytes).map_err(|e| decode(e.to_string()))?;
-    if !matches!(format, image::ImageFormat::Png | image::ImageFormat::Jpeg) {
-        return Err(decode(format!("format {format:?} is not supported")));
-    }
-    if format == image::ImageFormat::Png {
-        png_palette_fault(bytes).map_or(Ok(()), |why| Err(decode(why)))?;
-    }
-    let reader = || image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
-    let (width, height) = reader().into_dimensions().map_err(|e| decode(e.to_string()))?;
-    if u64::from(width) * u64::from(height) > max_pixels {
-        return Err(ImageFileError::TooLarge {
+    let img = decode_bounded(bytes, |w, h| u64::from(w) * u64::from(h) <= max_pixels).map_err(|e| match e {
+        Refusal::Size { width, height } => ImageFileError::TooLarge {
             file: file.to_path_buf(),
             width,
             height,
             max_pixels,
-        });
-    }
-    let mut limits = image::Limits::default();
-    limits.max_alloc = Some(max_pixels.saturating_mul(8).max(1 << 20));
-    let mut r = reader();
-    r.limits(limits);
-    let img = crate::panics::contain("no message", || r.decode())
-        .map_err(|why| decode(format!("the decoder failed on it ({why})")))?
-        .map_err(|e| decode(e.to_string()))?;
+        },
+        Refusal::Format(format) => decode(format!("format {format:?} is not supported")),
+        Refusal::Decode(why) => decode(why),
+    })?;
     let rgb = img.to_rgb8();
     let (w, h) = rgb.dimensions();
     if w == 0 || h == 0 {
@@ -129,6 +115,51 @@ pub fn decode_rgb(bytes: &[u8], file: &Path, max_pixels: u64) -> Result<RgbImage
     RgbImage::from_raw(w as usize, h as usize, rgb.into_raw()).map_err(|e| decode(e.to_string()))
 }
 
+/// Why [`decode_bounded`] refused bytes.
+pub(crate) enum Refusal {
+    /// A codec other than PNG or JPEG.
+    Format(image::ImageFormat),
+    /// The header's size is not accepted; nothing was decoded.
+    Size {
+        /// Width the header declares.
+        width: u32,
+        /// Height the header declares.
+        height: u32,
+    },
+    /// Not a decodable image (the decoder's message).
+    Decode(String),
+}
+
+/// The one way the crate decodes PNG or JPEG bytes, for image files and for a replayed
+/// log's compressed frames: the codec from the bytes, then the header's size, which
+/// `accept(width, height)` must allow before anything is allocated (the guard against a
+/// decompression bomb), then the decode, its allocations bounded to match (8 bytes a
+/// pixel: 16-bit RGBA). A PNG whose palette would crash the decoder is refused first
+/// ([`png_palette_fault`]); any other panic inside the decoder is a [`Refusal::Decode`].
+pub(crate) fn decode_bounded(bytes: &[u8], accept: impl Fn(u32, u32) -> bool) -> Result<image::DynamicImage, Refusal> {
+    let format = image::guess_format(bytes).map_err(|e| Refusal::Decode(e.to_string()))?;
+    if !matches!(format, image::ImageFormat::Png | image::ImageFormat::Jpeg) {
+        return Err(Refusal::Format(format));
+    }
+    if format == image::ImageFormat::Png
+        && let Some(why) = png_palette_fault(bytes)
+    {
+        return Err(Refusal::Decode(why));
+    }
+    let reader = || image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
+    let (width, height) = reader().into_dimensions().map_err(|e| Refusal::Decode(e.to_string()))?;
+    if !accept(width, height) {
+        return Err(Refusal::Size { width, height });
+    }
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some((u64::from(width) * u64::from(height)).saturating_mul(8).max(1 << 20));
+    let mut r = reader();
+    r.limits(limits);
+    crate::panics::contain("no message", || r.decode())
+        .map_err(|why| Refusal::Decode(format!("the decoder failed on it ({why})")))?
+        .map_err(|e| Refusal::Decode(e.to_string()))
+}
+
 /// Why a PNG's palette would crash the decoder, if it would: a `PLTE` chunk whose length
 /// is not a multiple of three (the PNG specification, §11.2.3, requires whole RGB
 /// entries). The `png` decoder (0.18) checks only that the length is 3–768 bytes and
@@ -139,7 +170,7 @@ pub fn decode_rgb(bytes: &[u8], file: &Path, max_pixels: u64) -> Result<RgbImage
 /// Walks the whole chunk list from the signature (a palette after the pixel data is
 /// invalid too, but the decoder is not trusted to say so first); a list that ends early or declares a chunk
 /// past the end is left to the decoder to report.
-pub(crate) fn png_palette_fault(bytes: &[u8]) -> Option<String> {
+fn png_palette_fault(bytes: &[u8]) -> Option<String> {
     let mut at = 8usize;
     while let Some(header) = bytes.get(at..at.checked_add(8)?) {
         let len = u32::from_be_bytes([header[0], header[1], header[2], header[3]]) as usize;

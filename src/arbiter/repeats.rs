@@ -5,9 +5,9 @@
 //! holds, with a fresh timestamp each time. Staleness alone cannot see it: every reading
 //! looks new. The content can:
 //! * **Frames.** An image sensor's shot and read noise make two real exposures differ in
-//!   some pixel, even of a still scene (the simulator's sensor model, 1.5 levels of read
-//!   noise, never repeats a frame: `scenarios/bujold-faults.toml`'s fault-free stretches
-//!   raise no `Frozen` stop, `tests/golden`). A frame bit-identical
+//!   some pixel, even of a still scene (the simulator's sensor model adds read noise, and
+//!   `tests/sim_faults.rs` checks that whole docking runs without an input fault spend
+//!   under 0.2 s in safe stop with this check on). A frame bit-identical
 //!   to the one before is the same exposure again. The loop dates it from when that
 //!   content first arrived, so it ages, and the camera's staleness limit stops the robot
 //!   as it would for a silent camera. A noiseless synthetic camera (a test double, a

@@ -147,6 +147,7 @@ pub fn rgb_from_raw(width: u32, height: u32, encoding: &str, step: u32, data: &[
 /// [`PixelError::Unsupported`] for depth or 16-bit images and codecs other than JPEG and
 /// PNG, [`PixelError::Decode`] for bytes that do not decode.
 pub fn rgb_from_compressed(format: &str, data: &[u8]) -> Result<RgbImage, PixelError> {
+    use crate::image_io::Refusal;
     let unsupported = |why| PixelError::Unsupported {
         encoding: format.to_string(),
         why,
@@ -158,31 +159,20 @@ pub fn rgb_from_compressed(format: &str, data: &[u8]) -> Result<RgbImage, PixelE
         format: format.to_string(),
         why,
     };
-    let kind = image::guess_format(data).map_err(|e| decode(e.to_string()))?;
-    if !matches!(kind, image::ImageFormat::Png | image::ImageFormat::Jpeg) {
-        return Err(unsupported("a codec other than JPEG or PNG"));
-    }
-    if kind == image::ImageFormat::Png
-        && let Some(why) = crate::image_io::png_palette_fault(data)
-    {
-        return Err(decode(why));
-    }
     // The header's size first, so a small message declaring a huge image (a
-    // decompression bomb) is refused before anything is allocated; the decoder's own
-    // allocations are bounded to match (16-bit RGBA, 8 bytes a pixel).
-    let reader = || image::ImageReader::with_format(std::io::Cursor::new(data), kind);
-    let (w, h) = reader().into_dimensions().map_err(|e| decode(e.to_string()))?;
-    let pixels = u64::from(w) * u64::from(h);
-    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE || pixels > crate::image_io::DEFAULT_MAX_PIXELS {
-        return Err(PixelError::Size { width: w, height: h });
-    }
-    let mut limits = image::Limits::default();
-    limits.max_alloc = Some(pixels.saturating_mul(8).max(1 << 20));
-    let mut r = reader();
-    r.limits(limits);
-    let img = crate::panics::contain("no message", || r.decode())
-        .map_err(|why| decode(format!("the decoder failed on it ({why})")))?
-        .map_err(|e| decode(e.to_string()))?;
+    // decompression bomb) is refused before anything is allocated.
+    let accept = |w: u32, h: u32| {
+        w > 0
+            && h > 0
+            && w <= MAX_SIDE
+            && h <= MAX_SIDE
+            && u64::from(w) * u64::from(h) <= crate::image_io::DEFAULT_MAX_PIXELS
+    };
+    let img = crate::image_io::decode_bounded(data, accept).map_err(|e| match e {
+        Refusal::Format(_) => unsupported("a codec other than JPEG or PNG"),
+        Refusal::Size { width, height } => PixelError::Size { width, height },
+        Refusal::Decode(why) => decode(why),
+    })?;
     use image::ColorType as C;
     if matches!(
         img.color(),
