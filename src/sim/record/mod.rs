@@ -510,8 +510,8 @@ impl McapRecorder {
         let (w, h) = (frame.width(), frame.height());
         let cam = &self.ch.cameras[i];
         let id = cam.image;
-        let mut cdr = CdrWriter(std::mem::take(&mut self.buf));
-        cdr.0.clear();
+        self.buf.clear();
+        let mut cdr = CdrWriter(&mut self.buf);
         cdr.0.extend_from_slice(&[0, 1, 0, 0]); // CDR, little-endian
         cdr.u32(t.sec);
         cdr.u32(t.nsec);
@@ -523,7 +523,6 @@ impl McapRecorder {
         cdr.u32(3 * w as u32);
         cdr.u32(frame.as_bytes().len() as u32);
         cdr.0.extend_from_slice(frame.as_bytes());
-        self.buf = cdr.0;
         self.put(id, ns);
     }
 
@@ -610,9 +609,9 @@ fn inverse(p: &Pose2) -> Pose2 {
 
 /// Little-endian CDR (the encapsulation header written by the caller), aligned from the
 /// first byte after that header as ROS 2 aligns it.
-struct CdrWriter(Vec<u8>);
+struct CdrWriter<'a>(&'a mut Vec<u8>);
 
-impl CdrWriter {
+impl CdrWriter<'_> {
     fn u32(&mut self, v: u32) {
         while !(self.0.len() - 4).is_multiple_of(4) {
             self.0.push(0);
