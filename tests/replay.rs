@@ -979,3 +979,38 @@ fn replay_err_with(o: &ReplayOptions) -> (Vec<serde_json::Value>, ReplayError) {
         other => panic!("expected a replay error, got {other:?}"),
     }
 }
+
+#[test]
+fn a_directory_an_empty_file_and_a_pipe_are_read_not_mapped() {
+    // The log is mapped into memory; what cannot be mapped is read, and refused by name
+    // when it is not a log.
+    let d = tmp("unmappable");
+    let (_, e) = replay_err(&d);
+    assert!(matches!(&e, ReplayError::Io { path, .. } if path == &d), "{e:?}");
+    let empty = d.join("empty.mcap");
+    std::fs::write(&empty, b"").unwrap();
+    let (_, e) = replay_err(&empty);
+    assert!(e.to_string().contains("not an MCAP file"), "{e}");
+    // A bag through a pipe (a FIFO cannot be mapped) replays as the file does.
+    let bag = d.join("one.mcap");
+    small_bag(&bag, vec![good(0), good(1)]);
+    let fifo = d.join("fifo.mcap");
+    let _ = std::fs::remove_file(&fifo);
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        eprintln!("no mkfifo here; the pipe case is skipped");
+        return;
+    }
+    let bytes = std::fs::read(&bag).unwrap();
+    let writer = std::thread::spawn({
+        let fifo = fifo.clone();
+        move || std::fs::write(fifo, bytes).unwrap()
+    });
+    let (piped, r) = replay(&opts(&fifo));
+    writer.join().unwrap();
+    assert!(r.is_ok(), "{r:?}");
+    let (direct, r) = replay(&opts(&bag));
+    assert!(r.is_ok(), "{r:?}");
+    assert_eq!(of_kind(&piped, "frame"), of_kind(&direct, "frame"));
+    assert_eq!(of_kind(&direct, "frame").len(), 2);
+}

@@ -96,10 +96,30 @@ pub struct LogMessage<'a> {
     pub data: Cow<'a, [u8]>,
 }
 
-/// An MCAP log in memory, with its topics.
+/// A log's bytes: its file mapped into memory, or bytes handed in.
+///
+/// A mapped file is read page by page as the replay reaches it, and the kernel may drop
+/// pages already read, so a bag larger than the memory replays; it is never copied.
+enum LogBytes {
+    Mapped(memmap2::Mmap),
+    Owned(Vec<u8>),
+}
+
+impl std::ops::Deref for LogBytes {
+    type Target = [u8];
+
+    fn deref(&self) -> &[u8] {
+        match self {
+            LogBytes::Mapped(m) => m,
+            LogBytes::Owned(v) => v,
+        }
+    }
+}
+
+/// An MCAP log, mapped into memory, with its topics.
 pub struct Log {
     path: PathBuf,
-    bytes: Vec<u8>,
+    bytes: LogBytes,
     topics: Topics,
 }
 
@@ -109,12 +129,31 @@ impl Log {
     ///
     /// # Errors
     /// [`ReplayError::Io`], or [`ReplayError::Log`] when the file is not MCAP.
+    ///
+    /// The file is mapped into memory, not read: a log of any size opens at once and
+    /// costs only the pages the replay touches. It must not shrink while it is replayed
+    /// (a log another program is still cutting or rotating): reading a page that a
+    /// truncation took away ends the process with `SIGBUS`, as it would for any reader
+    /// that maps files (rosbag2's and Foxglove's among them).
     pub fn open(path: &Path) -> Result<Self, ReplayError> {
-        let bytes = std::fs::read(path).map_err(|source| ReplayError::Io {
+        let io = |source| ReplayError::Io {
             path: path.to_path_buf(),
             source,
-        })?;
-        Self::from_bytes(path, bytes)
+        };
+        let mut file = std::fs::File::open(path).map_err(io)?;
+        let meta = file.metadata().map_err(io)?;
+        if !meta.is_file() || meta.len() == 0 {
+            // A pipe cannot be mapped, so it is read (and a directory is refused by the
+            // read, by name).
+            let mut bytes = Vec::new();
+            std::io::Read::read_to_end(&mut file, &mut bytes).map_err(io)?;
+            return Self::from_log_bytes(path, LogBytes::Owned(bytes));
+        }
+        // SAFETY: the map is read-only and lives as long as `Log`. That its bytes do not
+        // change holds only while no other program writes to or truncates the file; the
+        // doc above makes that the caller's condition, as every reader that maps logs does.
+        let map = unsafe { memmap2::Mmap::map(&file) }.map_err(io)?;
+        Self::from_log_bytes(path, LogBytes::Mapped(map))
     }
 
     /// As [`Log::open`], for bytes already in memory (`path` names them in errors).
@@ -122,6 +161,10 @@ impl Log {
     /// # Errors
     /// [`ReplayError::Log`] when the bytes are not MCAP.
     pub fn from_bytes(path: &Path, bytes: Vec<u8>) -> Result<Self, ReplayError> {
+        Self::from_log_bytes(path, LogBytes::Owned(bytes))
+    }
+
+    fn from_log_bytes(path: &Path, bytes: LogBytes) -> Result<Self, ReplayError> {
         let log_err = |fault| ReplayError::Log {
             path: path.to_path_buf(),
             fault,
