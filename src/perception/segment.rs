@@ -276,6 +276,14 @@ impl Mask {
         self.data.resize(width * height, 0);
     }
 
+    /// Resizes (reusing the allocation when possible) without clearing what is kept: for
+    /// a caller that then writes every pixel, so that the frame is not written twice.
+    pub(crate) fn resize_for_overwrite(&mut self, width: usize, height: usize) {
+        self.width = width;
+        self.height = height;
+        self.data.resize(width * height, 0);
+    }
+
     /// Width in pixels.
     pub fn width(&self) -> usize {
         self.width

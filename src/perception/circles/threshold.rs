@@ -62,18 +62,23 @@ impl Thresholder {
         black: &mut Mask,
         white: &mut Mask,
     ) {
-        black.reset(width, height);
-        white.reset(width, height);
         if width == 0 || height == 0 || grey.len() != width * height {
+            black.reset(width, height);
+            white.reset(width, height);
             return;
         }
+        // Every pixel of both masks, and every entry of the integral image off its zero
+        // first row and column, is written below, so none is cleared first.
+        black.resize_for_overwrite(width, height);
+        white.resize_for_overwrite(width, height);
         let iw = width + 1;
-        self.integral.clear();
         self.integral.resize(iw * (height + 1), 0);
+        self.integral[..iw].fill(0);
         for y in 0..height {
             let mut row = 0u32;
             let (above, here) = self.integral.split_at_mut((y + 1) * iw);
             let above = &above[y * iw..];
+            here[0] = 0;
             for x in 0..width {
                 row += grey[y * width + x] as u32;
                 here[x + 1] = above[x + 1] + row;
@@ -158,7 +163,14 @@ mod tests {
             window_px: 5,
             offset: 3,
         };
-        Thresholder::new(w, h).apply(&grey, w, h, &p, &mut b, &mut wh);
+        // The buffers are reused, not cleared: first a larger frame and then a bright one
+        // of the same size leave every mask pixel and integral entry set before the frame
+        // checked.
+        let mut t = Thresholder::new(w, h);
+        let big: Vec<u8> = (0..40 * 30).map(|i| (i * 91 % 256) as u8).collect();
+        t.apply(&big, 40, 30, &p, &mut b, &mut wh);
+        t.apply(&vec![255; w * h], w, h, &p, &mut b, &mut wh);
+        t.apply(&grey, w, h, &p, &mut b, &mut wh);
         for y in 0..h {
             for x in 0..w {
                 let (mut s, mut n) = (0i64, 0i64);
