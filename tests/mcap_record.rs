@@ -242,7 +242,7 @@ fn the_same_run_records_the_same_file_and_jpeg_frames_decode() {
 }
 
 #[test]
-fn record_failed_keeps_only_the_failed_runs() {
+fn record_failed_keeps_only_the_failed_runs_recorded_as_they_ran() {
     // A scripted backer: on the axis it docks; 6 cm off it, it catches the entrance.
     let d = dir("failed");
     let s = common::scenario_file(
@@ -280,8 +280,12 @@ fn record_failed_keeps_only_the_failed_runs() {
         .map(|r| format!("run-{:05}.mcap", r.index))
         .collect();
     assert_eq!(failed, ["run-00001.mcap"], "{records:?}");
+    let recorded = std::fs::read(rec_dir.join(&failed[0])).unwrap();
     let (again, kept) = run(true);
     assert_eq!(kept, failed);
     assert_eq!(again, records, "recording changed the runs");
+    // The failed run, recorded by running it again, is the same file as when every run
+    // is recorded as it goes.
+    assert!(std::fs::read(rec_dir.join(&failed[0])).unwrap() == recorded);
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -244,7 +244,9 @@ pub struct TrialsOptions {
     /// index; see `dock --record`).
     #[arg(long, value_name = "DIR")]
     pub record_dir: Option<PathBuf>,
-    /// With --record-dir, keep only the recordings of failed runs.
+    /// With --record-dir, record only the failed runs: a run that fails is run again with
+    /// the recorder (runs are deterministic, so the file is that run's), and the runs that
+    /// dock cost nothing to record.
     #[arg(long, requires = "record_dir")]
     pub record_failed: bool,
     /// With --record-dir, store frames as JPEG instead of raw RGB.

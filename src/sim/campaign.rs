@@ -157,8 +157,8 @@ pub struct CampaignOptions {
 pub struct RecordRuns {
     /// The folder: run N goes to `DIR/run-NNNNN.mcap`.
     pub dir: PathBuf,
-    /// Keep only the recordings of failed runs (successful ones are deleted when they
-    /// end).
+    /// Record only the failed runs: each run goes unrecorded, and one that fails is run
+    /// again with the recorder (runs are deterministic), so docked runs cost nothing.
     pub failed_only: bool,
     /// How each run is recorded.
     pub options: RecordOptions,
@@ -716,22 +716,33 @@ pub fn run_campaign(
                     }
                     let every = p.loaded.scenario.record.frames_every;
                     let mcap = opts.record.as_ref().map(|r| r.path(spec.index));
+                    let to_mcap = opts.record.as_ref().zip(mcap.as_deref()).map(|(r, path)| (path, r.options));
+                    let failed_only = opts.record.as_ref().is_some_and(|r| r.failed_only);
                     let mut rec_opts = Recording {
                         frames: frames_dir.as_deref().map(|d| (d, every)),
                         trace: None,
-                        mcap: opts
-                            .record
-                            .as_ref()
-                            .zip(mcap.as_deref())
-                            .map(|(r, path)| (path, r.options)),
+                        mcap: to_mcap.filter(|_| !failed_only),
                     };
-                    let rec = run_one(p, spec, make_agent, &mut rec_opts);
-                    if let (Ok(r), Some(path), Some(record)) = (&rec, &mcap, &opts.record)
-                        && r.success
-                        && record.failed_only
-                        && let Err(e) = std::fs::remove_file(path)
+                    let mut rec = run_one(p, spec, make_agent, &mut rec_opts);
+                    // `--record-failed`: a run is recorded only once it has failed, by
+                    // running it again with the recorder. The same seed gives the same run
+                    // and recording changes nothing in it, so the file is the failed run's,
+                    // and the runs that dock cost nothing to record.
+                    if failed_only
+                        && let (Ok(first), Some(to)) = (&rec, to_mcap)
+                        && !first.success
                     {
-                        tracing::warn!(target: "marsupial::sim", path = %path.display(), %e, "recording of a successful run not removed");
+                        let mut again = Recording {
+                            frames: None,
+                            trace: None,
+                            mcap: Some(to),
+                        };
+                        match run_one(p, spec, make_agent, &mut again) {
+                            // Compared as `runs.jsonl` holds them (a NaN is not == itself).
+                            Ok(r) if serde_json::to_vec(&r).ok() == serde_json::to_vec(first).ok() => {}
+                            Ok(_) => tracing::warn!(target: "marsupial::sim", index = spec.index, "the recorded re-run of a failed run differs from it"),
+                            Err(e) => rec = Err(e),
+                        }
                     }
                     if let (Ok(r), Some(d)) = (&rec, &frames_dir) {
                         let _ = write_track_csv(&d.join("trajectory.csv"), r);
