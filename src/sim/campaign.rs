@@ -157,8 +157,11 @@ pub struct CampaignOptions {
 pub struct RecordRuns {
     /// The folder: run N goes to `DIR/run-NNNNN.mcap`.
     pub dir: PathBuf,
-    /// Record only the failed runs: each run goes unrecorded, and one that fails is run
-    /// again with the recorder (runs are deterministic), so docked runs cost nothing.
+    /// Record only the failed runs. In a campaign each run goes unrecorded, and one that
+    /// fails is run again with the recorder (runs are deterministic), so docked runs cost
+    /// nothing. An endurance outing's cycles start where the one before left the robot and
+    /// cannot be run alone, so they are recorded as they go and a docked cycle's file is
+    /// deleted.
     pub failed_only: bool,
     /// How each run is recorded.
     pub options: RecordOptions,
@@ -715,8 +718,8 @@ pub fn run_campaign(
                         let _ = std::fs::create_dir_all(d);
                     }
                     let every = p.loaded.scenario.record.frames_every;
-                    let mcap = opts.record.as_ref().map(|r| r.path(spec.index));
-                    let to_mcap = opts.record.as_ref().zip(mcap.as_deref()).map(|(r, path)| (path, r.options));
+                    let mcap = opts.record.as_ref().map(|r| (r.path(spec.index), r.options));
+                    let to_mcap = mcap.as_ref().map(|(path, options)| (path.as_path(), *options));
                     let failed_only = opts.record.as_ref().is_some_and(|r| r.failed_only);
                     let mut rec_opts = Recording {
                         frames: frames_dir.as_deref().map(|d| (d, every)),
