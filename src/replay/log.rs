@@ -127,14 +127,14 @@ impl Log {
     /// Reads `path` and lists its topics (from the summary, or by reading the file
     /// through when it has none, as a truncated file has not).
     ///
+    /// The file is mapped into memory, not read: a log of any size opens at once and
+    /// costs only the pages the replay touches (a pipe, which cannot be mapped, is read).
+    /// It must not shrink while it is replayed (a log another program is still cutting or
+    /// rotating): reading a page that a truncation took away ends the process with
+    /// `SIGBUS`, as it would for any reader that maps files.
+    ///
     /// # Errors
     /// [`ReplayError::Io`], or [`ReplayError::Log`] when the file is not MCAP.
-    ///
-    /// The file is mapped into memory, not read: a log of any size opens at once and
-    /// costs only the pages the replay touches. It must not shrink while it is replayed
-    /// (a log another program is still cutting or rotating): reading a page that a
-    /// truncation took away ends the process with `SIGBUS`, as it would for any reader
-    /// that maps files (rosbag2's and Foxglove's among them).
     pub fn open(path: &Path) -> Result<Self, ReplayError> {
         let io = |source| ReplayError::Io {
             path: path.to_path_buf(),

@@ -26,8 +26,10 @@ pub const CONSENSUS_MAX: usize = 64;
 /// (bounded, or Gaussian) essentially never drops a true pair.
 pub const OUTLIER_T: f64 = 6.0;
 /// The least residual scale [`Homography::fit_trimmed`] assumes, as a fraction of a
-/// pair's gate. Our choice: a gate spans 16 noise levels or more (the circle
-/// correspondence's 0.3-radius gate is about 20 times the 0.32 px centroid error).
+/// pair's gate. Our choice, for a gate many noise levels wide: the circle
+/// correspondence's gate is 0.3 mark radii, 3 px for the smallest marks detected (about
+/// 10 px radius) and 6 px at 20 px, against a centroid error of at most 0.32 px on
+/// rendered marks.
 pub const NOISE_FLOOR: f64 = 1.0 / 16.0;
 
 /// A plane-to-plane projective map: `dst ~ H · [src; 1]`.
@@ -316,8 +318,9 @@ impl Homography {
     ///
     /// With few pairs a least-squares homography, with its 8 degrees of freedom, bends far
     /// enough to take a pair moved 40 px within an 8 px gate: a proptest found 1 of 10
-    /// pairs, alone at the edge of the set, absorbed so, and every exact four-pair fit
-    /// through it took in the rest too. The fit without that pair does not bend toward it
+    /// pairs, alone at the edge of the set, absorbed so, and the consensus start (the
+    /// exact four-pair fit of least MSAC cost) kept it too. The fit without that pair does
+    /// not bend toward it
     /// (its deleted residual `d`, 43 px there), but a true pair far from the others also
     /// has a deleted residual several times its noise, so `d` alone cannot decide. For a
     /// linear least-squares fit the in-sample residual is `r = (1 − h)·d` with `h` the

@@ -182,10 +182,11 @@ impl McapRecorder {
         })?;
         let e = mcap_err(path);
         // No compression, no CRCs: two passes less over every frame's bytes (readers
-        // accept a zero CRC as "not computed"), to keep recording cheap. The writer's
-        // chunks go straight to the file (no seeking disabled), so the buffer only gathers
-        // the small records: at 64 KiB a frame (over 64 KiB at any useful size) passes
-        // through it without being copied once more.
+        // accept a zero CRC as "not computed"), to keep recording cheap. The writer
+        // streams each chunk's records to the file as they come (it seeks back to patch
+        // the chunk's header), so the buffer gathers only the small records: a write
+        // larger than a `BufWriter`'s capacity goes straight through, so at 64 KiB a frame
+        // (over 64 KiB at any useful size) is not copied into it.
         let mut w = mcap::WriteOptions::new()
             .compression(None)
             .calculate_chunk_crcs(false)
