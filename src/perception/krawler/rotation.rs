@@ -32,6 +32,8 @@
 //!    found there is applied to the current θ.
 //!
 //! Our additions to the paper: the signed step, the midpoint snap and the coasting.
+//! Simplified: the white face is found by a fixed grey threshold at one point, so a
+//! light change that lifts the rubber past it, or glare, would read as a pass.
 //!
 //! Every buffer is sized in [`WheelTracker::new`]; [`WheelTracker::update`] does not
 //! allocate.
