@@ -363,7 +363,70 @@ fn bench_krawler(c: &mut Criterion) {
             black_box(out.iter().filter(|o| o.is_some()).count())
         })
     });
+    bench_krawler_state(&mut g, &p, &frames);
     g.finish();
+}
+
+/// The wheel stage and the whole ten-DOF estimate on the two bench frames, alternated,
+/// and RANSAC over forty steps.
+fn bench_krawler_state(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    p: &Profile,
+    frames: &[marsupial::perception::RgbImage; 2],
+) {
+    use marsupial::perception::krawler::{
+        AxleGeometry, AxleState, GearLayout, KrawlerParams, KrawlerStateSchema, SteeringPoly, WheelParams,
+        WheelTracker, ransac_angle,
+    };
+    use marsupial::sim::krawler::{KrawlerState, expected_markers};
+    let (w, h) = (p.cameras[0].width_px, p.cameras[0].height_px);
+    let geometry = AxleGeometry::from_profile(p, 0).expect("geometry");
+    let layout = GearLayout::from_profile(p).expect("layout");
+    let rest = KrawlerState::rest(p).expect("rest");
+    let axles = [0, 1].map(|a| AxleState {
+        roll: [0.05, -0.03][a],
+        drop: rest.drop[a],
+        steer: [0.2, -0.1][a],
+    });
+    let mut rng = Rng::new(1);
+    let mut draw = move |n: usize| (rng.next_u64() % n as u64) as usize;
+    let mut wheels = WheelTracker::new(w, h, layout, WheelParams::default());
+    let mut k = 0;
+    g.bench_function("wheel_stage_four_wheels_pyramid_corners_lk_ransac", |b| {
+        b.iter(|| {
+            k ^= 1;
+            let s = wheels.update(black_box(&frames[k].view()), &geometry, &axles, &mut draw);
+            black_box(s.iter().filter(|s| s.step.is_some()).count())
+        })
+    });
+    let steps: Vec<f64> = (0..40)
+        .map(|i| 0.05 + 0.0005 * ((i * 7) % 11) as f64 + if i % 5 == 0 { 0.3 } else { 0.0 })
+        .collect();
+    g.bench_function("ransac_40_steps", |b| {
+        b.iter(|| black_box(ransac_angle(black_box(&steps), 0.01, 40, &mut draw)))
+    });
+    let mut schema = KrawlerStateSchema::new(
+        (w, h),
+        geometry.clone(),
+        layout,
+        SteeringPoly::from_profile(p).expect("calibrated"),
+        KrawlerParams::default(),
+        expected_markers(p, &rest).expect("markers"),
+        [0, 1].map(|a| AxleState {
+            roll: 0.0,
+            drop: rest.drop[a],
+            steer: 0.0,
+        }),
+    );
+    g.bench_function("whole_ten_dof_estimate", |b| {
+        b.iter(|| {
+            k ^= 1;
+            let e = schema
+                .estimate(black_box(&frames[k].view()), &mut draw)
+                .expect("estimate");
+            black_box(e.wheel.iter().filter(|w| w.valid).count())
+        })
+    });
 }
 
 fn benches(c: &mut Criterion) {

@@ -9,7 +9,9 @@
 //! * the composed Bujold and RAPOSA behaviors through their phases;
 //! * Axel's circle marks: detection, correspondence and the module's pose (stereo, mono
 //!   and the fallback choice);
-//! * the AutoKrawler's marker step: segmentation, opening, labelling, identity.
+//! * the AutoKrawler's marker step: segmentation, opening, labelling, identity; and its
+//!   whole ten-DOF estimate (markers, roll, drop, steering, and the wheels' pyramids,
+//!   corners, Lucas–Kanade, RANSAC and correction).
 //!
 //! A counting global allocator, gated to the test's own thread, proves it. (The threaded
 //! runtime builds the same per-tick lists as the lockstep; its threads are not counted.)
@@ -662,4 +664,52 @@ fn corners_and_lucas_kanade_do_not_allocate() {
     COUNTING.with(|c| c.set(false));
     assert_eq!(allocs(), 0, "allocations in steady state");
     assert_eq!(tracked, warm);
+}
+
+/// The AutoKrawler's whole ten-DOF estimate (`KrawlerStateSchema`) on rendered frames:
+/// pyramids, corner and track buffers and RANSAC's steps are reused, nothing allocates.
+#[test]
+fn krawler_state_estimation_does_not_allocate() {
+    use common::krawler::{Rig, axles, draw};
+    use marsupial::perception::krawler::{KrawlerParams, KrawlerStateSchema, SteeringPoly};
+    use marsupial::sim::krawler::{KrawlerState, expected_markers};
+    use marsupial::sim::render::SensorParams;
+    use marsupial::sim::rng::Rng;
+    let mut rig = Rig::new(SensorParams::default(), 1);
+    let frames: Vec<RgbImage> = (0..4)
+        .map(|k| {
+            let state = KrawlerState {
+                steer: [0.2, -0.1],
+                wheel: [0.08 * k as f64 + 1.0; 4],
+                ..rig.rest
+            };
+            let mut im = RgbImage::default();
+            rig.render(&state, &mut im);
+            im
+        })
+        .collect();
+    let mut schema = KrawlerStateSchema::new(
+        (640, 480),
+        rig.geometry.clone(),
+        rig.layout,
+        SteeringPoly::from_profile(&rig.profile).unwrap(),
+        KrawlerParams::default(),
+        expected_markers(&rig.profile, &rig.rest).unwrap(),
+        axles(&rig.rest),
+    );
+    let mut rng = Rng::new(2);
+    let mut valid = 0;
+    let mut run = |schema: &mut KrawlerStateSchema| {
+        for f in &frames {
+            let e = schema.estimate(&f.view(), draw(&mut rng)).unwrap();
+            valid += e.wheel.iter().filter(|w| w.valid).count() + e.markers.found();
+        }
+    };
+    run(&mut schema); // warm-up
+    reset();
+    COUNTING.with(|c| c.set(true));
+    run(&mut schema);
+    COUNTING.with(|c| c.set(false));
+    assert_eq!(allocs(), 0, "allocations in steady state");
+    assert!(valid > 60, "{valid}");
 }

@@ -23,9 +23,9 @@ use crate::perception::krawler::{
 };
 use crate::profile::Profile;
 use crate::sim::camera::camera_pose;
-use crate::sim::krawler::{KrawlerScene, KrawlerState, build};
+use crate::sim::krawler::{KrawlerState, build, expected_markers};
 use crate::sim::lighting::LightState;
-use crate::sim::render::{CameraPose, Renderer, SensorParams};
+use crate::sim::render::{Renderer, SensorParams};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -179,28 +179,6 @@ fn save_sweep(dir: &Path, frames: &[SweepFrame]) -> Result<(), String> {
     std::fs::write(&p, csv).map_err(|e| err(&p, e))
 }
 
-/// Where the profile's nominal gear puts each marker, and how large (the first frame's
-/// prediction).
-fn nominal_prediction(
-    profile: &Profile,
-    model: &crate::perception::CameraModel,
-    pose: &CameraPose,
-) -> Result<[ExpectedMarker; 8], String> {
-    let rest = KrawlerState::rest(profile).map_err(|e| e.to_string())?;
-    let gear: KrawlerScene = build(profile, &rest).map_err(|e| e.to_string())?;
-    let side = profile.fiducial.markers.map_or(0.03, |m| m.side_m);
-    let project = |q: [f64; 3]| model.project(&pose.to_camera(&nalgebra::Point3::from(q)));
-    let mut out = [ExpectedMarker {
-        at: [0.0; 2],
-        area: 0.0,
-    }; 8];
-    for (o, m) in out.iter_mut().zip(&gear.markers) {
-        *o = ExpectedMarker::from_square(project, m.coords.into(), [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], side)
-            .ok_or("a marker of the nominal gear does not project into the camera")?;
-    }
-    Ok(out)
-}
-
 /// Fits both axles' polynomials from a sweep (recorded with `opts.sweep`, else
 /// simulated).
 ///
@@ -229,8 +207,8 @@ pub fn calibrate(profile: &Profile, opts: &CalibrateSteeringOptions) -> Result<S
     }
     let geometry = AxleGeometry::from_profile(profile, 0).map_err(|e| e.to_string())?;
     let cam = &profile.cameras[0];
-    let pose = camera_pose(&Pose2::new(0.0, 0.0, 0.0), &cam.mount);
-    let mut predicted = nominal_prediction(profile, &geometry.model, &pose)?;
+    let rest = KrawlerState::rest(profile).map_err(|e| e.to_string())?;
+    let mut predicted = expected_markers(profile, &rest).map_err(|e| e.to_string())?;
     let mut finder = MarkerFinder::new(cam.width_px, cam.height_px, MarkerParams::default());
     let mut samples: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
     for f in &frames {

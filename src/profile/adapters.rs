@@ -10,7 +10,8 @@
 use super::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount, PerceptionSpec, Profile};
 use super::{PyramidPerceptionSpec, TwoBlockSpec};
 use crate::perception::circles::{CircleModel, MarkRotation, RigCamera};
-use crate::perception::krawler::{AxleGeometry, SteeringPoly};
+use crate::perception::krawler::rotation::{HUB_BELOW_PLATE_M, TREAD_WIDTH_M};
+use crate::perception::krawler::{AxleGeometry, GearLayout, SteeringPoly};
 use crate::perception::{
     CameraModel, ColorModelParams, Fisheye, HsvLimits, MountAngles, PairLimits, Pinhole, PyramidGeometry,
     PyramidParams, PyramidTrackerParams, SegmentationMode, TwoBlockGeometry, TwoBlockParams, VisionError,
@@ -271,6 +272,27 @@ impl AxleGeometry {
             body_from_camera: crate::perception::body_from_camera(m),
             camera: nalgebra::Point3::new(m.x_m, m.y_m, m.z_m),
             axle_x: [half, -half],
+        })
+    }
+}
+
+impl GearLayout {
+    /// The wheels of a double-Ackermann profile: its track and wheel radius, with the
+    /// tread's width and the hubs' height below the marker plane the estimates
+    /// [`TREAD_WIDTH_M`] and [`HUB_BELOW_PLATE_M`] (the profile does not carry them).
+    ///
+    /// # Errors
+    /// [`VisionError::Profile`] without `drive.wheel_radius_m`.
+    pub fn from_profile(profile: &Profile) -> Result<Self, VisionError> {
+        let wheel_radius = profile
+            .drive
+            .wheel_radius_m
+            .ok_or_else(|| missing(format!("profile `{}` has no drive.wheel_radius_m", profile.name)))?;
+        Ok(Self {
+            track: profile.drive.track_m,
+            wheel_radius,
+            tread_half_width: TREAD_WIDTH_M / 2.0,
+            hub_below_plate: HUB_BELOW_PLATE_M,
         })
     }
 }

@@ -9,8 +9,9 @@
 //! beam's ends, and a tie rod joining the wheels' steering arms, carrying two more
 //! markers. Steering swings the arms, so the tie rod shifts sideways against the plate,
 //! which is what the paper's ratio of marker distances measures. Each wheel is a
-//! sixteen-sided prism whose faces carry a rubber tread texture, with one face painted
-//! white: the once-per-turn correction marker. Spinning a wheel turns its faces.
+//! 48-sided prism (the paper's cylinder to 0.2 % of its radius) whose faces carry a
+//! rubber tread texture, with three faces (22.5°) painted white: the once-per-turn
+//! correction marker. Spinning a wheel turns its faces.
 //!
 //! **Ackermann linkage.** The steering arms form a trapezoid: each arm points from its
 //! kingpin toward the centre of the *other* axle (the standard Ackermann trapezoid, arms'
@@ -44,6 +45,7 @@ use super::SimError;
 use super::scene::{Material, PaintedSquare, Prim, Scene, Shape, Tag, albedo, boxed};
 use super::world::paint;
 use crate::kinematics::DriveModel;
+use crate::perception::krawler::ExpectedMarker;
 use crate::profile::{NamedColor, Profile};
 use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
@@ -91,17 +93,22 @@ struct Gear {
     marker_color: NamedColor,
 }
 
-/// Width of a wheel's tread, m (estimate).
-const WHEEL_WIDTH: f64 = 0.08;
+/// Width of a wheel's tread, m (estimate, shared with the estimator).
+const WHEEL_WIDTH: f64 = crate::perception::krawler::rotation::TREAD_WIDTH_M;
 /// Steering-arm length from kingpin to tie-rod end, m (estimate).
 pub const ARM: f64 = 0.09;
 /// Markers sit this far either side of the axle's centre line, m (estimate).
 const MARKER_Y: f64 = 0.1;
-/// Tread faces per wheel.
-const FACES: usize = 16;
+/// Tread faces per wheel: enough that the prism is the paper's cylinder to 0.2 % of the
+/// radius (with 16, points between the faces' edges sat up to 2 % inside it, and the
+/// estimator, which intersects rays with the cylinder, under-counted θ by 3 %).
+const FACES: usize = 48;
+/// The white correction marker covers this many faces either side of face 0: 22.5° of
+/// the tread in all.
+const WHITE_HALF: usize = 1;
 /// Height of the axle plate's top (the markers' plane, the axle frame's origin) above the
-/// axle beam's centre, m.
-pub const PLATE_TOP: f64 = 0.021;
+/// axle beam's centre, m (estimate, shared with the estimator).
+pub const PLATE_TOP: f64 = crate::perception::krawler::rotation::HUB_BELOW_PLATE_M;
 /// The tie rod's height, m: its top, level with the plate's, carries the steering markers.
 const ROD_HEIGHT: f64 = 0.024;
 
@@ -183,6 +190,11 @@ pub fn build(profile: &Profile, state: &KrawlerState) -> Result<KrawlerScene, Si
         contrast: 0.6,
         cell: 0.012,
     };
+    let rubber_inverted = Material::Noise {
+        base: albedo([45, 45, 48], 1.0),
+        contrast: -0.6,
+        cell: 0.012,
+    };
     let white = Material::Solid(albedo([255, 255, 255], 0.85));
     let mut prims = Vec::new();
     let mut markers = [Point3::origin(); 8];
@@ -251,14 +263,25 @@ pub fn build(profile: &Profile, state: &KrawlerState) -> Result<KrawlerScene, Si
                 let apothem = g.wheel_radius * (std::f64::consts::PI / FACES as f64).cos();
                 let half_arc = g.wheel_radius * (std::f64::consts::PI / FACES as f64).sin();
                 let centre = Point3::new(apothem * sp, 0.0, apothem * cp);
+                // The texture is laid out from each face's centre, so neighbouring faces
+                // would repeat it every face (7.5°) and a tracker would alias; turning
+                // every other face's texture by 180° and inverting it on every other pair
+                // makes it repeat every fourth face (30°).
+                let turn = if f % 2 == 1 { -1.0 } else { 1.0 };
                 let face = Prim::new(
                     Shape::Rect {
                         centre,
-                        u: Vector3::new(cp, 0.0, -sp),
-                        v: Vector3::y(),
+                        u: Vector3::new(cp, 0.0, -sp) * turn,
+                        v: Vector3::y() * turn,
                         half: [half_arc, WHEEL_WIDTH / 2.0],
                     },
-                    if f == 0 { white.clone() } else { rubber.clone() },
+                    if f <= WHITE_HALF || f >= FACES - WHITE_HALF {
+                        white.clone()
+                    } else if (f / 2) % 2 == 1 {
+                        rubber_inverted.clone()
+                    } else {
+                        rubber.clone()
+                    },
                     Tag::Own,
                 );
                 if f == 0 {
@@ -289,6 +312,31 @@ pub fn build(profile: &Profile, state: &KrawlerState) -> Result<KrawlerScene, Si
         markers,
         correction,
     })
+}
+
+/// Where each of the eight markers of the gear in `state` projects in camera 0 of
+/// `profile`, and how large (squares of the profile's side, lying flat): the prediction
+/// a marker tracker starts from, in [`KrawlerScene::markers`]' order.
+///
+/// # Errors
+/// As [`build`], and [`SimError::Unsupported`] when a marker does not project into the
+/// camera.
+pub fn expected_markers(profile: &Profile, state: &KrawlerState) -> Result<[ExpectedMarker; 8], SimError> {
+    let gear = build(profile, state)?;
+    let cam = &profile.cameras[0];
+    let model = crate::perception::CameraModel::from_spec(cam);
+    let pose = super::camera::camera_pose(&crate::geometry::Pose2::new(0.0, 0.0, 0.0), &cam.mount);
+    let side = profile.fiducial.markers.map_or(0.03, |m| m.side_m);
+    let project = |q: [f64; 3]| model.project(&pose.to_camera(&Point3::from(q)));
+    let mut out = [ExpectedMarker {
+        at: [0.0; 2],
+        area: 0.0,
+    }; 8];
+    for (o, m) in out.iter_mut().zip(&gear.markers) {
+        *o = ExpectedMarker::from_square(project, m.coords.into(), [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], side)
+            .ok_or_else(|| SimError::Unsupported("a marker of the gear does not project into the camera".into()))?;
+    }
+    Ok(out)
 }
 
 /// The tie rod's ends (left, right) in the axle frame, on the markers' plane (z = 0), for

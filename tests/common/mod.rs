@@ -3,6 +3,9 @@
 //! folders, and a scripted driver that only backs in.
 #![allow(dead_code)]
 
+#[cfg(feature = "sim")]
+pub mod krawler;
+
 use marsupial::geometry::Pose2;
 use marsupial::perception::{RgbImage, SctRange};
 use marsupial::profile::Profile;

@@ -1,19 +1,26 @@
 //! The AutoKrawler's running-gear state from its belly fisheye (seed 003, DESIGN §2.4).
 //!
-//! The paper's pipeline, one stage per module. So far: [`markers`], the perceptual step
-//! that finds the eight magenta markers (HSV segmentation, a 3×3 opening, connected
-//! components, blob centres) and gives each its identity; and [`axle`], axle roll ψ and
-//! drop d from each plate-marker pair by ray-plane intersection; and [`steering`], λ from
-//! the tie-rod markers' distance ratio through a calibrated polynomial; and [`wheel`],
-//! the geometry and statistics of wheel rotation from tracked tread features (the
-//! tracking itself is [`crate::perception::flow`]).
+//! The paper's pipeline, one stage per module: [`markers`], the perceptual step that
+//! finds the eight magenta markers (HSV segmentation, a 3×3 opening, connected
+//! components, blob centres) and gives each its identity; [`axle`], axle roll ψ and drop
+//! d from each plate-marker pair by ray-plane intersection; [`steering`], λ from the
+//! tie-rod markers' distance ratio through a calibrated polynomial; [`wheel`], the
+//! geometry and statistics of wheel rotation from tracked tread features; [`rotation`],
+//! the wheel stage on whole frames (observation windows, Shi–Tomasi and Lucas–Kanade
+//! from [`crate::perception::flow`], RANSAC, the once-per-turn correction); and
+//! [`schema`], [`KrawlerStateSchema`], which runs them all on each frame and reports the
+//! ten degrees of freedom with validity flags.
 
 pub mod axle;
 pub mod markers;
+pub mod rotation;
+pub mod schema;
 pub mod steering;
 pub mod wheel;
 
 pub use axle::{AxleGeometry, AxlePose};
 pub use markers::{Blob, ExpectedMarker, MarkerFinder, MarkerParams, Markers};
+pub use rotation::{AxleState, GearLayout, WheelParams, WheelStep, WheelTracker};
+pub use schema::{Dof, KrawlerEstimate, KrawlerParams, KrawlerStateSchema};
 pub use steering::{SteeringFit, SteeringFitError, SteeringPoly, fit_steering};
 pub use wheel::{TurnCounter, WheelCylinder, ransac_angle};

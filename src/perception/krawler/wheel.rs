@@ -142,16 +142,23 @@ impl TurnCounter {
     /// after that, snap θ to the nearest 2πm + c₀ (eq. 7 with rounding instead of the
     /// printed floor, see the module docs). Returns the correction applied, rad.
     pub fn marker_seen(&mut self) -> f64 {
+        self.snap(self.theta)
+    }
+
+    /// As [`TurnCounter::marker_seen`], for a sighting whose θ was `at` (for example the
+    /// midpoint of the frames the marker was seen in, which does not depend on the
+    /// direction of rotation): the correction `at` needs is added to the current θ. The
+    /// first sighting remembers `at` as c₀. Returns the correction applied, rad.
+    pub fn snap(&mut self, at: f64) -> f64 {
         match self.c0 {
             None => {
-                self.c0 = Some(self.theta);
+                self.c0 = Some(at);
                 0.0
             }
             Some(c0) => {
-                let m = ((self.theta - c0) / TAU).round();
-                let corrected = m * TAU + c0;
-                let delta = corrected - self.theta;
-                self.theta = corrected;
+                let m = ((at - c0) / TAU).round();
+                let delta = m * TAU + c0 - at;
+                self.theta += delta;
                 delta
             }
         }
