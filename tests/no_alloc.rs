@@ -1,8 +1,8 @@
 //! Nothing allocates per frame or per tick in steady state:
 //! * the perceptual schemas in every segmentation mode, imprinted first, with the clock
 //!   running through the fallback chain (adapted → imprinted → table): segmentation,
-//!   labelling, pairing, adaptation (Bujold); HSV segmentation, ellipses, blue regions,
-//!   pair filters and tracking (RAPOSA);
+//!   labelling, pairing, adaptation and the colour-cast compensation (Bujold); HSV
+//!   segmentation, ellipses, blue regions, pair filters and tracking (RAPOSA);
 //! * the per-tick camera list, and the simulator's whole lockstep tick (device reads
 //!   through the hardware traits, rendering, the composed behavior, the command, the
 //!   physics step);
@@ -95,9 +95,18 @@ fn steady_state_schema_does_not_allocate() {
         p.cameras[0].width_px = w;
         p.cameras[0].height_px = h;
         p.perception.mode = mode;
+        p.perception.cast_tau_s = 2.0; // the colour-cast compensation is counted too
         let mut schema = TwoBlockSchema::from_profile(&p, 0).unwrap();
         let frames: Vec<_> = (0..6).map(|k| common::scene(w, h, 0.1 + 0.08 * k as f64, k)).collect();
-        let empty = common::background(w, h);
+        // The same scene with the fiducial out of view (a cast compensation would take a
+        // cut to a different scene for a change of light).
+        let empty = common::scene(w, h, 0.0, 6);
+        // A frame under a coloured flash (blue at 70 %), so the cast compensation runs.
+        let mut flash = frames[3].clone();
+        for px in flash.as_bytes_mut().chunks_exact_mut(3) {
+            px[2] = (px[2] as f64 * 0.7) as u8;
+        }
+        let mut corrected = 0;
         for _ in 0..schema.imprint_frames_wanted() {
             schema.imprint_frame(&frames[2].view());
         }
@@ -118,6 +127,9 @@ fn steady_state_schema_does_not_allocate() {
                 t += 0.1;
                 found += schema.process(&f.view(), t).unwrap().found as usize;
             }
+            t += 0.1;
+            schema.process(&flash.view(), t).unwrap();
+            corrected += (schema.cast().gains() != [1.0; 3]) as usize;
             if round % 5 == 4 {
                 // Ten seconds without the fiducial: past both fallback timeouts.
                 for _ in 0..100 {
@@ -131,6 +143,7 @@ fn steady_state_schema_does_not_allocate() {
         COUNTING.with(|c| c.set(false));
         assert_eq!(allocs(), 0, "{w}×{h} {mode:?}: allocations in steady state");
         assert_eq!(found, 120, "{w}×{h} {mode:?}: every fiducial frame detected");
+        assert!(corrected > 0, "{w}×{h} {mode:?}: the flash was never corrected");
         assert_fallbacks_counted(mode, &modes_seen, &format!("{w}×{h}"));
     }
     // Control: the counter does see allocations.

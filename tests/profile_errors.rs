@@ -95,6 +95,18 @@ const CASES: &[(&str, &str, Option<usize>, &str)] = &[
         "expected a number in [1, ",
     ),
     (
+        "cast_out_of_range.toml",
+        "perception.cast_tau_s",
+        Some(70),
+        "expected a number ≥ 0, got -1",
+    ),
+    (
+        "cast_out_of_range.toml",
+        "perception.cast_dead_band",
+        Some(71),
+        "expected a number in [0, 0.5], got 0.8",
+    ),
+    (
         "pairing_limits_out_of_range.toml",
         "perception.min_count_ratio",
         Some(71),

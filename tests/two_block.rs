@@ -256,3 +256,43 @@ fn same_input_same_output_bit_for_bit() {
     assert!(a == b);
     assert!(a.contains("\"found\":true"));
 }
+
+/// A frame of Bujold's camera: the flap (image-left magenta, image-right cyan) on a
+/// brown dock body, every pixel scaled per channel by `light` (a coloured light on the
+/// whole scene), with a little fixed noise.
+fn lit_flap(light: [f64; 3], k: u64) -> marsupial::perception::RgbImage {
+    let mut im = background(256, 240);
+    rect(&mut im, 0, 0, 256, 240, [70, 55, 40]);
+    fiducial(&mut im, 80, 90, 44, 52, [200, 40, 150], [30, 160, 140]);
+    let mut s = 0x9E3779B97F4A7C15u64.wrapping_mul(k + 1);
+    for (i, b) in im.as_bytes_mut().iter_mut().enumerate() {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        let v = (*b as f64 * light[i % 3] + (s % 5) as f64 - 2.0).round();
+        *b = v.clamp(0.0, 255.0) as u8;
+    }
+    im
+}
+
+#[test]
+fn a_coloured_flash_is_compensated_before_segmentation() {
+    // Adapted to the flap under white light for 3 s, the tracker then sees one frame
+    // under a strong yellow-green flash (blue falls to 70 %): both blocks move by
+    // several degrees of SCT angle A at once, far outside the adapted ranges. With the
+    // cast compensation the frame is brought back to the light the ranges were learnt
+    // under and the flap is found; without it, it is lost.
+    let found_under_flash = |cast_tau_s: f64| {
+        let mut p = bujold();
+        p.perception.cast_tau_s = cast_tau_s;
+        let mut s = TwoBlockSchema::from_profile(&p, 0).unwrap();
+        for k in 0..30 {
+            let pc = s.process(&lit_flap([1.0, 1.0, 1.0], k).view(), k as f64 * 0.1).unwrap();
+            assert!(pc.found, "steady light, frame {k}");
+        }
+        assert_eq!(s.model().mode(), ColorMode::Adapted);
+        s.process(&lit_flap([1.15, 1.1, 0.7], 30).view(), 3.0).unwrap().found
+    };
+    assert!(found_under_flash(2.0));
+    assert!(!found_under_flash(0.0));
+}

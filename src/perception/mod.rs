@@ -14,6 +14,7 @@
 //!
 //! * [`camera_model`]: pin-hole and omnidirectional projection, camera mounting.
 //! * [`sct`] and [`hsv`]: colour spaces, exact per pixel and fast over whole frames.
+//! * [`cast`]: removing fast colour casts (a flashing coloured light) before segmentation.
 //! * [`segment`]: per-colour ranges into reusable [`Mask`]s (the SCT test is trig-free).
 //! * [`components`]: 8-connected labelling with per-component moments.
 //! * [`colour_model`]: imprinting, adaptation and the fallback chain of seed 004 Fig. 5.
@@ -27,6 +28,7 @@
 //! * [`overlay`]: drawing a detection over its frame.
 
 pub mod camera_model;
+pub mod cast;
 pub mod circles;
 pub mod colour_model;
 pub mod components;
@@ -47,6 +49,7 @@ pub mod two_block;
 pub mod two_block_pose;
 
 pub use camera_model::{CameraModel, Fisheye, MountAngles, Pinhole, body_from_camera};
+pub use cast::{CastCompensator, CastParams};
 pub use colour_model::{
     AngleStats, Blend, ColorMode, ColorModel, ColorModelParams, Imprinter, SegmentationMode, StatsAccumulator,
 };

@@ -24,6 +24,7 @@
 //! to the larger total, then to the lower component indices, so the choice is
 //! deterministic.
 
+use super::cast::{CastCompensator, CastParams};
 use super::colour_model::{
     AngleStats, ColorMode, ColorModel, ColorModelParams, Imprinter, SegmentationMode, StatsAccumulator,
 };
@@ -386,6 +387,8 @@ pub struct TwoBlockParams {
     pub imprint_sample_frac: f64,
     /// Frames to imprint on.
     pub imprint_frames: u32,
+    /// Compensation of fast colour casts before segmentation ([`CastCompensator`]).
+    pub cast: CastParams,
 }
 
 /// Bujold's close-dock perception for one camera: detector + colour model (+ imprinting).
@@ -398,7 +401,7 @@ pub struct TwoBlockParams {
 ///
 /// ```
 /// use marsupial::perception::{
-///     ColorMode, ColorModelParams, PairLimits, RgbImage, SegmentationMode, TwoBlockParams, TwoBlockTracker,
+///     CastParams, ColorMode, ColorModelParams, PairLimits, RgbImage, SegmentationMode, TwoBlockParams, TwoBlockTracker,
 /// };
 ///
 /// let (cyan, magenta) = ([20, 190, 210], [200, 30, 190]);
@@ -438,6 +441,7 @@ pub struct TwoBlockParams {
 ///     imprint_rects: [[0.25, 0.25, 0.5, 0.75], [0.5, 0.25, 0.75, 0.75]],
 ///     imprint_sample_frac: 1.0,
 ///     imprint_frames: 1,
+///     cast: CastParams::OFF,
 /// };
 /// let mut t = TwoBlockTracker::new(&params);
 /// assert_eq!(t.model().mode(), ColorMode::Table);
@@ -466,6 +470,7 @@ pub struct TwoBlockTracker {
     /// `fixed` segmentation: imprints are not installed.
     fixed: bool,
     last_pair: Option<Pair>,
+    cast: CastCompensator,
 }
 
 impl TwoBlockTracker {
@@ -483,6 +488,7 @@ impl TwoBlockTracker {
             imprint_frames: p.imprint_frames,
             fixed: p.mode == SegmentationMode::Fixed,
             last_pair: None,
+            cast: CastCompensator::new(p.cast, p.width, p.height),
         }
     }
 
@@ -506,6 +512,11 @@ impl TwoBlockTracker {
         &mut self.detector
     }
 
+    /// The colour-cast compensator (its gains show what the last frame was corrected by).
+    pub fn cast(&self) -> &CastCompensator {
+        &self.cast
+    }
+
     /// The pair accepted in the last frame.
     pub fn last_pair(&self) -> Option<&Pair> {
         self.last_pair.as_ref()
@@ -517,8 +528,10 @@ impl TwoBlockTracker {
     }
 
     /// Samples one well-aligned frame for imprinting.
+    /// The frame is corrected with the cast gains of the last processed frame.
     pub fn imprint_frame(&mut self, view: &RgbView<'_>) {
-        self.imprinter.add_frame(view);
+        let view = self.cast.reapply(*view);
+        self.imprinter.add_frame(&view);
     }
 
     /// Installs the imprint gathered so far; false (and no change) when too few bright
@@ -554,8 +567,8 @@ impl TwoBlockTracker {
         TwoBlockPercept::not_found(now, self.model.mode(), self.detector.size())
     }
 
-    /// Runs the tracker on one frame taken at `stamp`: detect with the current ranges,
-    /// adapt, and report.
+    /// Runs the tracker on one frame taken at `stamp`: compensate a fast colour cast
+    /// ([`CastCompensator`]), detect with the current ranges, adapt, and report.
     ///
     /// # Errors
     /// As [`TwoBlockDetector::detect`].
@@ -563,6 +576,7 @@ impl TwoBlockTracker {
         let mode = self.model.mode();
         let ranges = self.model.ranges();
         let size = (view.width(), view.height());
+        let view = &self.cast.correct(*view, stamp);
         let pair = self.detector.detect(view, &ranges)?;
         self.last_pair = pair;
         let Some(pair) = pair else {

@@ -13,7 +13,7 @@ use crate::perception::circles::{CircleModel, MarkRotation, RigCamera};
 use crate::perception::krawler::rotation::{HUB_BELOW_PLATE_M, TREAD_WIDTH_M};
 use crate::perception::krawler::{AxleGeometry, GearLayout, SteeringPoly};
 use crate::perception::{
-    CameraModel, ColorModelParams, Fisheye, HsvLimits, MountAngles, PairLimits, Pinhole, PyramidGeometry,
+    CameraModel, CastParams, ColorModelParams, Fisheye, HsvLimits, MountAngles, PairLimits, Pinhole, PyramidGeometry,
     PyramidParams, PyramidTrackerParams, SegmentationMode, TwoBlockGeometry, TwoBlockParams, VisionError,
 };
 
@@ -202,6 +202,10 @@ impl TwoBlockParams {
             imprint_rects: [p.imprint.left_rect, p.imprint.right_rect],
             imprint_sample_frac: p.imprint.sample_frac,
             imprint_frames: p.imprint.frames,
+            cast: CastParams {
+                tau_s: p.cast_tau_s,
+                dead_band: p.cast_dead_band,
+            },
         })
     }
 }

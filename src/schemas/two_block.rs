@@ -27,7 +27,7 @@ impl Percept for TwoBlockPercept {
 /// gives "not found" at the tick's time.
 ///
 /// ```
-/// use marsupial::perception::{ColorModelParams, PairLimits, RgbImage, SegmentationMode, TwoBlockParams};
+/// use marsupial::perception::{CastParams, ColorModelParams, PairLimits, RgbImage, SegmentationMode, TwoBlockParams};
 /// use marsupial::schemas::{CameraInput, Inputs, Percept, PerceptualSchema, TwoBlockSchema};
 ///
 /// let (cyan, magenta) = ([20, 190, 210], [200, 30, 190]);
@@ -66,6 +66,7 @@ impl Percept for TwoBlockPercept {
 ///     imprint_rects: [[0.25, 0.25, 0.5, 0.75], [0.5, 0.25, 0.75, 0.75]],
 ///     imprint_sample_frac: 0.5,
 ///     imprint_frames: 1,
+///     cast: CastParams::OFF,
 /// };
 /// let mut schema = TwoBlockSchema::new(0, &params);
 /// let cameras = [Some(CameraInput { stamp: 0.1, image: im.view() })];
