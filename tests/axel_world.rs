@@ -130,3 +130,18 @@ fn the_module_body_blocks_starts_and_the_cone_is_its_dock() {
         }
     }
 }
+
+#[test]
+fn axel_stands_outdoors_with_seven_metre_starts_inside_the_world() {
+    let p = axel();
+    let w = world::build(&p, &[], &[]).expect("axel world");
+    assert!(w.dock.cone.is_some(), "Axel's dock is the cone");
+    // No backdrop (the room's walls) within 10 m: a 7 m start at 40° is well inside.
+    for prim in w.scene.prims.iter().filter(|q| matches!(q.tag, Tag::Backdrop)) {
+        for q in prim.bounds().as_slice() {
+            assert!(q.x.abs().max(q.y.abs()) > 10.0, "{q:?}");
+        }
+    }
+    let start = (7.0 * 40f64.to_radians().cos(), 7.0 * 40f64.to_radians().sin());
+    assert!(start.0.abs().max(start.1.abs()) < 10.0);
+}
