@@ -1,6 +1,7 @@
 //! Axel's central module in the simulator: the eight circle fiducials appear where both
-//! cameras of the stereo pair project them, with their pattern (black core, white ring,
-//! black rim) and their bars turned as the profile places them.
+//! cameras of the stereo pair (fish-eye lenses) project them, with their pattern (black
+//! core, white ring, black rim) and their bars turned as the profile places them; the
+//! module stands outdoors.
 
 mod common;
 
@@ -73,7 +74,9 @@ fn both_cameras_see_every_circle_where_their_models_project_it() {
                 cam.name
             );
             // The dark pixels' centroid is the projected centre (the pattern is symmetric
-            // under a half turn), to a fraction of a pixel.
+            // under a half turn), to within a pixel: through the fish-eye a mark is
+            // imaged unevenly (measured worst 0.76 px at 1.6 m); the detector's ellipse fit,
+            // not a centroid, finds the centre (0.38 px, `tests/circles_render.rs`).
             let reach = (project(at(0.0, 1.0 * radius))[1] - centre[1])
                 .abs()
                 .max((project(at(1.0 * radius, 0.0))[0] - centre[0]).abs())
@@ -84,7 +87,7 @@ fn both_cameras_see_every_circle_where_their_models_project_it() {
             };
             let [cx, cy] = common::weighted_centroid(&im, centre, reach, dark).expect("dark pixels");
             assert!(
-                (cx - centre[0]).abs() < 0.5 && (cy - centre[1]).abs() < 0.5,
+                (cx - centre[0]).abs() < 1.0 && (cy - centre[1]).abs() < 1.0,
                 "{} circle {i}: centroid ({cx:.2}, {cy:.2}) vs projected ({:.2}, {:.2})",
                 cam.name,
                 centre[0],

@@ -142,7 +142,12 @@ pub(crate) fn validate_dock(d: &DockSpec, body: &BodySpec, target_enters_robot: 
             );
         }
     }
-    if !target_enters_robot && d.cone.is_none() && d.entrance_width_m > 0.0 && body.width_m > 0.0 && d.entrance_width_m < body.width_m {
+    if !target_enters_robot
+        && d.cone.is_none()
+        && d.entrance_width_m > 0.0
+        && body.width_m > 0.0
+        && d.entrance_width_m < body.width_m
+    {
         v.problem(
             "dock.entrance_width_m",
             format!(
@@ -169,7 +174,10 @@ pub(crate) fn validate_cone_arm(d: &DockSpec, t: Option<&TetherSpec>, body: &Bod
         return;
     }
     let Some(t) = t else {
-        v.problem("tether", "a docking cone is entered by a tether-pulled arm: add a [tether] table");
+        v.problem(
+            "tether",
+            "a docking cone is entered by a tether-pulled arm: add a [tether] table",
+        );
         return;
     };
     if t.arm_m <= body.length_m / 2.0 + d.depth_m {

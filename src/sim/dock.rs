@@ -83,7 +83,11 @@ impl Cone {
             return true;
         }
         let descent = (above.abs() / self.anchor_depth.max(1e-3)).atan();
-        let along = if above > 0.0 { descent + self.tilt } else { descent - self.tilt };
+        let along = if above > 0.0 {
+            descent + self.tilt
+        } else {
+            descent - self.tilt
+        };
         along.tan() > FACE_FRICTION
     }
 }
@@ -206,10 +210,12 @@ pub fn judge(
 /// of the axis, and otherwise pushes against the cone (seed 000 §V-C: stuck).
 fn judge_cone(g: &DockGeometry, c: &Cone, from: &Pose2, to: &Pose2, length: f64, width: f64) -> Contact {
     let body_hits = footprint(to, length, width).iter().any(|&(x, y)| in_body(g, x, y))
-        || [(0.0, g.body_half_width), (0.0, -g.body_half_width)].iter().any(|&(x, y)| {
-            let (a, b) = to.to_local(x, y);
-            a.abs() < length / 2.0 && b.abs() < width / 2.0
-        });
+        || [(0.0, g.body_half_width), (0.0, -g.body_half_width)]
+            .iter()
+            .any(|&(x, y)| {
+                let (a, b) = to.to_local(x, y);
+                a.abs() < length / 2.0 && b.abs() < width / 2.0
+            });
     if body_hits {
         return Contact::Blocked;
     }
@@ -223,7 +229,10 @@ fn judge_cone(g: &DockGeometry, c: &Cone, from: &Pose2, to: &Pose2, length: f64,
         // slide into it, the tip catches on the flat face.
         let y = was.1 + (tip.1 - was.1) * was.0 / (was.0 - tip.0);
         if y.abs() > c.mouth_half - c.tip_radius || !c.slides_in() {
-            return Contact::Stuck { lateral: y, heading: psi };
+            return Contact::Stuck {
+                lateral: y,
+                heading: psi,
+            };
         }
     }
     if tip.0 <= -c.depth {
@@ -473,7 +482,7 @@ mod tests {
                 tilt: tilt_deg.to_radians(),
                 seat_length: 0.27,
                 anchor_depth: 0.25,
-                arm: 0.5,
+                arm: 0.55,
                 tip_radius: 0.03,
                 tip_height: 0.32,
             }),
@@ -483,7 +492,7 @@ mod tests {
     /// A rover whose arm's tip is at (`x`, `y`), its arm `psi_deg` off the cone's axis.
     fn tip_at(x: f64, y: f64, psi_deg: f64) -> Pose2 {
         let th = std::f64::consts::PI + psi_deg.to_radians();
-        Pose2::new(x - 0.5 * th.cos(), y - 0.5 * th.sin(), th)
+        Pose2::new(x - 0.55 * th.cos(), y - 0.55 * th.sin(), th)
     }
 
     #[test]
@@ -491,11 +500,24 @@ mod tests {
         let g = cone_dock(5.0);
         let c = g.cone.unwrap();
         assert!((c.seat_clearance().to_degrees() - 4.95).abs() < 0.05);
-        let at = |x: f64, y: f64, psi: f64| judge(&g, false, &tip_at(x + 0.004, y, psi), &tip_at(x, y, psi), 0.7, 1.1, false);
+        let at = |x: f64, y: f64, psi: f64| {
+            judge(
+                &g,
+                false,
+                &tip_at(x + 0.004, y, psi),
+                &tip_at(x, y, psi),
+                0.7,
+                1.1,
+                false,
+            )
+        };
         assert_eq!(at(0.05, 0.0, 0.0), Contact::Free, "approaching");
         assert_eq!(at(-0.05, 0.0, 2.0), Contact::Free, "in the cone, clear of its walls");
         assert_eq!(at(-0.101, 0.01, 4.0), Contact::Docked);
-        assert!(matches!(at(-0.101, 0.01, 6.0), Contact::Stuck { .. }), "pushes on the cone");
+        assert!(
+            matches!(at(-0.101, 0.01, 6.0), Contact::Stuck { .. }),
+            "pushes on the cone"
+        );
         // Near a wall: the wall turns the rover about its axle to hold the tip.
         match at(-0.05, 0.07, 0.0) {
             Contact::Guided(p) => {
@@ -508,7 +530,15 @@ mod tests {
         assert!(matches!(at(-0.001, 0.2, 0.0), Contact::Stuck { .. }));
         // The wheels meet the face: blocked.
         assert_eq!(
-            judge(&g, false, &Pose2::new(0.4, 0.0, 0.0), &Pose2::new(0.3, 0.0, 0.0), 0.7, 1.1, false),
+            judge(
+                &g,
+                false,
+                &Pose2::new(0.4, 0.0, 0.0),
+                &Pose2::new(0.3, 0.0, 0.0),
+                0.7,
+                1.1,
+                false
+            ),
             Contact::Blocked
         );
     }
@@ -517,7 +547,17 @@ mod tests {
     fn an_upright_station_snags_the_tip_on_its_face() {
         let up = cone_dock(0.0);
         let tilted = cone_dock(5.0);
-        let cross = |g: &DockGeometry| judge(g, false, &tip_at(0.002, 0.0, 0.0), &tip_at(-0.002, 0.0, 0.0), 0.7, 1.1, false);
+        let cross = |g: &DockGeometry| {
+            judge(
+                g,
+                false,
+                &tip_at(0.002, 0.0, 0.0),
+                &tip_at(-0.002, 0.0, 0.0),
+                0.7,
+                1.1,
+                false,
+            )
+        };
         assert!(matches!(cross(&up), Contact::Stuck { .. }));
         assert_eq!(cross(&tilted), Contact::Free);
     }

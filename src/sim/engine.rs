@@ -33,7 +33,9 @@ pub enum PhaseEnd {
     Finished(Outcome),
     /// The robot reached the contact plates.
     Docked,
-    /// The robot caught the entrance edge.
+    /// The robot caught the entrance edge; for a docking cone, the arm's tip caught on
+    /// the cone's face or pushed against its throat misaligned, or the tether fouled the
+    /// wheels (lateral: the tip's, heading: the arm's angle to the cone's axis).
     Stuck {
         /// Lateral error, m.
         lateral: f64,
@@ -660,7 +662,8 @@ impl Sim {
                     self.pose = to;
                     if let Some(c) = &self.world.dock.cone {
                         // A cone's "entrance": the arm's tip and angle as it seated.
-                        self.entrance.get_or_insert((c.tip(&to).1, super::dock::Cone::arm_angle(&to)));
+                        self.entrance
+                            .get_or_insert((c.tip(&to).1, super::dock::Cone::arm_angle(&to)));
                     }
                     if self.world.dock.open && self.entrance.is_none() {
                         self.entrance =
