@@ -171,6 +171,15 @@ fn bench_circles(c: &mut Criterion) {
     let (w, h) = (640, 480);
     let mut p = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/axel.toml")).expect("profile");
     for cam in &mut p.cameras {
+        // The same lens on a smaller sensor: a fish-eye's polynomial and centre are in
+        // pixels, so they scale with the width (ρ' = kρ: a_i' = a_i k^(1−i)).
+        let k = w as f64 / cam.width_px as f64;
+        if let Some(fe) = &mut cam.fisheye {
+            for (i, a) in fe.poly.iter_mut().enumerate() {
+                *a *= k.powi(1 - i as i32);
+            }
+            fe.center_px = fe.center_px.map(|c| c * k);
+        }
         cam.width_px = w;
         cam.height_px = h;
     }

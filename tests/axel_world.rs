@@ -1,6 +1,7 @@
 //! Axel's central module in the simulator: the eight circle fiducials appear where both
-//! cameras of the stereo pair project them, with their pattern (black core, white ring,
-//! black rim) and their bars turned as the profile places them.
+//! cameras of the stereo pair (fish-eye lenses) project them, with their pattern (black
+//! core, white ring, black rim) and their bars turned as the profile places them; the
+//! module stands outdoors.
 
 mod common;
 
@@ -73,7 +74,9 @@ fn both_cameras_see_every_circle_where_their_models_project_it() {
                 cam.name
             );
             // The dark pixels' centroid is the projected centre (the pattern is symmetric
-            // under a half turn), to a fraction of a pixel.
+            // under a half turn), to within a pixel: through the fish-eye a mark is
+            // imaged unevenly (measured worst 0.76 px at 1.6 m); the detector's ellipse fit,
+            // not a centroid, finds the centre (0.38 px, `tests/circles_render.rs`).
             let reach = (project(at(0.0, 1.0 * radius))[1] - centre[1])
                 .abs()
                 .max((project(at(1.0 * radius, 0.0))[0] - centre[0]).abs())
@@ -84,7 +87,7 @@ fn both_cameras_see_every_circle_where_their_models_project_it() {
             };
             let [cx, cy] = common::weighted_centroid(&im, centre, reach, dark).expect("dark pixels");
             assert!(
-                (cx - centre[0]).abs() < 0.5 && (cy - centre[1]).abs() < 0.5,
+                (cx - centre[0]).abs() < 1.0 && (cy - centre[1]).abs() < 1.0,
                 "{} circle {i}: centroid ({cx:.2}, {cy:.2}) vs projected ({:.2}, {:.2})",
                 cam.name,
                 centre[0],
@@ -129,4 +132,19 @@ fn the_module_body_blocks_starts_and_the_cone_is_its_dock() {
             assert!(q.y.abs() <= dock.body_half_width + 1e-9, "{q:?}");
         }
     }
+}
+
+#[test]
+fn axel_stands_outdoors_with_seven_metre_starts_inside_the_world() {
+    let p = axel();
+    let w = world::build(&p, &[], &[]).expect("axel world");
+    assert!(w.dock.cone.is_some(), "Axel's dock is the cone");
+    // No backdrop (the room's walls) within 10 m: a 7 m start at 40° is well inside.
+    for prim in w.scene.prims.iter().filter(|q| matches!(q.tag, Tag::Backdrop)) {
+        for q in prim.bounds().as_slice() {
+            assert!(q.x.abs().max(q.y.abs()) > 10.0, "{q:?}");
+        }
+    }
+    let start = (7.0 * 40f64.to_radians().cos(), 7.0 * 40f64.to_radians().sin());
+    assert!(start.0.abs().max(start.1.abs()) < 10.0);
 }

@@ -260,3 +260,33 @@ fn cli_check_prints_ok_and_fails_on_bad_files() {
     let out = Command::new(exe).args(["check", "--help"]).output().unwrap();
     assert!(String::from_utf8(out.stdout).unwrap().contains("FILE:LINE"));
 }
+
+#[test]
+fn a_docking_cone_names_the_field_that_cannot_work() {
+    let src = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/axel.toml")).unwrap();
+    let check = |from: &str, to: &str, field: &str| {
+        assert!(src.contains(from), "{from}");
+        let err = Profile::parse(&src.replace(from, to), Path::new("mem.toml")).unwrap_err();
+        let paths: Vec<_> = err.problems().iter().map(|p| p.path.as_str()).collect();
+        assert!(paths.contains(&field), "{to}: {paths:?}");
+    };
+    // Walls meeting before the throat; an arm too short to seat past the wheels; a tip
+    // wider than the throat; a mouth below the ground; a negative seat.
+    check(
+        "funnel_half_angle_deg = 25.0",
+        "funnel_half_angle_deg = 60.0",
+        "dock.funnel_half_angle_deg",
+    );
+    check("arm_m = 0.55 ", "arm_m = 0.4 ", "tether.arm_m");
+    check("tip_diameter_m = 0.06", "tip_diameter_m = 0.2", "tether.tip_diameter_m");
+    check(
+        "axis_height_m = 0.15",
+        "axis_height_m = 0.05",
+        "dock.cone.axis_height_m",
+    );
+    check(
+        "seat_length_m = 0.27",
+        "seat_length_m = -1.0",
+        "dock.cone.seat_length_m",
+    );
+}

@@ -438,7 +438,7 @@ impl LoopCore {
             });
         }
         if let Some(t) = inputs.tether
-            && !(t.value.length.is_finite() && t.value.tension.is_finite() && t.stamp.is_finite())
+            && !(t.value.length.is_finite() && t.value.motor_current_a.is_finite() && t.stamp.is_finite())
         {
             return Some(StopReason::NonFinite {
                 input: InputKind::Tether,

@@ -32,7 +32,7 @@ pub use drive::{DriveKind, DriveSpec};
 pub use fiducial::{
     CirclePlacement, CirclesSpec, FiducialSpec, MarkersSpec, NamedColor, PyramidSpec, SteeringCoeffs, TwoBlockSpec,
 };
-pub use geometry::{BodySpec, DockSpec, SuccessSpec, TetherSpec};
+pub use geometry::{BodySpec, ConeSpec, DockSpec, SuccessSpec, TetherSpec};
 pub use perception::{ImprintSpec, PerceptionSpec, SegmentationMode};
 pub use pyramid_perception::{HsvBand, PyramidPerceptionSpec};
 pub use tree::{NodeSpec, TreeSpec};
@@ -111,6 +111,7 @@ impl Validate for Profile {
         }
         if let Some(d) = &self.dock {
             geometry::validate_dock(d, &self.body, self.fiducial.pyramid.is_some(), v);
+            geometry::validate_cone_arm(d, self.tether.as_ref(), &self.body, v);
         } else if self.behavior.approach != ApproachKind::None {
             v.problem("behavior.approach", "a docking approach needs a [dock] table");
         }

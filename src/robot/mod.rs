@@ -152,7 +152,7 @@ pub trait TetherReel: Send {
     /// # Errors
     /// On a reel fault.
     fn command(&mut self, command: &TetherCommand) -> Result<(), HardwareError>;
-    /// Reads length and tension.
+    /// Reads length and the reel motor's current (no tension: see [`TetherReading`]).
     ///
     /// # Errors
     /// On a sensor fault.

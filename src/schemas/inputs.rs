@@ -42,13 +42,16 @@ pub struct OdometryReading {
     pub twist: Twist,
 }
 
-/// A tether reading.
+/// A tether reading: what a reel reports. Tension is not among it: Axel had no tension
+/// sensor and inferred the pull from the reel motor's current (seed 000 §IV-A), so a
+/// behavior may read the current (noisier, and idle current flows while the reel turns
+/// with no load), never the tension.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct TetherReading {
     /// Tether paid out, metres.
     pub length: f64,
-    /// Tension, newtons (0 when slack).
-    pub tension: f64,
+    /// The reel motor's current, amperes (0 when the reel is idle and the tether slack).
+    pub motor_current_a: f64,
 }
 
 /// Everything one tick of the reactive loop sees.

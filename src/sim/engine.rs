@@ -33,7 +33,9 @@ pub enum PhaseEnd {
     Finished(Outcome),
     /// The robot reached the contact plates.
     Docked,
-    /// The robot caught the entrance edge.
+    /// The robot caught the entrance edge; for a docking cone, the arm's tip caught on
+    /// the cone's face or pushed against its throat misaligned, or the tether fouled the
+    /// wheels (lateral: the tip's, heading: the arm's angle to the cone's axis).
     Stuck {
         /// Lateral error, m.
         lateral: f64,
@@ -147,14 +149,20 @@ impl Sim {
                 )
             })
             .collect();
+        // A leading arm's tether runs from its tip to its anchor inside the dock (Axel);
+        // otherwise from the body's rear to the dock's entrance (RAPOSA).
         let tether = profile.tether.map(|t| {
-            Tether::new(
-                (0.0, 0.0),
-                1.0,
-                t.length_m,
-                t.max_reel_rate_mps,
-                profile.body.length_m / 2.0,
-            )
+            if t.arm_m > 0.0 {
+                Tether::with_arm((-t.anchor_depth_m, 0.0), 1.0, t.length_m, t.max_reel_rate_mps, t.arm_m)
+            } else {
+                Tether::new(
+                    (0.0, 0.0),
+                    1.0,
+                    t.length_m,
+                    t.max_reel_rate_mps,
+                    profile.body.length_m / 2.0,
+                )
+            }
         });
         let drive_model = profile.drive.model();
         Self {
@@ -535,7 +543,7 @@ impl Sim {
         }
     }
 
-    /// The tether's length and tension (`None` without a tether).
+    /// The tether's length and reel motor current (`None` without a tether).
     pub fn tether_reading(&self) -> Option<TetherReading> {
         self.tether.map(|t| t.reading())
     }
@@ -590,7 +598,27 @@ impl Sim {
             let from = self.pose;
             let mut to = self.motion.step(self.t, dt, &from, &mut self.rng);
             if let Some(t) = &mut self.tether {
-                to = t.step(dt, &to, reel);
+                let pulled = t.step(dt, &to, reel);
+                if t.arm_leads() {
+                    // Dragged on free wheels, grousers on firm ground rock the rover: a yaw
+                    // disturbance growing with the distance dragged (terrain's
+                    // `reel_yaw_noise`; none on loose sand).
+                    let noise = self.motion.slip_spec().reel_yaw_noise;
+                    let dragged = pulled.distance(&to);
+                    to = pulled;
+                    if noise > 0.0 && dragged > 0.0 {
+                        to.theta += noise * dragged.sqrt() * self.rng.normal();
+                    }
+                    if t.fouled(&to, length, width) {
+                        self.motion.halt();
+                        let psi = super::dock::Cone::arm_angle(&to);
+                        let lateral = t.attach(&to).1;
+                        self.entrance.get_or_insert((lateral, psi));
+                        return Some(PhaseEnd::Stuck { lateral, heading: psi });
+                    }
+                } else {
+                    to = pulled;
+                }
             }
             if let Some(obstacle) = self.world.obstacles.entered(&from, &to, length, width) {
                 self.motion.halt();
@@ -608,6 +636,11 @@ impl Sim {
                     self.pose = to;
                 }
                 Contact::Blocked => {}
+                // A cone's wall turned the rover about its axle to hold the arm's tip.
+                Contact::Guided(guided) => {
+                    self.pose = guided;
+                    self.inside = false;
+                }
                 Contact::Inside => {
                     if !self.inside {
                         let arrival = (to.to_world(-length / 2.0, 0.0).1, crate::geometry::wrap_angle(to.theta));
@@ -627,6 +660,11 @@ impl Sim {
                 }
                 Contact::Docked => {
                     self.pose = to;
+                    if let Some(c) = &self.world.dock.cone {
+                        // A cone's "entrance": the arm's tip and angle as it seated.
+                        self.entrance
+                            .get_or_insert((c.tip(&to).1, super::dock::Cone::arm_angle(&to)));
+                    }
                     if self.world.dock.open && self.entrance.is_none() {
                         self.entrance =
                             Some((to.to_world(-length / 2.0, 0.0).1, crate::geometry::wrap_angle(to.theta)));

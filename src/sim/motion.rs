@@ -26,8 +26,14 @@ pub enum Terrain {
     Grass,
     /// Loose gravel.
     Gravel,
-    /// Loose sand or soil (Axel's loose terrain).
+    /// Loose sand or soil (Axel's loose terrain, seed 000 §V-A): the grousers sink in,
+    /// so reeling drags the rover smoothly (no yaw disturbance under the tether's pull).
     Sand,
+    /// Compacted mixed sand and gravel (Axel's firm terrain, seed 000 §V-A, §V-B): the
+    /// large discrete grousers meet the ground alternately, so a rover dragged by the
+    /// tether rocks side to side (yaw disturbance under the pull) and can leave the ±5°
+    /// heading tolerance.
+    CompactSandGravel,
     /// Uneven outdoor ground (RAPOSA outdoor).
     Uneven,
 }
@@ -45,6 +51,11 @@ pub struct SlipSpec {
     pub noise: f64,
     /// SD of random heading disturbance while moving, rad per metre (uneven ground).
     pub heading_noise: f64,
+    /// SD of the yaw disturbance while the tether drags a rover on free wheels, rad per
+    /// √metre dragged: grousers alternately catching firm ground (seed 000 §V-B). Only a
+    /// leading-arm tether (Axel) drags the rover this way.
+    #[serde(default)]
+    pub reel_yaw_noise: f64,
 }
 
 impl Terrain {
@@ -57,24 +68,30 @@ impl Terrain {
             Terrain::Gravel => "gravel",
             Terrain::Sand => "sand",
             Terrain::Uneven => "uneven",
+            Terrain::CompactSandGravel => "compact_sand_gravel",
         }
     }
 
     /// Default slip of this terrain.
     pub fn slip(&self) -> SlipSpec {
-        let (s, t, n, h) = match self {
-            Terrain::LabFloor => (0.02, 0.25, 0.03, 0.01),
-            Terrain::Steel => (0.05, 0.40, 0.08, 0.03),
-            Terrain::Grass => (0.08, 0.45, 0.10, 0.05),
-            Terrain::Gravel => (0.10, 0.50, 0.15, 0.08),
-            Terrain::Sand => (0.20, 0.55, 0.20, 0.10),
-            Terrain::Uneven => (0.10, 0.50, 0.20, 0.15),
+        // Compact sand/gravel: firmer than loose sand (less slip), but the grousers rock
+        // the rover while moving and, worse, while it is dragged in (our estimates; the
+        // paper compares the two terrains only qualitatively).
+        let (s, t, n, h, r) = match self {
+            Terrain::LabFloor => (0.02, 0.25, 0.03, 0.01, 0.0),
+            Terrain::Steel => (0.05, 0.40, 0.08, 0.03, 0.0),
+            Terrain::Grass => (0.08, 0.45, 0.10, 0.05, 0.0),
+            Terrain::Gravel => (0.10, 0.50, 0.15, 0.08, 0.0),
+            Terrain::Sand => (0.20, 0.55, 0.20, 0.10, 0.0),
+            Terrain::Uneven => (0.10, 0.50, 0.20, 0.15, 0.0),
+            Terrain::CompactSandGravel => (0.08, 0.45, 0.12, 0.12, 0.08),
         };
         SlipSpec {
             slip_straight: s,
             slip_turn: t,
             noise: n,
             heading_noise: h,
+            reel_yaw_noise: r,
         }
     }
 }
@@ -130,6 +147,12 @@ impl Motion {
             track,
             side_gain: (1.0, 1.0),
         }
+    }
+
+    /// The terrain's slip this base moves with (the tether's drag reads its
+    /// `reel_yaw_noise`).
+    pub fn slip_spec(&self) -> &SlipSpec {
+        &self.slip
     }
 
     /// Sets what each side's motor delivers of its command (see `side_gain`).
@@ -221,13 +244,14 @@ mod tests {
             slip_turn: 0.0,
             noise: 0.0,
             heading_noise: 0.0,
+            reel_yaw_noise: 0.0,
         }
     }
 
     #[test]
     fn names_match_the_toml_spelling() {
         use Terrain::*;
-        for t in [LabFloor, Steel, Grass, Gravel, Sand, Uneven] {
+        for t in [LabFloor, Steel, Grass, Gravel, Sand, Uneven, CompactSandGravel] {
             assert_eq!(serde_json::to_value(t).unwrap(), t.as_str());
         }
         for m in [

@@ -151,6 +151,7 @@ mod tests {
             needs_lowered: false,
             open: false,
             target_extent: None,
+            cone: None,
         }
     }
 

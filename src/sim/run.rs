@@ -289,10 +289,15 @@ fn simulation(p: &Prepared, spec: &RunSpec, pair: &mut Rng) -> (Sim, LightingRun
 /// it as docked again.
 /// Where a robot sits docked, and whether that is inside a closed dock's pouch: in the
 /// dock, or, for an open dock (a target on the ground), 1 cm outside the socket's mouth
-/// zone, where the dock judge would count it as docked again.
+/// zone, where the dock judge would count it as docked again; for a cone, with its arm's
+/// tip in the throat.
 pub(super) fn docked_pose(s: &Sim) -> (Pose2, bool) {
     let dock = s.world().dock;
     let length = s.profile().body.length_m;
+    if let Some(c) = &dock.cone {
+        // The arm's tip seated in the cone's throat, the rover facing the module.
+        return (Pose2::new(c.arm - c.depth, 0.0, std::f64::consts::PI), false);
+    }
     let at = if dock.open {
         Pose2::new(length / 2.0 + dock.mouth_reach(0.0) + 0.01, 0.0, 0.0)
     } else {

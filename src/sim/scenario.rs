@@ -863,6 +863,7 @@ impl Scenario {
             slip_turn: (s.slip_turn * k).min(0.95),
             noise: s.noise * k,
             heading_noise: s.heading_noise * k,
+            reel_yaw_noise: s.reel_yaw_noise * k,
         }
     }
 

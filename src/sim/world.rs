@@ -4,6 +4,7 @@
 //! the dock along its axis, +z up. The mother's (or station's) body lies at x < 0.
 
 use super::SimError;
+use super::dock::Cone;
 use super::obstacles::{Footprint, Obstacles};
 use super::scene::{CircleMark, Material, Prim, Scene, Shape, Tag, albedo, boxed};
 use crate::perception::RgbImage;
@@ -92,6 +93,10 @@ pub struct DockGeometry {
     /// Footprint of an open dock's target (x0, x1, y0, y1): touching it other than by
     /// docking is a collision.
     pub target_extent: Option<[f64; 4]>,
+    /// A docking cone that only a tether-pulled leading arm enters (Axel), replacing the
+    /// pouch: `entrance_half` and `depth` are then its mouth and depth, and the tolerances
+    /// go unused (the cone's geometry decides).
+    pub cone: Option<Cone>,
 }
 
 impl DockGeometry {
@@ -163,7 +168,22 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
         needs_lowered: false,
         open: false,
         target_extent: None,
+        cone: None,
     };
+    if let (Some(c), Some(t)) = (dock_spec.cone, profile.tether) {
+        dock.cone = Some(Cone {
+            mouth_half: entrance_half,
+            depth: dock_spec.depth_m,
+            throat_half: dock_spec.throat_half_width(),
+            axis_height: c.axis_height_m,
+            tilt: c.tilt_deg.to_radians(),
+            seat_length: c.seat_length_m,
+            anchor_depth: t.anchor_depth_m,
+            arm: t.arm_m,
+            tip_radius: t.tip_diameter_m / 2.0,
+            tip_height: t.tip_height_m,
+        });
+    }
     let body_grey = albedo([70, 72, 75], 1.0);
     if let Some(fid) = profile.fiducial.two_block {
         // Silver Bullet's rear: a box body with the pouch opening at x = 0, the flap over it.
@@ -315,11 +335,20 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
     for c in clutter {
         add_clutter(&mut prims, c, profile);
     }
-    // Backdrop: walls 3 m behind the dock and to the sides, with photos when given.
+    // Backdrop: walls 3 m behind the dock and to the sides, with photos when given. A
+    // cone's station stands outdoors (Axel in the Mars Yard, seed 000 §V-A), with starts
+    // out to the approach radius (7 m) at 40°: its "walls" are a distant skyline 5 m
+    // beyond the approach radius (12 m for Axel), 2.4 m high.
+    let (back, side, half_w, half_h) = if dock.cone.is_some() {
+        let far = dock_spec.approach_radius_m + 5.0;
+        (far, far, far + 2.0, 1.2)
+    } else {
+        (3.0, 3.2, 3.5, 1.2)
+    };
     let walls = [
-        (Point3::new(-3.0, 0.0, 1.2), y_axis(), 3.5),
-        (Point3::new(0.5, 3.2, 1.2), Vector3::x(), 3.5),
-        (Point3::new(0.5, -3.2, 1.2), -Vector3::x(), 3.5),
+        (Point3::new(-back, 0.0, half_h), y_axis(), half_w),
+        (Point3::new(0.5, side, half_h), Vector3::x(), half_w),
+        (Point3::new(0.5, -side, half_h), -Vector3::x(), half_w),
     ];
     for (i, (centre, u, half_w)) in walls.iter().enumerate() {
         let material = match backdrops.get(i % backdrops.len().max(1)) {
@@ -335,7 +364,7 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
                 centre: *centre,
                 u: *u,
                 v: z_axis(),
-                half: [*half_w, 1.2],
+                half: [*half_w, half_h],
             },
             material,
             Tag::Backdrop,
@@ -363,16 +392,13 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
     })
 }
 
-/// Height of the docking cone's mouth on Axel's central module; the fiducial face starts
-/// above it.
-const CONE_MOUTH_HEIGHT: f64 = 0.25;
-
 /// Axel's central module (seed 000): a box body whose front face (x = 0, facing +x)
 /// carries the circle fiducials at their placements, above the funnel-like docking cone.
-/// The cone's mouth, `entrance_width_m` wide and [`CONE_MOUTH_HEIGHT`] high at the
-/// ground, narrows over the dock depth to a throat a quarter as wide, which the
-/// caster arm must enter. The body is 1 m deep and wide enough for the mouth and the
-/// marks; it is tall enough for the highest mark.
+/// The cone's mouth (drawn square, `entrance_width_m` on a side, about the cone's axis
+/// height) narrows over the dock depth to the throat the caster arm must enter. Without
+/// a `[dock.cone]` table the mouth sits on the ground. The body is 1 m deep and wide
+/// enough for the mouth and the marks; it is tall enough for the highest mark. The
+/// station's forward tilt acts in the contact model ([`Cone`]) but is not drawn.
 fn build_central_module(
     circles: &CirclesSpec,
     dock: &mut DockGeometry,
@@ -386,7 +412,9 @@ fn build_central_module(
     let highest = circles.placements.iter().map(|p| p.z_m).fold(0.0, f64::max);
     dock.body_length = 1.0;
     dock.body_half_width = (widest + margin).max(dock.entrance_half + 0.05);
-    let (w2, top, z0) = (dock.body_half_width, highest + margin, CONE_MOUTH_HEIGHT);
+    let e = dock.entrance_half;
+    let axis = dock.cone.map_or(e, |c| c.axis_height);
+    let (w2, top, z0) = (dock.body_half_width, highest + margin, axis + e);
     let mut body = boxed(
         Point3::new(-dock.body_length, -w2, 0.0),
         Point3::new(0.0, w2, top),
@@ -422,16 +450,16 @@ fn build_central_module(
         },
         Tag::Target,
     ));
-    // Beside the mouth, the front face comes down to the ground.
-    let e = dock.entrance_half;
-    for (y0, y1) in [(-w2, -e), (e, w2)] {
-        if y1 - y0 > 1e-6 {
+    // Beside and below the mouth, the front face comes down to the ground.
+    let (lo, hi) = (axis - e, axis + e);
+    for (y0, y1, z0, z1) in [(-w2, -e, lo, hi), (e, w2, lo, hi), (-w2, w2, 0.0, lo)] {
+        if y1 - y0 > 1e-6 && z1 - z0 > 1e-6 {
             prims.push(Prim::new(
                 Shape::Rect {
-                    centre: Point3::new(0.0, (y0 + y1) / 2.0, z0 / 2.0),
+                    centre: Point3::new(0.0, (y0 + y1) / 2.0, (z0 + z1) / 2.0),
                     u: y_axis(),
                     v: z_axis(),
-                    half: [(y1 - y0) / 2.0, z0 / 2.0],
+                    half: [(y1 - y0) / 2.0, (z1 - z0) / 2.0],
                 },
                 Material::Solid(body_grey),
                 Tag::Body,
@@ -440,18 +468,18 @@ fn build_central_module(
     }
     // The cone: four walls from the mouth to the throat, and the dark throat.
     let d = dock.depth;
-    let (te, tz) = (e / 4.0, z0 / 2.0);
+    let te = dock.cone.map_or(e / 4.0, |c| c.throat_half);
     let mouth = [
-        Point3::new(0.0, -e, 0.0),
-        Point3::new(0.0, e, 0.0),
-        Point3::new(0.0, e, z0),
-        Point3::new(0.0, -e, z0),
+        Point3::new(0.0, -e, lo),
+        Point3::new(0.0, e, lo),
+        Point3::new(0.0, e, hi),
+        Point3::new(0.0, -e, hi),
     ];
     let throat = [
-        Point3::new(-d, -te, 0.0),
-        Point3::new(-d, te, 0.0),
-        Point3::new(-d, te, tz),
-        Point3::new(-d, -te, tz),
+        Point3::new(-d, -te, axis - te),
+        Point3::new(-d, te, axis - te),
+        Point3::new(-d, te, axis + te),
+        Point3::new(-d, -te, axis + te),
     ];
     let cone = Material::Solid(albedo([95, 97, 100], 1.0));
     for i in 0..4 {
@@ -464,10 +492,10 @@ fn build_central_module(
     }
     prims.push(Prim::new(
         Shape::Rect {
-            centre: Point3::new(-d, 0.0, tz / 2.0),
+            centre: Point3::new(-d, 0.0, axis),
             u: y_axis(),
             v: z_axis(),
-            half: [te, tz / 2.0],
+            half: [te, te],
         },
         Material::Solid(albedo([20, 20, 22], 1.0)),
         Tag::Body,
