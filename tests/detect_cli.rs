@@ -394,6 +394,44 @@ fn circles_fewer_than_five_marks_is_a_clean_not_found() {
 }
 
 #[test]
+fn circles_undetected_marks_are_filled_in_from_the_reprojection() {
+    let p = common::shipped_profile("axel");
+    let placements = &p.fiducial.circles.as_ref().unwrap().placements;
+    let robot = facing(2.0, -10.0, 2.0);
+    let (mut im, truth) = render_axel(1, &robot, 23);
+    // Hide marks 2 and 5: six remain, enough for a fit, and the two are filled in.
+    for &j in &[2usize, 5] {
+        let (x0, y0) = (truth[j][0] as usize - 32, truth[j][1] as usize - 32);
+        common::rect(&mut im, x0, y0, x0 + 64, y0 + 64, [128, 128, 128]);
+    }
+    let f = tmp("axel-six.png");
+    save(&im, &f);
+    let v = json_lines(&detect_axel(&["--json", "--camera", "1"], &[&f]));
+    let r = &v[0];
+    assert_eq!(r["found"], true, "{r}");
+    assert_eq!(
+        (r["detected"].clone(), r["inliers"].clone()),
+        (6.into(), 6.into()),
+        "{r}"
+    );
+    let marks = r["marks"].as_array().unwrap();
+    assert_eq!(marks.len(), 8);
+    for (j, m) in marks.iter().enumerate() {
+        let hidden = j == 2 || j == 5;
+        assert_eq!(m["detected"], !hidden, "{r}");
+        assert_eq!(m["rotation_deg"].as_f64().unwrap(), placements[j].rotation_deg);
+        let c = [m["centroid"][0].as_f64().unwrap(), m["centroid"][1].as_f64().unwrap()];
+        let e = (c[0] - truth[j][0]).hypot(c[1] - truth[j][1]);
+        // A filled-in centre is the homography's: it ignores the fish-eye's bending.
+        assert!(e < if hidden { 4.0 } else { 1.0 }, "mark {j}: {e:.2} px off: {r}");
+    }
+    assert_eq!(r["pose"]["marks_used"], 6, "{r}");
+    let rim = r["pose"]["rover_in_module"].as_array().unwrap();
+    let e = (rim[0].as_f64().unwrap() - robot.x).hypot(rim[1].as_f64().unwrap() - robot.y);
+    assert!(e < 0.03, "{e} m: {r}");
+}
+
+#[test]
 fn circles_none_in_real_photos() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/photos");
     if !dir.is_dir() {
