@@ -71,7 +71,8 @@ enum Command {
     /// ray-plane intersection, and fits λ = c0 + c1·(x−1) + c2·(x−1)² per axle. Prints
     /// the coefficients and residuals; `--write` puts them into the profile.
     CalibrateSteering(marsupial::cli::calibrate_steering::CalibrateSteeringOptions),
-    /// Run the two-block perceptual schema on image files.
+    /// Run a profile's fiducial detection on image files: the two-block schema for a
+    /// [fiducial.two_block] profile, circle marks for a [fiducial.circles] one.
     ///
     /// The images are processed in order as a stream, so adaptation carries from one to
     /// the next (and the fallback timeouts run on `--interval` seconds per image). With
@@ -81,6 +82,12 @@ enum Command {
     /// `--json` prints one object per image: image, width, height, found, left_px,
     /// right_px, total_px, ratio, left_centroid, right_centroid, offset_px, mode
     /// (adapted / imprinted / table) and us_per_frame (median over --repeat runs).
+    ///
+    /// For circles (Axel) each image is camera --camera N's frame, processed on its own:
+    /// detection, correspondence to the profile's layout and the monocular pose through
+    /// that camera's lens model. `--json` gives found (or the reason not), each mark's
+    /// id, rotation, centroid and whether it was detected or filled in, the hypothesis,
+    /// reprojection error, inliers, and the module's pose with its quality figures.
     Detect(marsupial::cli::detect::DetectOptions),
     /// Run a profile's perception, or its whole behavior open-loop, on a real log.
     ///

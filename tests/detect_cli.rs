@@ -1,5 +1,8 @@
 //! `marsupial detect` end to end: PNG and JPEG input, grey and RGBA conversion, JSON
-//! fields, imprinting, static mode, overlays, and clear errors for bad files.
+//! fields, imprinting, static mode, overlays, and clear errors for bad files; and for
+//! Axel's circle fiducials (profiles/axel.toml), the marks, labels and pose on frames the
+//! simulator renders from known poses, none on real photos, the overlay, and clean
+//! failures with fewer than 5 marks.
 
 mod common;
 use std::path::{Path, PathBuf};
@@ -192,5 +195,335 @@ fn bad_inputs_give_clear_errors() {
         String::from_utf8(out.stderr)
             .unwrap()
             .contains("--repeat must be at least 1")
+    );
+}
+
+// ---- Axel's circle fiducials ----
+
+use marsupial::geometry::Pose2;
+use marsupial::perception::camera_model::CameraModel;
+use marsupial::sim::camera::camera_pose;
+use marsupial::sim::lighting::LightState;
+use marsupial::sim::render::{Renderer, SensorParams};
+use marsupial::sim::world;
+use nalgebra::Point3;
+
+fn axel_profile() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/axel.toml")
+}
+
+fn detect_axel(args: &[&str], images: &[&Path]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_marsupial"))
+        .arg("detect")
+        .arg("--profile")
+        .arg(axel_profile())
+        .args(args)
+        .args(images)
+        .output()
+        .unwrap()
+}
+
+/// The robot `d` m from the module's face centre, `alpha_deg` off its axis, facing it
+/// and then turned `turn_deg` (as in `tests/circles_render.rs`).
+fn facing(d: f64, alpha_deg: f64, turn_deg: f64) -> Pose2 {
+    let a = alpha_deg.to_radians();
+    Pose2::new(
+        d * a.cos(),
+        d * a.sin(),
+        a + std::f64::consts::PI + turn_deg.to_radians(),
+    )
+}
+
+/// Camera `cam` of Axel at `robot`, rendered by the simulator (default noisy sensor,
+/// four frames of auto-exposure), and each mark's projected centre, px.
+fn render_axel(cam: usize, robot: &Pose2, seed: u64) -> (marsupial::perception::RgbImage, Vec<[f64; 2]>) {
+    let p = common::shipped_profile("axel");
+    let w = world::build(&p, &[], &[]).expect("axel world");
+    let spec = &p.cameras[cam];
+    let model = CameraModel::from_spec(spec);
+    let mut r = Renderer::new(model.clone(), spec.width_px, spec.height_px, seed);
+    let pose = camera_pose(robot, &spec.mount);
+    let mut im = marsupial::perception::RgbImage::default();
+    for k in 0..4 {
+        r.render(
+            &w.scene,
+            &pose,
+            &LightState::uniform(1.0),
+            &SensorParams::default(),
+            seed + k,
+            &mut im,
+        );
+    }
+    let truth = p
+        .fiducial
+        .circles
+        .as_ref()
+        .expect("circles")
+        .placements
+        .iter()
+        .map(|pl| {
+            let q = Point3::new(0.0, pl.y_m, pl.z_m);
+            model
+                .project(&(pose.rotation.transpose() * (q - pose.position)))
+                .expect("mark in front")
+        })
+        .collect();
+    (im, truth)
+}
+
+fn wrap_deg(a: f64) -> f64 {
+    (a + 180.0).rem_euclid(360.0) - 180.0
+}
+
+#[test]
+fn circles_marks_ids_and_pose_on_rendered_frames() {
+    let p = common::shipped_profile("axel");
+    let placements = &p.fiducial.circles.as_ref().unwrap().placements;
+    // Two poses, through each camera (the mono pose through that camera's fish-eye).
+    let cases = [
+        (1.8, 15.0, 4.0, 0usize),
+        (2.4, -20.0, -5.0, 1usize),
+        (2.0, 0.0, 0.0, 0usize),
+    ];
+    for (k, &(d, a, turn, cam)) in cases.iter().enumerate() {
+        let robot = facing(d, a, turn);
+        let (im, truth) = render_axel(cam, &robot, 40 + k as u64);
+        let f = tmp(&format!("axel-{k}.png"));
+        save(&im, &f);
+        let cam_arg = cam.to_string();
+        let v = json_lines(&detect_axel(&["--json", "--camera", &cam_arg], &[&f]));
+        assert_eq!(v.len(), 1);
+        let r = &v[0];
+        let label = format!("camera {cam} at {d} m, α {a}°, turned {turn}°: {r}");
+        assert_eq!(r["found"], true, "{label}");
+        assert!(r["reason"].is_null());
+        assert_eq!((r["width"].clone(), r["height"].clone()), (1024.into(), 768.into()));
+        assert_eq!(r["camera"], cam);
+        let marks = r["marks"].as_array().unwrap();
+        assert_eq!(marks.len(), 8, "{label}");
+        for (j, m) in marks.iter().enumerate() {
+            assert_eq!(m["id"], j, "{label}");
+            assert_eq!(m["detected"], true, "{label}");
+            assert_eq!(
+                m["rotation_deg"].as_f64().unwrap(),
+                placements[j].rotation_deg,
+                "{label}"
+            );
+            let c = [m["centroid"][0].as_f64().unwrap(), m["centroid"][1].as_f64().unwrap()];
+            let e = (c[0] - truth[j][0]).hypot(c[1] - truth[j][1]);
+            assert!(e < 1.0, "{label}: mark {j} {e:.2} px from its projection");
+        }
+        assert!(r["unlabelled"].as_array().unwrap().is_empty(), "{label}");
+        assert_eq!(r["inliers"], 8);
+        assert!(r["hypothesis"].as_u64().unwrap() < 16);
+        assert!((1..=16).contains(&r["hypotheses_tried"].as_u64().unwrap()));
+        assert!(r["reprojection_px"].as_f64().unwrap() < 3.0, "{label}");
+        let pose = &r["pose"];
+        assert_eq!(pose["source"], "mono");
+        assert_eq!(pose["camera"], cam);
+        assert_eq!(pose["marks_used"], 8);
+        assert!(pose["reprojection_px"].as_f64().unwrap() < 1.0, "{label}");
+        let rim = pose["rover_in_module"].as_array().unwrap();
+        let (x, y, h) = (
+            rim[0].as_f64().unwrap(),
+            rim[1].as_f64().unwrap(),
+            rim[2].as_f64().unwrap(),
+        );
+        let e = (x - robot.x).hypot(y - robot.y);
+        let eh = wrap_deg(h - robot.theta.to_degrees()).abs();
+        assert!(e < 0.03 && eh < 1.0, "{label}: rover {e:.4} m, {eh:.2}° off the truth");
+        // The module in the rover frame: its face looks back at the rover.
+        let hd = pose["heading_deg"].as_f64().unwrap();
+        assert!((wrap_deg(hd + robot.theta.to_degrees())).abs() < 1.0, "{label}");
+        let dist = pose["position_m"][0]
+            .as_f64()
+            .unwrap()
+            .hypot(pose["position_m"][1].as_f64().unwrap());
+        assert!((dist - d).abs() < 0.03, "{label}");
+        assert!(r["us_per_frame"].as_f64().unwrap() > 0.0);
+    }
+}
+
+#[test]
+fn circles_text_output_and_overlay() {
+    let robot = facing(2.0, 10.0, 3.0);
+    let (im, _) = render_axel(0, &robot, 7);
+    let f = tmp("axel-ov-in.png");
+    save(&im, &f);
+    let ov = tmp("axel-ov.png");
+    let out = detect_axel(&["--overlay", ov.to_str().unwrap()], &[&f]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("found  8 marks (0 filled in, 0 unlabelled)") && text.contains("[mono, camera 0"),
+        "{text}"
+    );
+    let drawn = image::open(&ov).unwrap().to_rgb8();
+    let input = image::open(&f).unwrap().to_rgb8();
+    assert_eq!(drawn.dimensions(), input.dimensions());
+    let changed = drawn.pixels().zip(input.pixels()).filter(|(a, b)| a != b).count();
+    assert!(changed > 1000, "only {changed} pixels drawn");
+    let count = |c: [u8; 3]| drawn.pixels().filter(|p| p.0 == c).count();
+    use marsupial::perception::overlay::{MARK_PAINT, MODEL_PAINT};
+    assert!(count(MARK_PAINT) > 200, "marks drawn: {}", count(MARK_PAINT));
+    assert!(count(MODEL_PAINT) > 200, "model drawn: {}", count(MODEL_PAINT));
+}
+
+#[test]
+fn circles_fewer_than_five_marks_is_a_clean_not_found() {
+    let robot = facing(1.8, 5.0, 0.0);
+    let (mut im, truth) = render_axel(0, &robot, 11);
+    // Paint over four of the eight marks (each about 40 px across here).
+    for c in &truth[..4] {
+        let (x0, y0) = (c[0] as usize - 35, c[1] as usize - 35);
+        common::rect(&mut im, x0, y0, x0 + 70, y0 + 70, [128, 128, 128]);
+    }
+    let f = tmp("axel-four.png");
+    save(&im, &f);
+    let v = json_lines(&detect_axel(&["--json"], &[&f]));
+    let r = &v[0];
+    assert_eq!(r["found"], false, "{r}");
+    assert_eq!(r["detected"], 4, "{r}");
+    assert_eq!(r["reason"], "4 marks detected, a fit needs 5");
+    assert!(r["marks"].as_array().unwrap().is_empty());
+    assert_eq!(r["unlabelled"].as_array().unwrap().len(), 4);
+    assert!(r["pose"].is_null() && r["hypothesis"].is_null());
+    let out = detect_axel(&[], &[&f]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("not found: 4 marks detected, a fit needs 5"), "{text}");
+}
+
+#[test]
+fn circles_undetected_marks_are_filled_in_from_the_reprojection() {
+    let p = common::shipped_profile("axel");
+    let placements = &p.fiducial.circles.as_ref().unwrap().placements;
+    let robot = facing(2.0, -10.0, 2.0);
+    let (mut im, truth) = render_axel(1, &robot, 23);
+    // Hide marks 2 and 5: six remain, enough for a fit, and the two are filled in.
+    for &j in &[2usize, 5] {
+        let (x0, y0) = (truth[j][0] as usize - 32, truth[j][1] as usize - 32);
+        common::rect(&mut im, x0, y0, x0 + 64, y0 + 64, [128, 128, 128]);
+    }
+    let f = tmp("axel-six.png");
+    save(&im, &f);
+    let v = json_lines(&detect_axel(&["--json", "--camera", "1"], &[&f]));
+    let r = &v[0];
+    assert_eq!(r["found"], true, "{r}");
+    assert_eq!(
+        (r["detected"].clone(), r["inliers"].clone()),
+        (6.into(), 6.into()),
+        "{r}"
+    );
+    let marks = r["marks"].as_array().unwrap();
+    assert_eq!(marks.len(), 8);
+    for (j, m) in marks.iter().enumerate() {
+        let hidden = j == 2 || j == 5;
+        assert_eq!(m["detected"], !hidden, "{r}");
+        assert_eq!(m["rotation_deg"].as_f64().unwrap(), placements[j].rotation_deg);
+        let c = [m["centroid"][0].as_f64().unwrap(), m["centroid"][1].as_f64().unwrap()];
+        let e = (c[0] - truth[j][0]).hypot(c[1] - truth[j][1]);
+        // A filled-in centre is the homography's: it ignores the fish-eye's bending.
+        assert!(e < if hidden { 4.0 } else { 1.0 }, "mark {j}: {e:.2} px off: {r}");
+    }
+    assert_eq!(r["pose"]["marks_used"], 6, "{r}");
+    let rim = r["pose"]["rover_in_module"].as_array().unwrap();
+    let e = (rim[0].as_f64().unwrap() - robot.x).hypot(rim[1].as_f64().unwrap() - robot.y);
+    assert!(e < 0.03, "{e} m: {r}");
+}
+
+#[test]
+fn circles_none_in_real_photos() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/photos");
+    if !dir.is_dir() {
+        eprintln!("skipping: {} not found", dir.display());
+        return;
+    }
+    let mut files = Vec::new();
+    for sub in ["backgrounds", "markers"] {
+        let mut f: Vec<PathBuf> = std::fs::read_dir(dir.join(sub))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "jpg" || e == "png"))
+            .collect();
+        f.sort();
+        files.extend(f.into_iter().take(3));
+    }
+    assert!(files.len() >= 4, "{files:?}");
+    let refs: Vec<&Path> = files.iter().map(|p| p.as_path()).collect();
+    let v = json_lines(&detect_axel(&["--json"], &refs));
+    assert_eq!(v.len(), files.len());
+    for r in &v {
+        assert_eq!(r["found"], false, "{r}");
+        assert_eq!(r["detected"], 0, "{r}");
+        assert!(
+            r["reason"].as_str().unwrap().contains("marks detected, a fit needs 5"),
+            "{r}"
+        );
+        assert!(r["pose"].is_null());
+    }
+}
+
+#[test]
+fn circles_bad_inputs_give_clear_errors() {
+    let missing = tmp("axel-missing.png");
+    let out = detect_axel(&[], &[&missing]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.contains("axel-missing.png: cannot read image") && !err.contains("panicked"),
+        "{err}"
+    );
+    let f = tmp("axel-bad-opts.png");
+    save(&scene(), &f);
+    for (args, want) in [
+        (
+            vec!["--imprint", f.to_str().unwrap()],
+            "--imprint applies to [fiducial.two_block] profiles only; `axel` has [fiducial.circles]",
+        ),
+        (
+            vec!["--static"],
+            "--static applies to [fiducial.two_block] profiles only",
+        ),
+        (
+            vec!["--camera", "2"],
+            "--camera 2: profile `axel` has 2 camera(s), numbered from 0",
+        ),
+    ] {
+        let out = detect_axel(&args, &[&f]);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert!(err.contains(want), "{args:?}: {err}");
+    }
+    // A frame of another size than the camera's: the marks are labelled, but no pose is
+    // made through a lens model calibrated for another size.
+    let (im, _) = render_axel(0, &facing(2.0, 0.0, 0.0), 3);
+    let mut big = marsupial::perception::RgbImage::new(1100, 800);
+    big.fill([128, 128, 128]);
+    for y in 0..im.height() {
+        for x in 0..im.width() {
+            big.put(x, y, im.view().get(x, y).unwrap());
+        }
+    }
+    let g = tmp("axel-padded.png");
+    save(&big, &g);
+    let v = json_lines(&detect_axel(&["--json"], &[&g]));
+    assert_eq!(v[0]["found"], true, "{}", v[0]);
+    assert!(v[0]["pose"].is_null());
+    assert_eq!(
+        v[0]["pose_error"],
+        "the image is 1100×800 px but camera 0 is 1024×768: no pose through its model"
+    );
+    // A profile with neither fiducial names both.
+    let raposa = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml");
+    let out = Command::new(env!("CARGO_BIN_EXE_marsupial"))
+        .args(["detect", "--profile"])
+        .arg(raposa)
+        .arg(&f)
+        .output()
+        .unwrap();
+    assert!(
+        String::from_utf8(out.stderr)
+            .unwrap()
+            .contains("has no [fiducial.two_block] or [fiducial.circles]")
     );
 }

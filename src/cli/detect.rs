@@ -1,8 +1,16 @@
-//! `marsupial detect`: run the two-block perceptual schema over image files, as a stream.
+//! `marsupial detect`: run a profile's fiducial detection over image files. A
+//! `[fiducial.two_block]` profile runs the two-block perceptual schema as a stream
+//! (adaptation carries from image to image); a `[fiducial.circles]` profile runs Axel's
+//! circle-mark detection, correspondence and monocular pose on each image independently
+//! ([`run`] dispatches on the profile).
 
 use crate::config::ConfigError;
 use crate::image_io::{ImageFileError, load_rgb, save_png};
-use crate::perception::overlay::paint_overlay;
+use crate::perception::circles::{
+    CircleDetector, CircleModel, CircleParams, CorrespondenceError, CorrespondenceParams, DetectedMark,
+    MarkObservations, ModelFit, ModulePose, PoseBuffers, PoseError, PoseParams, RigCamera, correspond, mono_pose,
+};
+use crate::perception::overlay::{CirclesDrawing, paint_circles_overlay, paint_overlay};
 use crate::perception::{RgbImage, TwoBlockPercept, VisionError};
 use crate::profile::Profile;
 use crate::schemas::TwoBlockSchema;
@@ -15,26 +23,34 @@ use thiserror::Error;
 /// Options of `marsupial detect` (also its command-line arguments).
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 pub struct DetectOptions {
-    /// Profile with a [fiducial.two_block] (e.g. profiles/bujold.toml).
+    /// Profile with a [fiducial.two_block] (e.g. profiles/bujold.toml) or a
+    /// [fiducial.circles] (profiles/axel.toml).
     #[arg(long, value_name = "PROFILE")]
     pub profile: PathBuf,
-    /// Imprint on this image first (repeatable; several frames are averaged).
+    /// The profile camera the images come from (its colour order for two-block; its lens
+    /// model and mount for the circles' pose).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub camera: usize,
+    /// Imprint on this image first (repeatable; several frames are averaged; two-block only).
     #[arg(long, value_name = "IMAGE")]
     pub imprint: Vec<PathBuf>,
-    /// Static segmentation: keep the imprint, never adapt.
+    /// Static segmentation: keep the imprint, never adapt (two-block only).
     #[arg(long = "static")]
     pub static_mode: bool,
     /// One JSON object per image.
     #[arg(long)]
     pub json: bool,
-    /// Write the frame with segmented pixels painted in (PNG); with several images an
-    /// index is added: OUT-000.png, OUT-001.png …
+    /// Write the frame with what was found drawn in (PNG): two-block, the segmented
+    /// pixels; circles, the marks, their ids and the reprojected model. With several
+    /// images an index is added: OUT-000.png, OUT-001.png …
     #[arg(long, value_name = "OUT.png")]
     pub overlay: Option<PathBuf>,
-    /// Time the whole schema this many times per image and report the median.
+    /// Time the whole schema (circles: detection, correspondence and pose) this many
+    /// times per image and report the median.
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub repeat: usize,
-    /// Seconds between images (default: one frame period of the profile's camera).
+    /// Seconds between images (default: one frame period of the profile's camera;
+    /// two-block only).
     #[arg(long, value_name = "S")]
     pub interval: Option<f64>,
     /// Images, in stream order.
@@ -62,6 +78,9 @@ pub enum DetectError {
     /// Bad option value.
     #[error("{0}")]
     Usage(String),
+    /// The profile has no fiducial `detect` handles.
+    #[error("profile `{0}` has no [fiducial.two_block] or [fiducial.circles]: detect handles those two fiducials")]
+    NoFiducial(String),
     /// Writing the output failed.
     #[error("cannot write output: {0}")]
     Output(#[from] std::io::Error),
@@ -130,11 +149,25 @@ pub fn run(opts: &DetectOptions, out: &mut dyn Write) -> Result<(), DetectError>
         return Err(DetectError::Usage("--repeat must be at least 1".into()));
     }
     let profile = Profile::load(&opts.profile)?;
-    let mut schema = TwoBlockSchema::from_profile(&profile, 0)?;
+    if opts.camera >= profile.cameras.len() {
+        return Err(DetectError::Usage(format!(
+            "--camera {}: profile `{}` has {} camera(s), numbered from 0",
+            opts.camera,
+            profile.name,
+            profile.cameras.len()
+        )));
+    }
+    if profile.fiducial.circles.is_some() {
+        return run_circles(opts, &profile, out);
+    }
+    if profile.fiducial.two_block.is_none() {
+        return Err(DetectError::NoFiducial(profile.name.clone()));
+    }
+    let mut schema = TwoBlockSchema::from_profile(&profile, opts.camera)?;
     let interval = match opts.interval {
         Some(i) if i.is_finite() && i >= 0.0 => i,
         Some(i) => return Err(DetectError::Usage(format!("--interval must be a number ≥ 0, got {i}"))),
-        None => 1.0 / profile.cameras[0].fps,
+        None => 1.0 / profile.cameras[opts.camera].fps,
     };
     // Load everything first so a bad file fails before any output.
     let imprint: Vec<RgbImage> = opts.imprint.iter().map(|p| load_rgb(p)).collect::<Result<_, _>>()?;
@@ -203,5 +236,318 @@ fn write_record(out: &mut dyn Write, image: &str, p: &TwoBlockPercept, us: f64, 
     } else {
         writeln!(out, "{image}: not found  [{}]  {:.1} µs", p.mode, rec.us_per_frame)?;
     }
+    Ok(())
+}
+
+/// One labelled mark of a circles record: a model mark, detected or filled in.
+#[derive(Debug, Clone, Serialize)]
+pub struct CircleMarkRecord {
+    /// Index of the mark in the profile's `[fiducial.circles].placements`.
+    pub id: usize,
+    /// The bar's rotation, degrees: as the detector read it for a detected mark, the
+    /// model's for a filled-in one.
+    pub rotation_deg: f64,
+    /// Centre, px: the fitted ellipse's for a detected mark, the homography's
+    /// reprojection for a filled-in one.
+    pub centroid: [f64; 2],
+    /// True when detected; false when filled in from the reprojection.
+    pub detected: bool,
+}
+
+/// A detected mark the correspondence did not label (a false positive, or any mark when
+/// no labelling was accepted).
+#[derive(Debug, Clone, Serialize)]
+pub struct UnlabelledMarkRecord {
+    /// The bar's rotation as read, degrees (null when the bar was not resolved).
+    pub rotation_deg: Option<f64>,
+    /// Centre of the fitted ellipse, px.
+    pub centroid: [f64; 2],
+}
+
+/// The module's pose in a circles record: the monocular pose through the camera's lens
+/// model, in the rover frame (+x forward, +y left, +z up, origin on the ground under the
+/// rover's reference point).
+#[derive(Debug, Clone, Serialize)]
+pub struct CirclePoseRecord {
+    /// `mono` (one image, one camera).
+    pub source: &'static str,
+    /// The camera it was measured through.
+    pub camera: usize,
+    /// The module frame's origin (its face centre on the ground) in the rover frame, m.
+    pub position_m: [f64; 3],
+    /// Direction the module's face looks, degrees counter-clockwise from rover +x
+    /// (about ±180 when the rover faces the face squarely).
+    pub heading_deg: f64,
+    /// The rover's planar pose about the module, (x m, y m, heading °) in the module
+    /// frame: what the polar planner uses.
+    pub rover_in_module: [f64; 3],
+    /// Quality figure: RMS distance between the detected centres and the posed model's
+    /// marks projected through the camera, px.
+    pub reprojection_px: f64,
+    /// Quality figure: RMS distance between the posed model's marks and the rays
+    /// through their detections, m.
+    pub rms_residual_m: f64,
+    /// Detected marks the pose was computed from.
+    pub marks_used: usize,
+}
+
+/// One line of `--json` output for a `[fiducial.circles]` profile.
+#[derive(Debug, Clone, Serialize)]
+pub struct CirclesRecord<'a> {
+    /// The image path as given.
+    pub image: &'a str,
+    /// Width, px.
+    pub width: usize,
+    /// Height, px.
+    pub height: usize,
+    /// A labelling of at least 5 marks was accepted.
+    pub found: bool,
+    /// Why not found (null when found).
+    pub reason: Option<String>,
+    /// The profile camera the image is taken as.
+    pub camera: usize,
+    /// Marks the detector reported.
+    pub detected: usize,
+    /// Every model mark, by id, when found (empty otherwise).
+    pub marks: Vec<CircleMarkRecord>,
+    /// Detections left unlabelled.
+    pub unlabelled: Vec<UnlabelledMarkRecord>,
+    /// The correspondence hypothesis kept, 0–15 (bit c: rotation class c's marks taken in
+    /// reverse), or null.
+    pub hypothesis: Option<u8>,
+    /// Distinct hypotheses tried (at most 16), or null.
+    pub hypotheses_tried: Option<u8>,
+    /// RMS distance between the inliers and the homography's reprojection, px, or null.
+    pub reprojection_px: Option<f64>,
+    /// Detected marks the labelling matched, or null.
+    pub inliers: Option<usize>,
+    /// The module's pose, or null.
+    pub pose: Option<CirclePoseRecord>,
+    /// Why there is no pose although marks were labelled (null otherwise).
+    pub pose_error: Option<String>,
+    /// Median wall time of detection, correspondence and pose on this image, µs.
+    pub us_per_frame: f64,
+}
+
+/// The circles pipeline for one camera, every buffer owned and reused.
+struct CirclesRun {
+    detector: CircleDetector,
+    model: CircleModel,
+    cam: RigCamera,
+    camera: usize,
+    cam_size: (usize, usize),
+    corr: CorrespondenceParams,
+    pose_params: PoseParams,
+    buf: PoseBuffers,
+}
+
+/// What the pipeline made of one image (the marks stay in the detector).
+struct CirclesOutcome {
+    fit: Result<ModelFit, CorrespondenceError>,
+    pose: Option<Result<ModulePose, String>>,
+}
+
+impl CirclesRun {
+    fn process(&mut self, im: &RgbImage) -> Result<CirclesOutcome, VisionError> {
+        if self.detector.size() != (im.width(), im.height()) {
+            self.detector = CircleDetector::new(im.width(), im.height(), CircleParams::for_image(im.width()));
+        }
+        let marks = self.detector.detect(&im.view())?;
+        let fit = correspond(&self.model, marks, &self.corr);
+        let pose = fit.as_ref().ok().map(|f| {
+            if (im.width(), im.height()) != self.cam_size {
+                return Err(format!(
+                    "the image is {}×{} px but camera {} is {}×{}: no pose through its model",
+                    im.width(),
+                    im.height(),
+                    self.camera,
+                    self.cam_size.0,
+                    self.cam_size.1
+                ));
+            }
+            let obs = MarkObservations::from_fit(f, marks);
+            mono_pose(
+                &self.model,
+                &self.cam,
+                self.camera,
+                &obs,
+                &self.pose_params,
+                &mut self.buf,
+            )
+            .map_err(|e: PoseError| e.to_string())
+        });
+        Ok(CirclesOutcome { fit, pose })
+    }
+}
+
+fn round(v: f64, decimals: i32) -> f64 {
+    let s = 10f64.powi(decimals);
+    (v * s).round() / s
+}
+
+fn run_circles(opts: &DetectOptions, profile: &Profile, out: &mut dyn Write) -> Result<(), DetectError> {
+    for (given, name) in [
+        (!opts.imprint.is_empty(), "--imprint"),
+        (opts.static_mode, "--static"),
+        (opts.interval.is_some(), "--interval"),
+    ] {
+        if given {
+            return Err(DetectError::Usage(format!(
+                "{name} applies to [fiducial.two_block] profiles only; `{}` has [fiducial.circles]",
+                profile.name
+            )));
+        }
+    }
+    let spec = &profile.cameras[opts.camera];
+    let mut run = CirclesRun {
+        detector: CircleDetector::new(spec.width_px, spec.height_px, CircleParams::for_image(spec.width_px)),
+        model: CircleModel::from_profile(profile)?,
+        cam: RigCamera::from_profile(profile, opts.camera)?,
+        camera: opts.camera,
+        cam_size: (spec.width_px, spec.height_px),
+        corr: CorrespondenceParams::default(),
+        pose_params: PoseParams::default(),
+        buf: PoseBuffers::new(),
+    };
+    let images: Vec<RgbImage> = opts.images.iter().map(|p| load_rgb(p)).collect::<Result<_, _>>()?;
+    let mut overlay = RgbImage::default();
+    let mut times = Vec::with_capacity(opts.repeat);
+    for (k, (path, im)) in opts.images.iter().zip(&images).enumerate() {
+        times.clear();
+        let mut outcome = None;
+        for _ in 0..opts.repeat {
+            let start = Instant::now();
+            let o = run.process(im)?;
+            times.push(start.elapsed().as_secs_f64() * 1e6);
+            outcome = Some(o);
+        }
+        times.sort_by(f64::total_cmp);
+        let us = times[times.len() / 2];
+        let Some(o) = outcome else { continue };
+        let name = path.display().to_string();
+        let rec = circles_record(&name, im, &run, &o, us);
+        write_circles(out, &rec, opts.json)?;
+        if let Some(base) = &opts.overlay {
+            let pose = o.pose.as_ref().and_then(|p| p.as_ref().ok()).map(|p| (p, &run.cam));
+            let drawing = CirclesDrawing {
+                marks: run.detector.marks(),
+                model: &run.model,
+                fit: o.fit.as_ref().ok(),
+                pose,
+            };
+            paint_circles_overlay(&im.view(), &drawing, &mut overlay);
+            save_png(&overlay_path(base, k, opts.images.len()), &overlay)?;
+        }
+    }
+    Ok(())
+}
+
+fn circles_record<'a>(
+    image: &'a str,
+    im: &RgbImage,
+    run: &CirclesRun,
+    o: &CirclesOutcome,
+    us: f64,
+) -> CirclesRecord<'a> {
+    let marks: &[DetectedMark] = run.detector.marks();
+    let px = |c: [f64; 2]| [round(c[0], 2), round(c[1], 2)];
+    let mut rec = CirclesRecord {
+        image,
+        width: im.width(),
+        height: im.height(),
+        found: o.fit.is_ok(),
+        reason: o.fit.as_ref().err().map(|e| e.to_string()),
+        camera: run.camera,
+        detected: marks.len(),
+        marks: Vec::new(),
+        unlabelled: Vec::new(),
+        hypothesis: None,
+        hypotheses_tried: None,
+        reprojection_px: None,
+        inliers: None,
+        pose: None,
+        pose_error: None,
+        us_per_frame: round(us, 1),
+    };
+    let fit = o.fit.as_ref().ok();
+    for (i, m) in marks.iter().enumerate() {
+        if !fit.is_some_and(|f| f.is_inlier(i)) {
+            rec.unlabelled.push(UnlabelledMarkRecord {
+                rotation_deg: m.rotation.map(|r| r.degrees()),
+                centroid: px(m.centre),
+            });
+        }
+    }
+    let Some(fit) = fit else { return rec };
+    for (j, model_rot) in run.model.rotations().iter().enumerate() {
+        let det = fit.detection_of(j).and_then(|i| marks.get(i));
+        rec.marks.push(CircleMarkRecord {
+            id: j,
+            rotation_deg: det.and_then(|m| m.rotation).unwrap_or(*model_rot).degrees(),
+            centroid: px(fit.centre(marks, j).unwrap_or(fit.projected()[j])),
+            detected: det.is_some(),
+        });
+    }
+    rec.hypothesis = Some(fit.hypothesis);
+    rec.hypotheses_tried = Some(fit.hypotheses_tried);
+    rec.reprojection_px = Some(round(fit.rms_px, 3));
+    rec.inliers = Some(fit.inliers);
+    match &o.pose {
+        Some(Ok(p)) => {
+            let t = p.translation;
+            let r = p.rover_in_module();
+            rec.pose = Some(CirclePoseRecord {
+                source: "mono",
+                camera: run.camera,
+                position_m: [round(t.x, 4), round(t.y, 4), round(t.z, 4)],
+                heading_deg: round(p.heading().to_degrees(), 2),
+                rover_in_module: [round(r[0], 4), round(r[1], 4), round(r[2].to_degrees(), 2)],
+                reprojection_px: round(p.reprojection_px, 3),
+                rms_residual_m: round(p.rms_residual_m, 5),
+                marks_used: p.marks_used,
+            });
+        }
+        Some(Err(e)) => rec.pose_error = Some(e.clone()),
+        None => {}
+    }
+    rec
+}
+
+fn write_circles(out: &mut dyn Write, rec: &CirclesRecord<'_>, json: bool) -> Result<(), DetectError> {
+    if json {
+        writeln!(out, "{}", serde_json::to_string(rec).map_err(std::io::Error::other)?)?;
+        return Ok(());
+    }
+    let image = rec.image;
+    let Some(reason) = &rec.reason else {
+        let filled = rec.marks.iter().filter(|m| !m.detected).count();
+        write!(
+            out,
+            "{image}: found  {} marks ({filled} filled in, {} unlabelled)  hypothesis {} of {}  reprojection {:.2} px",
+            rec.marks.len(),
+            rec.unlabelled.len(),
+            rec.hypothesis.unwrap_or_default(),
+            rec.hypotheses_tried.unwrap_or_default(),
+            rec.reprojection_px.unwrap_or_default(),
+        )?;
+        match (&rec.pose, &rec.pose_error) {
+            (Some(p), _) => write!(
+                out,
+                "  module at ({:.3}, {:.3}, {:.3}) m heading {:.1}° [mono, camera {}, {:.2} px, {} marks]",
+                p.position_m[0],
+                p.position_m[1],
+                p.position_m[2],
+                p.heading_deg,
+                p.camera,
+                p.reprojection_px,
+                p.marks_used
+            )?,
+            (None, Some(e)) => write!(out, "  no pose: {e}")?,
+            (None, None) => {}
+        }
+        writeln!(out, "  {:.1} µs", rec.us_per_frame)?;
+        return Ok(());
+    };
+    writeln!(out, "{image}: not found: {reason}  {:.1} µs", rec.us_per_frame)?;
     Ok(())
 }
