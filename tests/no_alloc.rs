@@ -681,6 +681,7 @@ fn corners_and_lucas_kanade_do_not_allocate() {
 
 /// The AutoKrawler's whole ten-DOF estimate (`KrawlerStateSchema`) on rendered frames:
 /// pyramids, corner and track buffers and RANSAC's steps are reused, nothing allocates.
+#[cfg(feature = "sim")]
 #[test]
 fn krawler_state_estimation_does_not_allocate() {
     use common::krawler::{Rig, axles, draw};
