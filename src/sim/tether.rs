@@ -136,16 +136,8 @@ impl Tether {
         if self.arm_leads() {
             return self.step_arm(dt, pose, rate, free);
         }
-        self.reeling = rate != 0.0;
         let dist = self.distance(pose);
-        if rate > 0.0 {
-            self.length = (self.length - rate * dt).max(0.0);
-        } else {
-            self.length = (self.length - rate * dt).min(self.max_length);
-            if dist > self.length {
-                self.length = dist.min(self.max_length); // passive pay-out
-            }
-        }
+        self.reel(dt, rate, dist);
         let stretch = dist - self.length;
         self.tension = (stretch * STIFFNESS_N_PER_M).max(0.0);
         if stretch <= 0.0 || !free {
@@ -173,11 +165,11 @@ impl Tether {
 }
 
 impl Tether {
-    /// A leading arm's step: the reel shortens (or passively pays out) the tether, up to
-    /// its stall; a taut tether with the wheels free drags the tip toward the anchor by
-    /// the stretch, the rover following as a towed caster.
-    fn step_arm(&mut self, dt: f64, pose: &Pose2, rate: f64, free: bool) -> Pose2 {
-        let dist = self.distance(pose);
+    /// The reel's part of a step, whichever end the tether pulls: reeling in at `rate`
+    /// (m/s, positive in) shortens the tether; paying out lengthens it up to its length,
+    /// and a robot `dist` from the anchor that has moved beyond the tether draws it out
+    /// passively.
+    fn reel(&mut self, dt: f64, rate: f64, dist: f64) {
         self.reeling = rate != 0.0;
         if rate > 0.0 {
             self.length = (self.length - rate * dt).max(0.0);
@@ -187,6 +179,14 @@ impl Tether {
                 self.length = dist.min(self.max_length); // passive pay-out
             }
         }
+    }
+
+    /// A leading arm's step: the reel shortens (or passively pays out) the tether, up to
+    /// its stall; a taut tether with the wheels free drags the tip toward the anchor by
+    /// the stretch, the rover following as a towed caster.
+    fn step_arm(&mut self, dt: f64, pose: &Pose2, rate: f64, free: bool) -> Pose2 {
+        let dist = self.distance(pose);
+        self.reel(dt, rate, dist);
         let stall = (STALL_CURRENT_A - REEL_IDLE_A) / AMPS_PER_NEWTON / STIFFNESS_N_PER_M;
         if dist - self.length > stall {
             self.length = dist - stall; // the stalled reel slips back
