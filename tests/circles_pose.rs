@@ -14,18 +14,14 @@
 //! rotation = the angle of R̂ᵀR (all three axes).
 
 mod common;
+use common::axel::{facing, render};
 
 use marsupial::geometry::Pose2;
-use marsupial::perception::RgbImage;
 use marsupial::perception::camera_model::{CameraModel, Fisheye, MountAngles, Pinhole};
 use marsupial::perception::circles::{
     CircleDetector, CircleModel, CircleParams, CorrespondenceParams, MarkObservations, PoseBuffers, PoseParams,
     PoseSource, RigCamera, correspond, mono_pose, rigid_fit, stereo_pose,
 };
-use marsupial::profile::Profile;
-use marsupial::sim::camera::camera_pose;
-use marsupial::sim::lighting::LightState;
-use marsupial::sim::render::{Renderer, SensorParams};
 use marsupial::sim::world;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use proptest::prelude::*;
@@ -229,37 +225,6 @@ proptest! {
             prop_assert!(be > 0.01, "ignoring distortion {be} m vs {ge} m");
         }
     }
-}
-
-/// The robot `d` m from the module's face centre, `alpha_deg` off its axis, facing it
-/// and then turned `turn_deg` (as in `tests/circles_render.rs`).
-fn facing(d: f64, alpha_deg: f64, turn_deg: f64) -> Pose2 {
-    let a = alpha_deg.to_radians();
-    Pose2::new(
-        d * a.cos(),
-        d * a.sin(),
-        a + std::f64::consts::PI + turn_deg.to_radians(),
-    )
-}
-
-/// Camera `cam` of `p` at robot pose `robot`, the default (noisy, auto-exposed) sensor
-/// after four frames.
-fn render(p: &Profile, w: &world::World, cam: usize, robot: &Pose2, seed: u64) -> RgbImage {
-    let spec = &p.cameras[cam];
-    let mut r = Renderer::new(CameraModel::from_spec(spec), spec.width_px, spec.height_px, seed);
-    let pose = camera_pose(robot, &spec.mount);
-    let mut im = RgbImage::default();
-    for k in 0..4 {
-        r.render(
-            &w.scene,
-            &pose,
-            &LightState::uniform(1.0),
-            &SensorParams::default(),
-            seed + k,
-            &mut im,
-        );
-    }
-    im
 }
 
 /// Position (m), heading (°) and rotation (°) errors of `est` against the module's

@@ -9,6 +9,7 @@
 //! and some marks are missed: short of the paper's "discernable from 5 m".
 
 mod common;
+use common::axel::{facing, render as render_frame};
 
 use marsupial::geometry::Pose2;
 use marsupial::perception::RgbImage;
@@ -18,44 +19,20 @@ use marsupial::perception::circles::{
 };
 use marsupial::profile::Profile;
 use marsupial::sim::camera::camera_pose;
-use marsupial::sim::lighting::LightState;
-use marsupial::sim::render::{Renderer, SensorParams};
 use marsupial::sim::world;
 use nalgebra::Point3;
 
 /// A mark's projected centre and outer radius, px.
 type Seen = ([f64; 2], f64);
 
-/// The robot `d` m from the module's face centre, `alpha_deg` off its axis, facing it
-/// and then turned `turn_deg`.
-fn facing(d: f64, alpha_deg: f64, turn_deg: f64) -> Pose2 {
-    let a = alpha_deg.to_radians();
-    Pose2::new(
-        d * a.cos(),
-        d * a.sin(),
-        a + std::f64::consts::PI + turn_deg.to_radians(),
-    )
-}
-
 /// Camera `cam` of `p` at robot pose `robot`: the frame (the default sensor, with noise,
 /// after four frames of auto-exposure) and each mark's projected centre and outer radius,
 /// px (`None` when the mark with its margin is not wholly in view).
 fn render(p: &Profile, w: &world::World, cam: usize, robot: &Pose2, seed: u64) -> (RgbImage, Vec<Option<Seen>>) {
+    let im = render_frame(p, w, cam, robot, seed);
     let spec = &p.cameras[cam];
     let model = CameraModel::from_spec(spec);
-    let mut r = Renderer::new(model.clone(), spec.width_px, spec.height_px, seed);
     let pose = camera_pose(robot, &spec.mount);
-    let mut im = RgbImage::default();
-    for k in 0..4 {
-        r.render(
-            &w.scene,
-            &pose,
-            &LightState::uniform(1.0),
-            &SensorParams::default(),
-            seed + k,
-            &mut im,
-        );
-    }
     let circles = p.fiducial.circles.as_ref().expect("circles");
     let radius = circles.diameter_m / 2.0;
     let project = |q: Point3<f64>| model.project(&(pose.rotation.transpose() * (q - pose.position)));

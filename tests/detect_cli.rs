@@ -5,6 +5,7 @@
 //! failures with fewer than 5 marks.
 
 mod common;
+use common::axel::{facing, render};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -203,8 +204,6 @@ fn bad_inputs_give_clear_errors() {
 use marsupial::geometry::Pose2;
 use marsupial::perception::camera_model::CameraModel;
 use marsupial::sim::camera::camera_pose;
-use marsupial::sim::lighting::LightState;
-use marsupial::sim::render::{Renderer, SensorParams};
 use marsupial::sim::world;
 use nalgebra::Point3;
 
@@ -223,37 +222,15 @@ fn detect_axel(args: &[&str], images: &[&Path]) -> Output {
         .unwrap()
 }
 
-/// The robot `d` m from the module's face centre, `alpha_deg` off its axis, facing it
-/// and then turned `turn_deg` (as in `tests/circles_render.rs`).
-fn facing(d: f64, alpha_deg: f64, turn_deg: f64) -> Pose2 {
-    let a = alpha_deg.to_radians();
-    Pose2::new(
-        d * a.cos(),
-        d * a.sin(),
-        a + std::f64::consts::PI + turn_deg.to_radians(),
-    )
-}
-
 /// Camera `cam` of Axel at `robot`, rendered by the simulator (default noisy sensor,
 /// four frames of auto-exposure), and each mark's projected centre, px.
 fn render_axel(cam: usize, robot: &Pose2, seed: u64) -> (marsupial::perception::RgbImage, Vec<[f64; 2]>) {
     let p = common::shipped_profile("axel");
     let w = world::build(&p, &[], &[]).expect("axel world");
+    let im = render(&p, &w, cam, robot, seed);
     let spec = &p.cameras[cam];
     let model = CameraModel::from_spec(spec);
-    let mut r = Renderer::new(model.clone(), spec.width_px, spec.height_px, seed);
     let pose = camera_pose(robot, &spec.mount);
-    let mut im = marsupial::perception::RgbImage::default();
-    for k in 0..4 {
-        r.render(
-            &w.scene,
-            &pose,
-            &LightState::uniform(1.0),
-            &SensorParams::default(),
-            seed + k,
-            &mut im,
-        );
-    }
     let truth = p
         .fiducial
         .circles

@@ -4,6 +4,8 @@
 #![allow(dead_code)]
 
 #[cfg(feature = "sim")]
+pub mod axel;
+#[cfg(feature = "sim")]
 pub mod krawler;
 
 use marsupial::geometry::Pose2;
