@@ -33,15 +33,20 @@ fn scene() -> marsupial::perception::RgbImage {
     im
 }
 
-fn detect(args: &[&str], images: &[&Path]) -> Output {
+/// `marsupial detect --profile PROFILE ARGS... IMAGES...`.
+fn detect_with(profile: &Path, args: &[&str], images: &[&Path]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_marsupial"))
         .arg("detect")
         .arg("--profile")
-        .arg(profile())
+        .arg(profile)
         .args(args)
         .args(images)
         .output()
         .unwrap()
+}
+
+fn detect(args: &[&str], images: &[&Path]) -> Output {
+    detect_with(&profile(), args, images)
 }
 
 fn json_lines(out: &Output) -> Vec<serde_json::Value> {
@@ -169,23 +174,14 @@ fn bad_inputs_give_clear_errors() {
     }
     let f = tmp("ok.png");
     save(&scene(), &f);
-    let out = Command::new(env!("CARGO_BIN_EXE_marsupial"))
-        .args(["detect", "--profile", "no/such/profile.toml"])
-        .arg(&f)
-        .output()
-        .unwrap();
+    let out = detect_with(Path::new("no/such/profile.toml"), &[], &[&f]);
     assert!(
         String::from_utf8(out.stderr)
             .unwrap()
             .contains("no/such/profile.toml: cannot read file")
     );
     let raposa = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml");
-    let out = Command::new(env!("CARGO_BIN_EXE_marsupial"))
-        .args(["detect", "--profile"])
-        .arg(raposa)
-        .arg(&f)
-        .output()
-        .unwrap();
+    let out = detect_with(&raposa, &[], &[&f]);
     assert!(
         String::from_utf8(out.stderr)
             .unwrap()
@@ -212,14 +208,7 @@ fn axel_profile() -> PathBuf {
 }
 
 fn detect_axel(args: &[&str], images: &[&Path]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_marsupial"))
-        .arg("detect")
-        .arg("--profile")
-        .arg(axel_profile())
-        .args(args)
-        .args(images)
-        .output()
-        .unwrap()
+    detect_with(&axel_profile(), args, images)
 }
 
 /// Camera `cam` of Axel at `robot`, rendered by the simulator (default noisy sensor,
@@ -492,12 +481,7 @@ fn circles_bad_inputs_give_clear_errors() {
     );
     // A profile with neither fiducial names both.
     let raposa = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml");
-    let out = Command::new(env!("CARGO_BIN_EXE_marsupial"))
-        .args(["detect", "--profile"])
-        .arg(raposa)
-        .arg(&f)
-        .output()
-        .unwrap();
+    let out = detect_with(&raposa, &[], &[&f]);
     assert!(
         String::from_utf8(out.stderr)
             .unwrap()
