@@ -64,7 +64,7 @@ pub use pyramid_tracker::{PyramidTracker, PyramidTrackerParams};
 pub use sct::{Sct, SctPlanes, sct_from_rgb};
 pub use segment::{ColorRange, HsvRange, Mask, SctRange, Segmenter};
 pub use two_block::{Block, Pair, PairLimits, TwoBlockDetector, TwoBlockParams, TwoBlockPercept, TwoBlockTracker};
-pub use two_block_pose::{FiducialView, TwoBlockGeometry};
+pub use two_block_pose::{FiducialView, RatioJumpGate, TwoBlockGeometry};
 
 use thiserror::Error;
 

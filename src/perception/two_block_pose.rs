@@ -190,6 +190,75 @@ impl FiducialView {
     }
 }
 
+/// Flags frames whose block ratio jumped: the ratio cue's guard against a flash or a
+/// passing shadow that hits one block.
+///
+/// A light change that reaches one block and not the other (a beacon sweeping across the
+/// flap, a shadow edge) shrinks or swells that block's pixel count for a frame or two.
+/// The pair is still found, but the asymmetry (L − R)/(L + R), and with it the viewing
+/// angle α, jumps by tens of degrees, while a real change of viewpoint moves it a little
+/// per frame (at 0.4 m, a 2° change of α moves it by 0.014). The gate compares each
+/// frame's asymmetry with the last accepted one and rejects a jump larger than
+/// `max_jump`; after `reset_after` rejected frames in a row the view is taken to have
+/// really changed and the new asymmetry is accepted. Moving closer scales both blocks
+/// alike and leaves the asymmetry, so approaching never trips it.
+///
+/// ```
+/// use marsupial::perception::RatioJumpGate;
+///
+/// let mut gate = RatioJumpGate::new(0.04, 3);
+/// assert!(gate.check(0.01)); // the first view is the reference
+/// assert!(gate.check(0.02)); // a small change of viewpoint
+/// assert!(!gate.check(0.15)); // one block flashed
+/// assert!(gate.check(0.03)); // back to normal
+/// // A lasting change is accepted after three rejected frames.
+/// assert!(!gate.check(0.2) && !gate.check(0.2) && !gate.check(0.2));
+/// assert!(gate.check(0.2));
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RatioJumpGate {
+    /// Largest accepted change of the asymmetry from the last accepted frame.
+    pub max_jump: f64,
+    /// Rejected frames in a row after which the new asymmetry is accepted.
+    pub reset_after: u32,
+    reference: Option<f64>,
+    rejected: u32,
+}
+
+impl RatioJumpGate {
+    /// A gate with no reference yet. `max_jump` = ∞ accepts every frame.
+    pub fn new(max_jump: f64, reset_after: u32) -> Self {
+        Self {
+            max_jump,
+            reset_after,
+            reference: None,
+            rejected: 0,
+        }
+    }
+
+    /// Whether the ratio of a frame with asymmetry `asym` ([`FiducialView::asym`]) can be
+    /// trusted; updates the reference.
+    pub fn check(&mut self, asym: f64) -> bool {
+        let accept = match self.reference {
+            None => true,
+            Some(r) => (asym - r).abs() <= self.max_jump || self.rejected >= self.reset_after,
+        };
+        if accept {
+            self.reference = Some(asym);
+            self.rejected = 0;
+        } else {
+            self.rejected += 1;
+        }
+        accept
+    }
+
+    /// Forgets the reference (the fiducial was lost, or a new docking begins).
+    pub fn reset(&mut self) {
+        self.reference = None;
+        self.rejected = 0;
+    }
+}
+
 /// sin α from the pixel asymmetry (L − R)/(L + R) of a flap `width_m` wide seen from
 /// `distance` m. A patch at lateral position y on the flap subtends a solid angle
 /// ∝ cos β/r², with r its distance and β the angle between its line of sight and the

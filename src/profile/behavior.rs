@@ -38,6 +38,12 @@ pub struct BujoldTuning {
     /// Reliable frames the repositioning decision takes the median over (longer than a
     /// rotating beacon's period: a flash cannot fake an off-axis view), at most 64.
     pub alpha_window_frames: usize,
+    /// Largest change of the block asymmetry (L − R)/(L + R) from one trusted frame to
+    /// the next; a larger jump is a flash or a shadow on one block, and that frame's ratio
+    /// is not used (`inf` trusts every frame). See `perception::RatioJumpGate`.
+    pub ratio_jump: f64,
+    /// Rejected frames in a row after which a changed ratio is accepted as real.
+    pub ratio_jump_reset_frames: u32,
     /// Staging distance on the dock axis for repositioning, m.
     pub staging_x_m: f64,
     /// Staging at least this much farther out than the robot is, m.
@@ -57,6 +63,8 @@ impl Default for BujoldTuning {
             alpha_low_pass: 0.3,
             reliable_height_px: 40.0,
             alpha_window_frames: 16,
+            ratio_jump: 0.04,
+            ratio_jump_reset_frames: 3,
             staging_x_m: 0.75,
             staging_margin_m: 0.15,
             clearance_x_m: 0.45,
@@ -271,6 +279,12 @@ pub(crate) fn validate_behavior(b: &BehaviorSpec, v: &mut Validator<'_>) {
     if let Some(t) = &b.bujold {
         v.range("behavior.bujold.alpha_low_pass", t.alpha_low_pass, 0.0, 1.0);
         v.positive("behavior.bujold.trust_ramp_px", t.trust_ramp_px);
+        v.require(t.ratio_jump > 0.0, "behavior.bujold.ratio_jump", || {
+            format!(
+                "expected a positive number (inf trusts every frame), got {}",
+                t.ratio_jump
+            )
+        });
         v.require(
             (1..=64).contains(&t.alpha_window_frames),
             "behavior.bujold.alpha_window_frames",

@@ -14,7 +14,7 @@ use crate::behaviors::composed::SharedMemory;
 use crate::geometry::Pose2;
 use crate::perception::TwoBlockPercept;
 use crate::perception::frame_change::FrameChange;
-use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
+use crate::perception::two_block_pose::{FiducialView, RatioJumpGate, TwoBlockGeometry};
 use crate::profile::{ApproachKind, Profile};
 use crate::schemas::TwoBlockSchema;
 use crate::schemas::{
@@ -92,7 +92,8 @@ pub struct Memory {
     pub odo: Pose2,
     /// This tick's view for steering: viewing angle low-passed and scaled by its trust.
     pub view: Option<FiducialView>,
-    /// This tick's view for planning: viewing angle low-passed, not scaled.
+    /// This tick's view for planning: viewing angle low-passed, not scaled. `None` on a
+    /// frame whose block ratio jumped ([`RatioJumpGate`]): no decision is made on it.
     pub planning: Option<FiducialView>,
     /// The fiducial was found this tick.
     pub found: bool,
@@ -104,6 +105,8 @@ pub struct Memory {
     pub alpha_filtered: Option<f64>,
     /// The last raw viewing angles of reliable frames, for the repositioning decision.
     pub alpha_window: MedianWindow,
+    /// Rejects frames whose block ratio jumped (a flash or a shadow on one block).
+    pub ratio_gate: RatioJumpGate,
     /// How much the view changes from frame to frame (a turn that does not change it is
     /// jammed); observed by the phases that search or may fall back to search.
     pub frame_change: FrameChange,
@@ -211,6 +214,7 @@ impl Memory {
             percept: None,
             alpha_filtered: None,
             alpha_window: MedianWindow::new(tuning.alpha_window_frames),
+            ratio_gate: RatioJumpGate::new(tuning.ratio_jump, tuning.ratio_jump_reset_frames),
             frame_change: FrameChange::new(),
             ever_seen: false,
             last_seen: None,
@@ -259,21 +263,27 @@ impl Memory {
             // robot therefore pursues the fiducial along the line of sight; the aim point
             // fades in close.
             let trust = ((v.height_px - p.trust_from_px) / p.trust_ramp_px).clamp(0.0, 1.0);
+            // A frame whose ratio jumped (one block flashed or shadowed) keeps the last
+            // viewing angle and gives no planning view; the bearing still steers.
+            let consistent = self.ratio_gate.check(v.asym);
             let a = match self.alpha_filtered {
                 None => v.alpha,
+                Some(prev) if !consistent => prev,
                 Some(prev) => prev + p.alpha_low_pass * (v.alpha - prev),
             };
             self.alpha_filtered = Some(a);
-            if v.height_px >= p.reliable_height_px {
+            if consistent && v.height_px >= p.reliable_height_px {
                 self.alpha_window.push(v.alpha);
             }
             // The final decision uses the filtered estimate (repositioning the median of
             // `alpha_window`); steering uses it scaled by its trust.
             let planning = v.with_alpha(a);
-            self.planning = Some(planning);
-            // dock → odometry: odo = T ⊕ here, so T = odo ⊕ here⁻¹.
-            let here = planning.dock_pose();
-            self.dock_in_odometry = Some(self.odo.compose(&here.relative(&Pose2::default())));
+            if consistent {
+                self.planning = Some(planning);
+                // dock → odometry: odo = T ⊕ here, so T = odo ⊕ here⁻¹.
+                let here = planning.dock_pose();
+                self.dock_in_odometry = Some(self.odo.compose(&here.relative(&Pose2::default())));
+            }
             *v = v.with_alpha(a * trust);
         }
         self.view = view;
@@ -386,6 +396,7 @@ impl SharedMemory for Memory {
             Mission::Docking { dock_hint } => {
                 self.alpha_filtered = None;
                 self.alpha_window.clear();
+                self.ratio_gate.reset();
                 self.retries = 0;
                 self.unjams = 0;
                 self.ever_seen = false;

@@ -159,6 +159,7 @@ impl Behavior for Reposition {
                 if err.abs() < tol {
                     m.alpha_filtered = None;
                     m.alpha_window.clear();
+                    m.ratio_gate.reset();
                     m.hold(phase).with_event("aligned")
                 } else {
                     m.turn_by(err, phase)
