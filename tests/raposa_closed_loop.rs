@@ -1,19 +1,45 @@
 //! RAPOSA's seven-state docking closed in the simulator from starts across region I (on
 //! the axis, near and far, 15° off) and region II (30°, 60° and 90° on either side, and
 //! inside δ where the manoeuvre backs away). Each must dock within the profile's
-//! tolerance, region-II starts through at least one alignment manoeuvre.
+//! tolerance, region-II starts through at least one alignment manoeuvre. And from the
+//! paper's dead zone (0.33 m, far off the axis, where only the ball is in view), which
+//! the paper never docked: by probing around the ball until the pair shows its side.
 
 use marsupial::behaviors::agent_for;
 use marsupial::sim::campaign;
 use marsupial::sim::scenario::Scenario;
 use std::path::Path;
 
-#[test]
-fn docks_from_starts_across_regions_one_and_two() {
-    let dir = std::env::temp_dir().join(format!("marsupial-raposa-loop-{}", std::process::id()));
+type Outcome = (Vec<campaign::RunRecord>, campaign::Summary, f64, f64);
+
+/// Runs the profile from `points` (distance m, angle °), one trial each; the records, the
+/// summary and the profile's lateral (m) and heading (°) tolerances.
+fn run(tag: &str, points: &[(f64, f64)]) -> Outcome {
+    let dir = std::env::temp_dir().join(format!("marsupial-raposa-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let profile = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml");
     let s = dir.join("s.toml");
+    let list: Vec<String> = points
+        .iter()
+        .map(|(d, a)| format!("{{ distance_m = {d}, angle_deg = {a} }}"))
+        .collect();
+    std::fs::write(
+        &s,
+        format!(
+            "name = \"raposa-{tag}\"\nprofile = \"{}\"\nseed = 5\ntrials = 1\ntimeout_s = 300.0\n[starts]\nposition_jitter_m = 0.02\nheading_jitter_deg = 2.0\npoints = [{}]\n[imprint]\nenabled = false\n",
+            profile.display(),
+            list.join(", ")
+        ),
+    )
+    .unwrap();
+    let p = campaign::prepare(Scenario::load(&s).unwrap()).unwrap();
+    let (records, summary) = campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap();
+    let tol = p.loaded.profile.success;
+    (records, summary, tol.lateral_tolerance_m, tol.heading_tolerance_deg)
+}
+
+#[test]
+fn docks_from_starts_across_regions_one_and_two() {
     let points: [(f64, f64); 8] = [
         (0.5, 0.0),
         (2.0, 0.0),
@@ -24,35 +50,43 @@ fn docks_from_starts_across_regions_one_and_two() {
         (1.5, 60.0),
         (1.5, -90.0),
     ];
-    let list: Vec<String> = points
-        .iter()
-        .map(|(d, a)| format!("{{ distance_m = {d}, angle_deg = {a} }}"))
-        .collect();
-    std::fs::write(
-        &s,
-        format!(
-            "name = \"raposa-loop\"\nprofile = \"{}\"\nseed = 5\ntrials = 1\ntimeout_s = 300.0\n[starts]\nposition_jitter_m = 0.02\nheading_jitter_deg = 2.0\npoints = [{}]\n[imprint]\nenabled = false\n",
-            profile.display(),
-            list.join(", ")
-        ),
-    )
-    .unwrap();
-    let p = campaign::prepare(Scenario::load(&s).unwrap()).unwrap();
-    let (records, summary) = campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap();
-    let tol = p.loaded.profile.success;
+    let (records, summary, lateral, heading) = run("loop", &points);
     for (r, (_, a)) in records.iter().zip(points) {
         assert!(
             r.success,
             "start {} ({a}°): {} after {:.1} s",
             r.start, r.outcome, r.time_s
         );
-        assert!(r.entrance_lateral_m.unwrap().abs() <= tol.lateral_tolerance_m);
-        assert!(r.entrance_heading_deg.unwrap().abs() <= tol.heading_tolerance_deg);
+        assert!(r.entrance_lateral_m.unwrap().abs() <= lateral);
+        assert!(r.entrance_heading_deg.unwrap().abs() <= heading);
         if a.abs() >= 30.0 {
             assert!(r.manoeuvres >= 1, "start {} ({a}°) docked without region II", r.start);
         } else {
             assert_eq!(r.manoeuvres, 0, "start {} ({a}°) is region I", r.start);
         }
+    }
+    assert_eq!(summary.overall.successes, points.len());
+}
+
+/// The paper's points 1 and 3 (0.33 m, ±70°) and one between them and the axis: only the
+/// ball is in view, so the robot probes (at least one manoeuvre) and docks.
+#[test]
+fn docks_from_the_dead_zone_by_probing() {
+    let points: [(f64, f64); 3] = [(0.33, -70.0), (0.33, 70.0), (0.4, -62.0)];
+    let (records, summary, lateral, heading) = run("dead-zone", &points);
+    for (r, (_, a)) in records.iter().zip(points) {
+        assert!(
+            r.success,
+            "start {} ({a}°): {} after {:.1} s",
+            r.start, r.outcome, r.time_s
+        );
+        assert!(r.entrance_lateral_m.unwrap().abs() <= lateral);
+        assert!(r.entrance_heading_deg.unwrap().abs() <= heading);
+        assert!(
+            r.manoeuvres >= 1,
+            "start {} ({a}°) docked without moving around",
+            r.start
+        );
     }
     assert_eq!(summary.overall.successes, points.len());
 }

@@ -532,6 +532,30 @@ fn the_selector_maps_percepts_to_states_and_looks_until_the_ellipse_is_seen() {
         select(from, seen(0.43, Some(60.0), [0.0, 0.0], true)),
         Some("leave_dead_zone")
     );
+    // Only the ball in the dead zone, no pair yet this docking: probe after
+    // `lost_frames` frames (8), at most four times; a pair seen before means the side is
+    // known, and the lone ball is approached.
+    let lone_ball = || seen(0.43, None, [0.0, 0.0], false);
+    mem.with(|m| m.lone = 7);
+    assert_eq!(select(from, lone_ball()), Some("approach"));
+    mem.with(|m| m.lone = 8);
+    assert_eq!(select(from, lone_ball()), Some("probe"));
+    assert_eq!(
+        select(from, seen(0.8, None, [0.0, 0.0], false)),
+        Some("approach"),
+        "outside the dead zone"
+    );
+    mem.with(|m| m.probes = 4);
+    assert_eq!(select(from, lone_ball()), Some("approach"));
+    mem.with(|m| {
+        m.probes = 0;
+        m.pair_seen = true;
+    });
+    assert_eq!(select(from, lone_ball()), Some("approach"));
+    mem.with(|m| {
+        m.pair_seen = false;
+        m.lone = 0;
+    });
     // A sighting restarts the search clock.
     mem.with(|m| m.search_start = Some(3.0));
     select(from, seen(1.5, Some(5.0), [0.0, 0.0], true));
@@ -564,6 +588,7 @@ fn the_selector_maps_percepts_to_states_and_looks_until_the_ellipse_is_seen() {
         ServoState::S5Nothing,
         ServoState::S6Final,
         ServoState::LeaveDeadZone,
+        ServoState::Probe,
     ] {
         assert!(sel.index(s).is_some(), "{s:?}");
     }

@@ -64,6 +64,14 @@ pub struct Memory {
     pub retries: u32,
     /// Consecutive frames with neither the ellipse nor the blue edges.
     pub unseen: u32,
+    /// Consecutive frames with the ellipse and no pair (no α): inside the dead zone, a
+    /// viewpoint from which the blue edges cannot be seen at all.
+    pub lone: u32,
+    /// Probes (`raposa.probe`) since a pair was last seen.
+    pub probes: u32,
+    /// A pair (with α) has been seen this docking: its side is known, so a lone ball
+    /// later is a lost pair, not the dead zone's blind side.
+    pub pair_seen: bool,
     /// When the current state-5 search began.
     pub search_start: Option<f64>,
     /// Sign of the last turn commanded (+1 CCW): searches start the other way.
@@ -146,6 +154,9 @@ impl Memory {
             aux: Auxiliary::default(),
             retries: 0,
             unseen: 0,
+            lone: 0,
+            probes: 0,
+            pair_seen: false,
             search_start: None,
             last_turn: 1.0,
             settling: false,
@@ -170,6 +181,15 @@ impl Memory {
         let p = self.source.perceive(inputs, !self.blind);
         if p.view.is_some() || p.detection.blue.is_some() {
             self.unseen = 0;
+        }
+        match p.view {
+            Some(v) if v.alpha.is_some() => {
+                self.lone = 0;
+                self.probes = 0;
+                self.pair_seen = true;
+            }
+            Some(_) => self.lone += 1,
+            None => {}
         }
         self.percept = p;
     }
@@ -267,6 +287,9 @@ impl SharedMemory for Memory {
                 self.run_start = None;
                 self.retries = 0;
                 self.unseen = 0;
+                self.lone = 0;
+                self.probes = 0;
+                self.pair_seen = false;
                 self.search_start = None;
                 self.settling = false;
                 self.aux = Auxiliary {

@@ -34,7 +34,8 @@
 //!
 //! Beyond the paper (profile switch `leave_dead_zone`): a robot misaligned inside the dead
 //! zone backs away to `dead_zone_exit_m` first, so that region II can align it; the paper's
-//! points 1 and 3 never docked.
+//! points 1 and 3 never docked. A robot that sees only the ball inside the dead zone (no
+//! pair, so no side) probes around it (`probe`) until the pair comes into view.
 //!
 //! Simplified relative to the paper: the simulator is planar, so the arm command and the
 //! lights are issued but do not change what the camera sees.
@@ -47,6 +48,7 @@ pub mod final_approach;
 pub mod manoeuvre;
 pub mod memory;
 pub mod params;
+pub mod probe;
 pub mod region2;
 pub mod rotate7;
 pub mod search;
@@ -132,6 +134,9 @@ pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
                 m.clone(),
                 Distance::DeadZone(a.params()?),
             )))
+        })
+        .register("raposa.probe", |m: &Ctx, a: &LeafArgs<'_>| {
+            Ok(Box::new(probe::Probe::new(a.node, m.clone(), a.params()?)))
         })
         .register("raposa.retreat", |m: &Ctx, a: &LeafArgs<'_>| {
             Ok(Box::new(BackAway::new(

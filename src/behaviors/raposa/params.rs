@@ -92,3 +92,19 @@ pub struct FinalParams {
     /// default): no posture command.
     pub posture: Option<Posture>,
 }
+
+/// `probe` (ours): a lone ball in the dead zone, side unknown.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ProbeParams {
+    /// Angle around the ball of the first probe, degrees; each next probe goes the other
+    /// way and one step further (+1, −2, +3, −4 steps: ending ±1 and ±2 steps from the
+    /// start).
+    pub step_deg: f64,
+}
+
+impl Default for ProbeParams {
+    fn default() -> Self {
+        Self { step_deg: 35.0 }
+    }
+}

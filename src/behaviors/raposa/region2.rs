@@ -46,7 +46,13 @@ pub fn robot_in_ball_frame(view: &PyramidView, alpha: f64, camera_x: f64) -> Pos
 /// Plans the manoeuvre from `start` to the socket at distance `delta` on the axis;
 /// `half_length` is the centre-to-rear distance.
 pub fn plan(start: Pose2, delta: f64, half_length: f64) -> Region2Plan {
-    let target = (delta + half_length, 0.0);
+    plan_to(start, (delta + half_length, 0.0), 0.0)
+}
+
+/// The same manoeuvre to any `target` of the robot's centre in the ball frame, ending at
+/// heading `final_heading`: rotate onto the line to the target (front or back first,
+/// whichever turns less), travel, rotate.
+pub fn plan_to(start: Pose2, target: (f64, f64), final_heading: f64) -> Region2Plan {
     let (dx, dy) = (target.0 - start.x, target.1 - start.y);
     let forward = dy.atan2(dx);
     let backward = wrap_angle(forward + PI);
@@ -63,7 +69,7 @@ pub fn plan(start: Pose2, delta: f64, half_length: f64) -> Region2Plan {
         reverse,
         rotation,
         distance: dx.hypot(dy),
-        final_rotation: wrap_angle(0.0 - travel_heading),
+        final_rotation: wrap_angle(final_heading - travel_heading),
     }
 }
 

@@ -7,7 +7,7 @@
 //! seen, then selects with the angle threshold widened (settling) in that same tick.
 
 use super::memory::Memory;
-use super::states::{ServoState, select_state};
+use super::states::{ServoState, probe_due, select_state};
 use crate::arbiter::{Blackboard, Selector};
 use crate::behaviors::registry::SelectorArgs;
 use crate::schemas::Inputs;
@@ -23,11 +23,14 @@ pub struct SevenState {
     final_: usize,
     leave_dead_zone: usize,
     look: usize,
+    probe: Option<usize>,
 }
 
 impl SevenState {
     /// The selector of a sequencer with states named `approach`, `align`,
-    /// `far_ellipse`, `blue_only`, `search`, `final`, `leave_dead_zone` and `look`.
+    /// `far_ellipse`, `blue_only`, `search`, `final`, `leave_dead_zone` and `look`, and
+    /// optionally `probe` (ours: without it a lone ball in the dead zone is approached,
+    /// as in the paper).
     ///
     /// # Errors
     /// A message naming a missing state.
@@ -42,10 +45,12 @@ impl SevenState {
             final_: args.state("final")?,
             leave_dead_zone: args.state("leave_dead_zone")?,
             look: args.state("look")?,
+            probe: args.state("probe").ok(),
         })
     }
 
-    /// The state index of a servo state (`None` for state 7, which `align` hands over to).
+    /// The state index of a servo state (`None` for state 7, which `align` hands over to,
+    /// and for `probe` in a tree without it).
     pub fn index(&self, state: ServoState) -> Option<usize> {
         Some(match state {
             ServoState::S1Approach => self.approach,
@@ -55,6 +60,7 @@ impl SevenState {
             ServoState::S5Nothing => self.search,
             ServoState::S6Final => self.final_,
             ServoState::LeaveDeadZone => self.leave_dead_zone,
+            ServoState::Probe => return self.probe,
             ServoState::S7Rotate => return None,
         })
     }
@@ -71,7 +77,13 @@ impl Selector for SevenState {
             p.view?;
             m.settling = true;
         }
-        let state = select_state(&p, &m.gains, m.socket_inset, m.settling);
+        let mut state = select_state(&p, &m.gains, m.socket_inset, m.settling);
+        if state == ServoState::S1Approach
+            && self.probe.is_some()
+            && probe_due(&p, &m.gains, m.socket_inset, m.lone, m.probes, m.pair_seen)
+        {
+            state = ServoState::Probe;
+        }
         self.index(state)
     }
 }

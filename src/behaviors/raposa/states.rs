@@ -44,6 +44,10 @@ pub enum ServoState {
     S7Rotate,
     /// Ours: misaligned inside the dead zone, back away before choosing again.
     LeaveDeadZone,
+    /// Ours: only the ball, no pair this docking, inside the dead zone for `lost_frames`
+    /// frames: the side is unknown, so move around the ball and look again
+    /// (`raposa.probe`, [`probe_due`]).
+    Probe,
 }
 
 impl ServoState {
@@ -58,6 +62,7 @@ impl ServoState {
             ServoState::S6Final => "state_6",
             ServoState::S7Rotate => "state_7",
             ServoState::LeaveDeadZone => "leave_dead_zone",
+            ServoState::Probe => "probe",
         }
     }
 
@@ -101,6 +106,36 @@ pub fn select_state(p: &PyramidPercept, g: &SevenStateGains, socket_inset: f64, 
         None if v.ball_distance_m >= g.far_distance_m => ServoState::S3FarEllipse,
         None => ServoState::S1Approach,
     }
+}
+
+/// Probes before the servo gives up probing and approaches the lone ball as state 1
+/// does: two each way, alternating and growing, cover ±2 probe steps around the start.
+pub const MAX_PROBES: u32 = 4;
+
+/// Ours: whether to probe instead of approaching a lone ball (state 1 without α). Inside
+/// the dead zone the pair cannot be seen from beyond about 60° off the axis, so nothing
+/// tells the robot which side it is on and driving in catches the entrance (the paper's
+/// points 1 and 3). When no pair has been seen this docking (`pair_seen`: one seen
+/// earlier gave the side, and a lone ball now is a pair lost to the light), after
+/// `lost_frames` such frames in a row (`lone`), and while fewer than [`MAX_PROBES`]
+/// probes have been made, it probes.
+pub fn probe_due(
+    p: &PyramidPercept,
+    g: &SevenStateGains,
+    socket_inset: f64,
+    lone: u32,
+    probes: u32,
+    pair_seen: bool,
+) -> bool {
+    let Some(v) = p.view else {
+        return false;
+    };
+    !pair_seen
+        && v.alpha.is_none()
+        && v.ball_distance_m > g.final_distance_m
+        && v.ball_distance_m - socket_inset < g.distance_threshold_m
+        && lone >= g.lost_frames
+        && probes < MAX_PROBES
 }
 
 #[cfg(test)]
