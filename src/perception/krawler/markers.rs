@@ -159,6 +159,7 @@ pub struct MarkerFinder {
     params: MarkerParams,
     mask: Mask,
     scratch: Mask,
+    line: Mask,
     labeler: Labeler,
     blobs: Vec<Blob>,
     pairs: Vec<(f64, u8, u16)>,
@@ -177,6 +178,7 @@ impl MarkerFinder {
             params,
             mask: Mask::new(width, height),
             scratch: Mask::new(width, height),
+            line: Mask::new(width, height),
             labeler: Labeler::new(width, height),
             blobs: Vec::with_capacity(MAX_BLOBS),
             pairs: Vec::with_capacity(8 * MAX_BLOBS),
@@ -210,13 +212,41 @@ impl MarkerFinder {
         if self.params.windows {
             self.mask.data_mut().fill(0);
             let rects = expected.map(|e| Rect::around(&e, self.params.gate_px, w, h));
-            for r in rects {
-                self.segment(frame, r);
+            // Each row's stretches covered by the windows, merged, so a pixel of
+            // overlapping windows is segmented once.
+            let (y0, y1) = rects
+                .iter()
+                .filter(|r| r.x0 < r.x1 && r.y0 < r.y1)
+                .fold((usize::MAX, 0), |(a, b), r| (a.min(r.y0), b.max(r.y1)));
+            for y in y0..y1 {
+                let mut spans = [(0usize, 0usize); 8];
+                let mut n = 0;
+                for r in rects.iter().filter(|r| r.x0 < r.x1 && r.y0 <= y && y < r.y1) {
+                    spans[n] = (r.x0, r.x1);
+                    n += 1;
+                }
+                spans[..n].sort_unstable();
+                let mut open: Option<(usize, usize)> = None;
+                for &(a, b) in &spans[..n] {
+                    open = match open {
+                        Some((oa, ob)) if a <= ob => Some((oa, ob.max(b))),
+                        Some((oa, ob)) => {
+                            self.segment(frame, y, oa, ob);
+                            Some((a, b))
+                        }
+                        None => Some((a, b)),
+                    };
+                }
+                if let Some((a, b)) = open {
+                    self.segment(frame, y, a, b);
+                }
             }
-            open3(&mut self.mask, &mut self.scratch, &rects);
+            open3(&mut self.mask, &mut self.scratch, &mut self.line, &rects);
         } else {
-            self.segment(frame, Rect::full(w, h));
-            open3(&mut self.mask, &mut self.scratch, &[Rect::full(w, h)]);
+            for y in 0..h {
+                self.segment(frame, y, 0, w);
+            }
+            open3(&mut self.mask, &mut self.scratch, &mut self.line, &[Rect::full(w, h)]);
         }
         self.collect_blobs()?;
         let mut found = self.assign(expected);
@@ -289,8 +319,8 @@ impl MarkerFinder {
         }
     }
 
-    /// Segments the pixels of `r` into the mask.
-    fn segment(&mut self, frame: &RgbView<'_>, r: Rect) {
+    /// Segments the pixels x0..x1 of row y into the mask.
+    fn segment(&mut self, frame: &RgbView<'_>, y: usize, x0: usize, x1: usize) {
         let p = &self.params;
         let w = frame.width();
         let bytes = frame.as_bytes();
@@ -299,16 +329,15 @@ impl MarkerFinder {
         // `magenta_needs_green_least`): for such a band, every other pixel is rejected
         // before the conversion, with the same result.
         let green_least = p.hue_deg.0 > 240.0;
-        for y in r.y0..r.y1 {
-            for x in r.x0..r.x1 {
-                let i = y * w + x;
-                let rgb = [bytes[3 * i], bytes[3 * i + 1], bytes[3 * i + 2]];
-                data[i] = if green_least && (rgb[1] >= rgb[0] || rgb[1] >= rgb[2]) {
-                    0
-                } else {
-                    in_band(p, rgb) as u8
-                };
-            }
+        let out = &mut data[y * w + x0..y * w + x1];
+        let px = &bytes[3 * (y * w + x0)..3 * (y * w + x1)];
+        for (o, rgb) in out.iter_mut().zip(px.chunks_exact(3)) {
+            let rgb = [rgb[0], rgb[1], rgb[2]];
+            *o = if green_least && (rgb[1] >= rgb[0] || rgb[1] >= rgb[2]) {
+                0
+            } else {
+                in_band(p, rgb) as u8
+            };
         }
     }
 
@@ -437,65 +466,77 @@ impl Rect {
     }
 }
 
-/// A 3×3 opening of `mask` (erosion, then dilation), through `scratch` (same size), for
-/// a mask that is unset outside `r`. Pixels outside the image count as unset, so erosion
-/// clears the border ring.
-fn open3(mask: &mut Mask, scratch: &mut Mask, rects: &[Rect]) {
+/// A 3×3 opening of `mask` (erosion, then dilation), through `scratch` and `line` (same
+/// size), for a mask that is unset outside `rects`. Pixels outside the image count as
+/// unset, so erosion clears the border ring. Both are separable (a row pass, then a
+/// column pass over whole row slices, which the compiler vectorises); the test below
+/// checks it against the plain 3×3 reference.
+fn open3(mask: &mut Mask, scratch: &mut Mask, line: &mut Mask, rects: &[Rect]) {
     let (w, h) = mask.size();
     if w < 3 || h < 3 {
         // Every pixel is on the border ring, which erosion clears.
         mask.data_mut().fill(0);
         return;
     }
+    let live = |r: &&Rect| r.x0 < r.x1 && r.y0 < r.y1;
     // Erosion of every rectangle first (a pixel of two overlapping rectangles gets the
     // same value twice), so the dilation reads the finished erosion everywhere.
-    {
-        let src = mask.data();
-        let dst = scratch.data_mut();
-        dst.fill(0);
-        for r in rects.iter().filter(|r| r.x0 < r.x1 && r.y0 < r.y1) {
-            let (x0, x1) = (r.x0.max(1), r.x1.min(w - 1));
-            if x0 >= x1 {
-                continue;
+    scratch.data_mut().fill(0);
+    for r in rects.iter().filter(live) {
+        let (x0, x1) = (r.x0.max(1), r.x1.min(w - 1));
+        let (y0, y1) = (r.y0.max(1), r.y1.min(h - 1));
+        if x0 >= x1 || y0 >= y1 {
+            continue;
+        }
+        let (src, tmp) = (mask.data(), line.data_mut());
+        for y in y0 - 1..y1 + 1 {
+            let row = &src[y * w..(y + 1) * w];
+            let out = &mut tmp[y * w + x0..y * w + x1];
+            for (((o, a), b), c) in out.iter_mut().zip(&row[x0 - 1..]).zip(&row[x0..]).zip(&row[x0 + 1..]) {
+                *o = a & b & c;
             }
-            for y in r.y0.max(1)..r.y1.min(h - 1) {
-                let (up, mid, down) = (
-                    &src[(y - 1) * w..y * w],
-                    &src[y * w..(y + 1) * w],
-                    &src[(y + 1) * w..(y + 2) * w],
-                );
-                let out = &mut dst[y * w..(y + 1) * w];
-                for x in x0..x1 {
-                    out[x] = up[x - 1]
-                        & up[x]
-                        & up[x + 1]
-                        & mid[x - 1]
-                        & mid[x]
-                        & mid[x + 1]
-                        & down[x - 1]
-                        & down[x]
-                        & down[x + 1];
-                }
+        }
+        let (tmp, dst) = (line.data(), scratch.data_mut());
+        for y in y0..y1 {
+            let out = &mut dst[y * w + x0..y * w + x1];
+            let (a, b, c) = (&tmp[(y - 1) * w + x0..], &tmp[y * w + x0..], &tmp[(y + 1) * w + x0..]);
+            for (((o, a), b), c) in out.iter_mut().zip(a).zip(b).zip(c) {
+                *o = a & b & c;
             }
         }
     }
     // Eroded pixels lie inside the rectangles, so the dilation reaches at most one
     // pixel beyond them; the mask outside is unset and stays so.
-    let src = scratch.data();
-    let dst = mask.data_mut();
-    for r in rects.iter().filter(|r| r.x0 < r.x1 && r.y0 < r.y1) {
+    for r in rects.iter().filter(live) {
         let (x0, x1) = (r.x0.saturating_sub(1), (r.x1 + 1).min(w));
-        for y in r.y0.saturating_sub(1)..(r.y1 + 1).min(h) {
-            let (ya, yb) = (y.saturating_sub(1), (y + 2).min(h));
-            for x in x0..x1 {
-                let (xa, xb) = (x.saturating_sub(1), (x + 2).min(w));
-                let mut any = 0u8;
-                for rr in ya..yb {
-                    for &v in &src[rr * w + xa..rr * w + xb] {
-                        any |= v;
-                    }
+        let (y0, y1) = (r.y0.saturating_sub(1), (r.y1 + 1).min(h));
+        let (src, tmp) = (scratch.data(), line.data_mut());
+        for y in y0.saturating_sub(1)..(y1 + 1).min(h) {
+            let row = &src[y * w..(y + 1) * w];
+            let out = &mut tmp[y * w + x0..y * w + x1];
+            out.copy_from_slice(&row[x0..x1]);
+            let left = usize::from(x0 == 0);
+            for (o, a) in out[left..].iter_mut().zip(&row[x0 + left - 1..]) {
+                *o |= a;
+            }
+            let n = out.len() - usize::from(x1 == w);
+            for (o, c) in out[..n].iter_mut().zip(&row[x0 + 1..]) {
+                *o |= c;
+            }
+        }
+        let (tmp, dst) = (line.data(), mask.data_mut());
+        for y in y0..y1 {
+            let out = &mut dst[y * w + x0..y * w + x1];
+            out.copy_from_slice(&tmp[y * w + x0..y * w + x1]);
+            if y > 0 {
+                for (o, a) in out.iter_mut().zip(&tmp[(y - 1) * w + x0..]) {
+                    *o |= a;
                 }
-                dst[y * w + x] = any;
+            }
+            if y + 1 < h {
+                for (o, c) in out.iter_mut().zip(&tmp[(y + 1) * w + x0..]) {
+                    *o |= c;
+                }
             }
         }
     }
@@ -521,8 +562,8 @@ mod tests {
         }
         m.set(15, 15, true);
         m.set(16, 15, true);
-        let mut s = Mask::new(20, 20);
-        open3(&mut m, &mut s, &[Rect::full(20, 20)]);
+        let (mut s, mut l) = (Mask::new(20, 20), Mask::new(20, 20));
+        open3(&mut m, &mut s, &mut l, &[Rect::full(20, 20)]);
         assert_eq!(m.count(), 36);
         assert!(!m.get(15, 15));
     }
@@ -578,8 +619,8 @@ mod tests {
                 }
             }
             let want = open_reference(&m);
-            let mut scratch = Mask::new(w, h);
-            open3(&mut m, &mut scratch, &rects);
+            let (mut scratch, mut line) = (Mask::new(w, h), Mask::new(w, h));
+            open3(&mut m, &mut scratch, &mut line, &rects);
             proptest::prop_assert_eq!(m.data(), want.data());
         }
     }
