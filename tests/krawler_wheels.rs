@@ -183,7 +183,6 @@ fn pyramids_around_the_windows_give_the_whole_frames_results() {
                 roll: [0.02 * f, -0.015 * f],
                 drop: [rest.drop[0] - 0.003 * f, rest.drop[1] + 0.002 * f],
                 steer: [0.05 * f, -0.04 * f],
-                ..rest
             };
             rig.render(&state, &mut image);
             let a = windowed.update(&image.view(), &rig.geometry, &axles(&state), draw(&mut rng_a));

@@ -214,14 +214,20 @@ impl LucasKanade {
                     &d[row + w.dy..row + w.dy + side],
                     &d[row + w.dx + w.dy..row + w.dx + w.dy + side],
                 );
+                // Each row is summed on its own and then added in: the rows' sums do
+                // not wait on one another, which a single running sum over the window
+                // made them do (the same terms, summed in a different order).
                 let k0 = j * side;
+                let (mut rx, mut ry) = (0.0f64, 0.0f64);
                 for i in 0..side {
                     let k = k0 + i;
                     let sample = w.w[0] * a[i] + w.w[1] * b[i] + w.w[2] * c[i] + w.w[3] * e[i];
                     let diff = (self.prev_win[k] - sample) as f64;
-                    bx += diff * self.grad_x[k] as f64;
-                    by += diff * self.grad_y[k] as f64;
+                    rx += diff * self.grad_x[k] as f64;
+                    ry += diff * self.grad_y[k] as f64;
                 }
+                bx += rx;
+                by += ry;
             }
             let eta = [(gyy * bx - gxy * by) / det, (gxx * by - gxy * bx) / det];
             v[0] += eta[0];
