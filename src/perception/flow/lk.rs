@@ -9,7 +9,9 @@
 //! near-singular (λ_min below [`LkParams::min_eigen`]), whose window there leaves the
 //! image, or whose step diverges is lost (`None`), never guessed; at a coarser level the
 //! same conditions only skip that level's refinement (near the border of a small image
-//! the coarse windows leave it first). The forward–backward check tracks each result back
+//! the coarse windows leave it first). A pyramid built only around regions
+//! ([`GreyPyramid::build_from_rgb_in`]) counts its pixels outside them as outside the
+//! image ([`GreyPyramid::covers`]). The forward–backward check tracks each result back
 //! and drops points that do not return within [`LkParams::max_fb_px`].
 //!
 //! Coordinates have pixel centres at integers (add 0.5 for the camera model). The window

@@ -10,7 +10,9 @@
 //!    image; a square of [`WheelParams::window_half_px`] around it.
 //! 3. **Shi–Tomasi corners** in the previous frame's window, **pyramidal Lucas–Kanade**
 //!    forward to this frame and back, inconsistent tracks dropped
-//!    ([`crate::perception::flow`]).
+//!    ([`crate::perception::flow`]). Each frame's pyramid is built only around the
+//!    windows of this frame and the previous one ([`WheelParams::pyramid_margin_px`]),
+//!    with the whole frame's values there.
 //! 4. **Per-feature steps**: both ends of a track are back-projected onto their frame's
 //!    tread cylinder and expressed in that wheel's own frame (centre at the origin, axis
 //!    y, forward x), so axle roll, drop and steering between the frames do not read as
