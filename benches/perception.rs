@@ -14,9 +14,12 @@
 //! correspondence and pose for a stereo pair under 5 ms on one core.
 //!
 //! The AutoKrawler's stages so far (issue 17), on rendered 640×480 belly-fisheye frames:
-//! the eight markers, roll/drop and steering from them, Shi–Tomasi corners in an 80×80
-//! window on a tread, and pyramidal Lucas–Kanade of those corners to the next frame
-//! (wheels turned 3°). Target (issue 17): the whole ten-DOF estimate under 5 ms.
+//! the eight markers, roll/drop and steering from them (geometry), grey pyramids of two
+//! frames (whole, and only around one tread window as the wheel stage builds them),
+//! Shi–Tomasi corners in an 80×80 window on a tread, pyramidal Lucas–Kanade of those
+//! corners to the next frame (wheels turned 3°) and of one wheel's corners with the wheel
+//! stage's settings (LK per wheel), RANSAC over forty steps, the wheel stage, and the
+//! whole estimate. Target (issue 17): the whole ten-DOF estimate under 5 ms.
 //!
 //! Run: `cargo bench --bench perception` (add `-- --quick` for a fast pass; `-- axel`
 //! for the circle cases only).
@@ -372,6 +375,36 @@ fn bench_krawler(c: &mut Criterion) {
             black_box(out.iter().filter(|o| o.is_some()).count())
         })
     });
+    // The wheel stage's own settings: its corners in a 41×41 window and its tracker,
+    // over pyramids built only around the window (grown by the stage's margin).
+    let wp = marsupial::perception::krawler::WheelParams::default();
+    let margin = wp.pyramid_margin_px.unwrap_or(0);
+    let win = Roi::around(tread[0], tread[1], wp.window_half_px, w, h);
+    let grown = Roi {
+        x0: win.x0.saturating_sub(margin),
+        y0: win.y0.saturating_sub(margin),
+        x1: (win.x1 + margin).min(w),
+        y1: (win.y1 + margin).min(h),
+    };
+    g.bench_function("grey_pyramids_two_frames_one_tread_window", |b| {
+        b.iter(|| {
+            pa.build_from_rgb_in(black_box(&frames[0].view()), &[grown]);
+            pb.build_from_rgb_in(black_box(&frames[1].view()), &[grown]);
+        })
+    });
+    let mut wheel_corners = ShiTomasi::new(w, h, wp.corners);
+    let wheel_pts: Vec<[f64; 2]> = wheel_corners.detect(pa.level(0), win).to_vec();
+    let mut wheel_lk = LucasKanade::new(wp.lk, wp.corners.max_corners);
+    let mut wheel_out = vec![None; wheel_pts.len()];
+    g.bench_function(
+        format!("lk_per_wheel_checked_{}_points_wheel_params", wheel_pts.len()),
+        |b| {
+            b.iter(|| {
+                wheel_lk.track_checked(&pa, &pb, black_box(&wheel_pts), &mut wheel_out);
+                black_box(wheel_out.iter().filter(|o| o.is_some()).count())
+            })
+        },
+    );
     bench_krawler_state(&mut g, &p, &frames);
     g.finish();
 }

@@ -154,3 +154,43 @@ fn the_white_marker_snaps_theta_back_once_per_turn_whichever_way_it_turns() {
         }
     }
 }
+
+/// Pyramids built only around the observation windows (the default) give bit for bit
+/// the steps, features, tracks and θ of pyramids over the whole frame, at the fastest
+/// speed of the tests above in both directions, with the axles rolling, dropping and
+/// steering from frame to frame so that the windows move.
+#[test]
+fn pyramids_around_the_windows_give_the_whole_frames_results() {
+    let mut rig = Rig::new(SensorParams::default(), 11);
+    let rest = rig.rest;
+    let cam = &rig.profile.cameras[0];
+    let (w, h) = (cam.width_px, cam.height_px);
+    let whole_params = WheelParams {
+        pyramid_margin_px: None,
+        ..WheelParams::default()
+    };
+    assert!(WheelParams::default().pyramid_margin_px.is_some());
+    let mut image = RgbImage::default();
+    for speed in [0.15, -0.15] {
+        let mut windowed = tracker(&rig);
+        let mut whole = WheelTracker::new(w, h, rig.layout, whole_params);
+        let (mut rng_a, mut rng_b) = (Rng::new(3), Rng::new(3));
+        let mut measured = 0;
+        for frame in 0..6 {
+            let f = frame as f64;
+            let state = KrawlerState {
+                wheel: [0, 1, 2, 3].map(|k| 0.5 + k as f64 + speed * f),
+                roll: [0.02 * f, -0.015 * f],
+                drop: [rest.drop[0] - 0.003 * f, rest.drop[1] + 0.002 * f],
+                steer: [0.05 * f, -0.04 * f],
+            };
+            rig.render(&state, &mut image);
+            let a = windowed.update(&image.view(), &rig.geometry, &axles(&state), draw(&mut rng_a));
+            let b = whole.update(&image.view(), &rig.geometry, &axles(&state), draw(&mut rng_b));
+            assert_eq!(a, b, "speed {speed}, frame {frame}");
+            assert_eq!(windowed.theta(), whole.theta());
+            measured += a.iter().filter(|s| s.step.is_some()).count();
+        }
+        assert!(measured >= 16, "speed {speed}: only {measured} steps measured");
+    }
+}

@@ -41,7 +41,7 @@ impl Default for CornerParams {
 }
 
 /// A region of interest, pixel bounds `[x0, x1) × [y0, y1)`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Roi {
     /// First column.
     pub x0: usize,

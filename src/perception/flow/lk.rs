@@ -9,7 +9,9 @@
 //! near-singular (λ_min below [`LkParams::min_eigen`]), whose window there leaves the
 //! image, or whose step diverges is lost (`None`), never guessed; at a coarser level the
 //! same conditions only skip that level's refinement (near the border of a small image
-//! the coarse windows leave it first). The forward–backward check tracks each result back
+//! the coarse windows leave it first). A pyramid built only around regions
+//! ([`GreyPyramid::build_from_rgb_in`]) counts its pixels outside them as outside the
+//! image ([`GreyPyramid::covers`]). The forward–backward check tracks each result back
 //! and drops points that do not return within [`LkParams::max_fb_px`].
 //!
 //! Coordinates have pixel centres at integers (add 0.5 for the camera model). The window
@@ -55,6 +57,8 @@ impl Default for LkParams {
 pub struct LucasKanade {
     params: LkParams,
     prev_win: Vec<f32>,
+    /// The previous window with a one-pixel ring, sampled once for the gradients.
+    patch: Vec<f32>,
     grad_x: Vec<f32>,
     grad_y: Vec<f32>,
     back: Vec<Option<[f64; 2]>>,
@@ -67,6 +71,7 @@ impl LucasKanade {
         Self {
             params,
             prev_win: vec![0.0; n],
+            patch: vec![0.0; (2 * params.radius + 3).pow(2)],
             grad_x: vec![0.0; n],
             grad_y: vec![0.0; n],
             back: Vec::with_capacity(max_points),
@@ -130,7 +135,7 @@ impl LucasKanade {
             let at = [p[0] / scale, p[1] / scale];
             // A coarse level whose window leaves the image or has too little texture
             // passes its guess on unrefined; the full-resolution level must succeed.
-            let v = match self.refine(prev.level(l), next.level(l), at, g) {
+            let v = match self.refine(prev, next, l, at, g) {
                 Some(v) => v,
                 None if l > 0 => [0.0, 0.0],
                 None => return None,
@@ -145,20 +150,38 @@ impl LucasKanade {
     }
 
     /// Newton iterations at one level: the displacement v beyond the guess `g`.
-    fn refine(&mut self, prev: &GreyImage, next: &GreyImage, at: [f64; 2], g: [f64; 2]) -> Option<[f64; 2]> {
+    fn refine(
+        &mut self,
+        prev_pyramid: &GreyPyramid,
+        next_pyramid: &GreyPyramid,
+        level: usize,
+        at: [f64; 2],
+        g: [f64; 2],
+    ) -> Option<[f64; 2]> {
+        let (prev, next) = (prev_pyramid.level(level), next_pyramid.level(level));
         let r = self.params.radius;
         let side = 2 * r + 1;
         // The previous window and its gradients (central differences of the bilinear
         // image), and G. Every sample shares at's fractional offset, so the window is
         // read through one set of bilinear weights (`Window`), its bounds checked once.
-        let win = Window::at(prev, at[0] - r as f64 - 1.0, at[1] - r as f64 - 1.0, side + 2)?;
+        let ring = side + 2;
+        let win = Window::at(
+            prev_pyramid,
+            level,
+            at[0] - r as f64 - 1.0,
+            at[1] - r as f64 - 1.0,
+            ring,
+        )?;
+        win.read(prev, ring, &mut self.patch);
+        let patch = &self.patch;
         let (mut gxx, mut gxy, mut gyy) = (0.0f64, 0.0f64, 0.0f64);
         for j in 0..side {
             for i in 0..side {
                 let k = j * side + i;
-                let c = win.get(prev, i + 1, j + 1);
-                let ix = (win.get(prev, i + 2, j + 1) - win.get(prev, i, j + 1)) * 0.5;
-                let iy = (win.get(prev, i + 1, j + 2) - win.get(prev, i + 1, j)) * 0.5;
+                let q = (j + 1) * ring + i + 1;
+                let c = patch[q];
+                let ix = (patch[q + 1] - patch[q - 1]) * 0.5;
+                let iy = (patch[q + ring] - patch[q - ring]) * 0.5;
                 self.prev_win[k] = c;
                 self.grad_x[k] = ix;
                 self.grad_y[k] = iy;
@@ -176,19 +199,37 @@ impl LucasKanade {
         let mut v = [0.0f64; 2];
         for _ in 0..self.params.iterations {
             let w = Window::at(
-                next,
+                next_pyramid,
+                level,
                 at[0] + g[0] + v[0] - r as f64,
                 at[1] + g[1] + v[1] - r as f64,
                 side,
             )?;
             let (mut bx, mut by) = (0.0f64, 0.0f64);
+            let d = next.data();
+            let width = next.width();
             for j in 0..side {
+                let row = (w.y0 + j) * width + w.x0;
+                let (a, b, c, e) = (
+                    &d[row..row + side],
+                    &d[row + w.dx..row + w.dx + side],
+                    &d[row + w.dy..row + w.dy + side],
+                    &d[row + w.dx + w.dy..row + w.dx + w.dy + side],
+                );
+                // Each row is summed on its own and then added in: the rows' sums do
+                // not wait on one another, which a single running sum over the window
+                // made them do (the same terms, summed in a different order).
+                let k0 = j * side;
+                let (mut rx, mut ry) = (0.0f64, 0.0f64);
                 for i in 0..side {
-                    let k = j * side + i;
-                    let diff = (self.prev_win[k] - w.get(next, i, j)) as f64;
-                    bx += diff * self.grad_x[k] as f64;
-                    by += diff * self.grad_y[k] as f64;
+                    let k = k0 + i;
+                    let sample = w.w[0] * a[i] + w.w[1] * b[i] + w.w[2] * c[i] + w.w[3] * e[i];
+                    let diff = (self.prev_win[k] - sample) as f64;
+                    rx += diff * self.grad_x[k] as f64;
+                    ry += diff * self.grad_y[k] as f64;
                 }
+                bx += rx;
+                by += ry;
             }
             let eta = [(gyy * bx - gxy * by) / det, (gxx * by - gxy * bx) / det];
             v[0] += eta[0];
@@ -212,13 +253,19 @@ struct Window {
     x0: usize,
     y0: usize,
     w: [f32; 4],
+    /// Offsets of the right and lower neighbours: 1 and the width, or 0 where the
+    /// neighbour's weight is zero (so the read stays in the image at its edge).
+    dx: usize,
+    dy: usize,
 }
 
 impl Window {
-    /// The window whose sample (0, 0) is at (x, y), or `None` when any of its `n × n`
-    /// samples (and their bilinear neighbours) would leave the image.
+    /// The window of level `level` whose sample (0, 0) is at (x, y), or `None` when any
+    /// of its `n × n` samples (and their bilinear neighbours) would leave the image or
+    /// the pixels the pyramid computed ([`GreyPyramid::covers`]).
     #[inline]
-    fn at(im: &GreyImage, x: f64, y: f64, n: usize) -> Option<Self> {
+    fn at(pyramid: &GreyPyramid, level: usize, x: f64, y: f64, n: usize) -> Option<Self> {
+        let im = pyramid.level(level);
         if !(x >= 0.0 && y >= 0.0) {
             return None;
         }
@@ -227,31 +274,82 @@ impl Window {
         let (fx, fy) = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
         let need_x = x0 + n - 1 + usize::from(fx > 0.0);
         let need_y = y0 + n - 1 + usize::from(fy > 0.0);
-        if need_x >= im.width() || need_y >= im.height() {
+        if !pyramid.covers(level, x0, y0, need_x, need_y) {
             return None;
         }
+        let w = [(1.0 - fx) * (1.0 - fy), fx * (1.0 - fy), (1.0 - fx) * fy, fx * fy];
+        // The right and bottom neighbours exist whenever their weight is non-zero (the
+        // check above); when a weight is zero the neighbour is the pixel itself.
         Some(Self {
             x0,
             y0,
-            w: [(1.0 - fx) * (1.0 - fy), fx * (1.0 - fy), (1.0 - fx) * fy, fx * fy],
+            dx: usize::from(w[1] != 0.0 || w[3] != 0.0),
+            dy: if w[2] != 0.0 || w[3] != 0.0 { im.width() } else { 0 },
+            w,
         })
     }
 
-    /// Sample (i, j) of the window.
+    /// Sample (i, j) of the window: the reference that [`Window::read`] and the Newton
+    /// step's inner loop unroll.
     #[inline]
     fn get(&self, im: &GreyImage, i: usize, j: usize) -> f32 {
-        let width = im.width();
         let d = im.data();
-        let k = (self.y0 + j) * width + self.x0 + i;
-        // The right and bottom neighbours exist whenever their weight is non-zero (`at`);
-        // when a weight is zero the index is clamped so the read stays in the image.
-        let right = if self.w[1] != 0.0 || self.w[3] != 0.0 { k + 1 } else { k };
-        let below = if self.w[2] != 0.0 || self.w[3] != 0.0 {
-            k + width
-        } else {
-            k
-        };
-        let diag = right + (below - k);
-        self.w[0] * d[k] + self.w[1] * d[right] + self.w[2] * d[below] + self.w[3] * d[diag]
+        let k = (self.y0 + j) * im.width() + self.x0 + i;
+        self.w[0] * d[k]
+            + self.w[1] * d[k + self.dx]
+            + self.w[2] * d[k + self.dy]
+            + self.w[3] * d[k + self.dx + self.dy]
+    }
+
+    /// The `n × n` samples, row-major, into `out` (at least n² long).
+    fn read(&self, im: &GreyImage, n: usize, out: &mut [f32]) {
+        for (j, o) in out.chunks_exact_mut(n).take(n).enumerate() {
+            for (i, v) in o.iter_mut().enumerate() {
+                *v = self.get(im, i, j);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// A window's samples, read row by row as the tracker reads them, are the image's
+        /// bilinear samples ([`GreyImage::sample`], the reference), and a window that
+        /// would leave the image is refused.
+        #[test]
+        fn window_samples_are_bilinear_samples(x in -2.0f64..30.0, y in -2.0f64..30.0, n in 1usize..12, seed in any::<u64>()) {
+            let (w, h) = (32, 30);
+            let mut s = seed | 1;
+            let data: Vec<f32> = (0..w * h)
+                .map(|_| {
+                    s ^= s << 13;
+                    s ^= s >> 7;
+                    s ^= s << 17;
+                    (s % 256) as f32
+                })
+                .collect();
+            let im = GreyImage::from_vec(w, h, data).expect("size");
+            let mut p = GreyPyramid::new(1);
+            p.build_from_grey(&im);
+            let fits = x >= 0.0 && y >= 0.0 && x + (n - 1) as f64 <= (w - 1) as f64 && y + (n - 1) as f64 <= (h - 1) as f64;
+            match Window::at(&p, 0, x, y, n) {
+                None => prop_assert!(!fits),
+                Some(win) => {
+                    prop_assert!(fits);
+                    let mut out = vec![0.0; n * n];
+                    win.read(p.level(0), n, &mut out);
+                    for j in 0..n {
+                        for i in 0..n {
+                            let want = im.sample(x + i as f64, y + j as f64).expect("inside");
+                            prop_assert!((out[j * n + i] - want).abs() < 1e-3, "({}, {}): {} vs {}", i, j, out[j * n + i], want);
+                        }
+                    }
+                }
+            }
+        }
     }
 }

@@ -159,6 +159,7 @@ pub struct MarkerFinder {
     params: MarkerParams,
     mask: Mask,
     scratch: Mask,
+    line: Mask,
     labeler: Labeler,
     blobs: Vec<Blob>,
     pairs: Vec<(f64, u8, u16)>,
@@ -177,6 +178,7 @@ impl MarkerFinder {
             params,
             mask: Mask::new(width, height),
             scratch: Mask::new(width, height),
+            line: Mask::new(width, height),
             labeler: Labeler::new(width, height),
             blobs: Vec::with_capacity(MAX_BLOBS),
             pairs: Vec::with_capacity(8 * MAX_BLOBS),
@@ -209,16 +211,42 @@ impl MarkerFinder {
         let (w, h) = self.mask.size();
         if self.params.windows {
             self.mask.data_mut().fill(0);
-            let mut all = Rect::EMPTY;
-            for e in expected {
-                let r = Rect::around(e, self.params.gate_px, w, h);
-                self.segment(frame, r);
-                all = all.union(r);
+            let rects = expected.map(|e| Rect::around(&e, self.params.gate_px, w, h));
+            // Each row's stretches covered by the windows, merged, so a pixel of
+            // overlapping windows is segmented once.
+            let (y0, y1) = rects
+                .iter()
+                .filter(|r| r.x0 < r.x1 && r.y0 < r.y1)
+                .fold((usize::MAX, 0), |(a, b), r| (a.min(r.y0), b.max(r.y1)));
+            for y in y0..y1 {
+                let mut spans = [(0usize, 0usize); 8];
+                let mut n = 0;
+                for r in rects.iter().filter(|r| r.x0 < r.x1 && r.y0 <= y && y < r.y1) {
+                    spans[n] = (r.x0, r.x1);
+                    n += 1;
+                }
+                spans[..n].sort_unstable();
+                let mut open: Option<(usize, usize)> = None;
+                for &(a, b) in &spans[..n] {
+                    open = match open {
+                        Some((oa, ob)) if a <= ob => Some((oa, ob.max(b))),
+                        Some((oa, ob)) => {
+                            self.segment(frame, y, oa, ob);
+                            Some((a, b))
+                        }
+                        None => Some((a, b)),
+                    };
+                }
+                if let Some((a, b)) = open {
+                    self.segment(frame, y, a, b);
+                }
             }
-            open3(&mut self.mask, &mut self.scratch, all);
+            open3(&mut self.mask, &mut self.scratch, &mut self.line, &rects);
         } else {
-            self.segment(frame, Rect::full(w, h));
-            open3(&mut self.mask, &mut self.scratch, Rect::full(w, h));
+            for y in 0..h {
+                self.segment(frame, y, 0, w);
+            }
+            open3(&mut self.mask, &mut self.scratch, &mut self.line, &[Rect::full(w, h)]);
         }
         self.collect_blobs()?;
         let mut found = self.assign(expected);
@@ -291,19 +319,25 @@ impl MarkerFinder {
         }
     }
 
-    /// Segments the pixels of `r` into the mask.
-    fn segment(&mut self, frame: &RgbView<'_>, r: Rect) {
+    /// Segments the pixels x0..x1 of row y into the mask.
+    fn segment(&mut self, frame: &RgbView<'_>, y: usize, x0: usize, x1: usize) {
         let p = &self.params;
         let w = frame.width();
         let bytes = frame.as_bytes();
         let data = self.mask.data_mut();
-        for y in r.y0..r.y1 {
-            for x in r.x0..r.x1 {
-                let i = y * w + x;
-                let c = Hsv::from_rgb([bytes[3 * i], bytes[3 * i + 1], bytes[3 * i + 2]]);
-                data[i] =
-                    (c.h >= p.hue_deg.0 && c.h <= p.hue_deg.1 && c.s >= p.min_saturation && c.v >= p.min_value) as u8;
-            }
+        // A hue above 240° needs green to be the strictly smallest channel (see
+        // `magenta_needs_green_least`): for such a band, every other pixel is rejected
+        // before the conversion, with the same result.
+        let green_least = p.hue_deg.0 > 240.0;
+        let out = &mut data[y * w + x0..y * w + x1];
+        let px = &bytes[3 * (y * w + x0)..3 * (y * w + x1)];
+        for (o, rgb) in out.iter_mut().zip(px.chunks_exact(3)) {
+            let rgb = [rgb[0], rgb[1], rgb[2]];
+            *o = if green_least && (rgb[1] >= rgb[0] || rgb[1] >= rgb[2]) {
+                0
+            } else {
+                in_band(p, rgb) as u8
+            };
         }
     }
 
@@ -404,13 +438,6 @@ struct Rect {
 }
 
 impl Rect {
-    const EMPTY: Self = Self {
-        x0: usize::MAX,
-        y0: usize::MAX,
-        x1: 0,
-        y1: 0,
-    };
-
     fn full(w: usize, h: usize) -> Self {
         Self {
             x0: 0,
@@ -437,57 +464,88 @@ impl Rect {
             y1: clip(e.at[1] + r + 1.0, h),
         }
     }
+}
 
-    fn union(self, o: Self) -> Self {
-        if o.x0 >= o.x1 || o.y0 >= o.y1 {
-            return self;
+/// A 3×3 opening of `mask` (erosion, then dilation), through `scratch` and `line` (same
+/// size), for a mask that is unset outside `rects`. Pixels outside the image count as
+/// unset, so erosion clears the border ring. Both are separable (a row pass, then a
+/// column pass over whole row slices, which the compiler vectorises); the test below
+/// checks it against the plain 3×3 reference.
+fn open3(mask: &mut Mask, scratch: &mut Mask, line: &mut Mask, rects: &[Rect]) {
+    let (w, h) = mask.size();
+    if w < 3 || h < 3 {
+        // Every pixel is on the border ring, which erosion clears.
+        mask.data_mut().fill(0);
+        return;
+    }
+    let live = |r: &&Rect| r.x0 < r.x1 && r.y0 < r.y1;
+    // Erosion of every rectangle first (a pixel of two overlapping rectangles gets the
+    // same value twice), so the dilation reads the finished erosion everywhere.
+    scratch.data_mut().fill(0);
+    for r in rects.iter().filter(live) {
+        let (x0, x1) = (r.x0.max(1), r.x1.min(w - 1));
+        let (y0, y1) = (r.y0.max(1), r.y1.min(h - 1));
+        if x0 >= x1 || y0 >= y1 {
+            continue;
         }
-        Self {
-            x0: self.x0.min(o.x0),
-            y0: self.y0.min(o.y0),
-            x1: self.x1.max(o.x1),
-            y1: self.y1.max(o.y1),
+        let (src, tmp) = (mask.data(), line.data_mut());
+        for y in y0 - 1..y1 + 1 {
+            let row = &src[y * w..(y + 1) * w];
+            let out = &mut tmp[y * w + x0..y * w + x1];
+            for (((o, a), b), c) in out.iter_mut().zip(&row[x0 - 1..]).zip(&row[x0..]).zip(&row[x0 + 1..]) {
+                *o = a & b & c;
+            }
+        }
+        let (tmp, dst) = (line.data(), scratch.data_mut());
+        for y in y0..y1 {
+            let out = &mut dst[y * w + x0..y * w + x1];
+            let (a, b, c) = (&tmp[(y - 1) * w + x0..], &tmp[y * w + x0..], &tmp[(y + 1) * w + x0..]);
+            for (((o, a), b), c) in out.iter_mut().zip(a).zip(b).zip(c) {
+                *o = a & b & c;
+            }
+        }
+    }
+    // Eroded pixels lie inside the rectangles, so the dilation reaches at most one
+    // pixel beyond them; the mask outside is unset and stays so.
+    for r in rects.iter().filter(live) {
+        let (x0, x1) = (r.x0.saturating_sub(1), (r.x1 + 1).min(w));
+        let (y0, y1) = (r.y0.saturating_sub(1), (r.y1 + 1).min(h));
+        let (src, tmp) = (scratch.data(), line.data_mut());
+        for y in y0.saturating_sub(1)..(y1 + 1).min(h) {
+            let row = &src[y * w..(y + 1) * w];
+            let out = &mut tmp[y * w + x0..y * w + x1];
+            out.copy_from_slice(&row[x0..x1]);
+            let left = usize::from(x0 == 0);
+            for (o, a) in out[left..].iter_mut().zip(&row[x0 + left - 1..]) {
+                *o |= a;
+            }
+            let n = out.len() - usize::from(x1 == w);
+            for (o, c) in out[..n].iter_mut().zip(&row[x0 + 1..]) {
+                *o |= c;
+            }
+        }
+        let (tmp, dst) = (line.data(), mask.data_mut());
+        for y in y0..y1 {
+            let out = &mut dst[y * w + x0..y * w + x1];
+            out.copy_from_slice(&tmp[y * w + x0..y * w + x1]);
+            if y > 0 {
+                for (o, a) in out.iter_mut().zip(&tmp[(y - 1) * w + x0..]) {
+                    *o |= a;
+                }
+            }
+            if y + 1 < h {
+                for (o, c) in out.iter_mut().zip(&tmp[(y + 1) * w + x0..]) {
+                    *o |= c;
+                }
+            }
         }
     }
 }
 
-/// A 3×3 opening of `mask` (erosion, then dilation), through `scratch` (same size), for
-/// a mask that is unset outside `r`. Pixels outside the image count as unset, so erosion
-/// clears the border ring.
-fn open3(mask: &mut Mask, scratch: &mut Mask, r: Rect) {
-    let (w, h) = mask.size();
-    if r.x0 >= r.x1 || r.y0 >= r.y1 {
-        return;
-    }
-    {
-        let src = mask.data();
-        let dst = scratch.data_mut();
-        dst.fill(0);
-        for y in r.y0.max(1)..r.y1.min(h.saturating_sub(1)) {
-            for x in r.x0.max(1)..r.x1.min(w - 1) {
-                let mut all = 1u8;
-                for rr in [y - 1, y, y + 1] {
-                    let row = &src[rr * w + x - 1..rr * w + x + 2];
-                    all &= row[0] & row[1] & row[2];
-                }
-                dst[y * w + x] = all;
-            }
-        }
-    }
-    // Eroded pixels lie inside r, so the dilation reaches at most one pixel beyond it.
-    let src = scratch.data();
-    let dst = mask.data_mut();
-    for y in r.y0.saturating_sub(1)..(r.y1 + 1).min(h) {
-        for x in r.x0.saturating_sub(1)..(r.x1 + 1).min(w) {
-            let mut any = 0u8;
-            for rr in y.saturating_sub(1)..(y + 2).min(h) {
-                for c in x.saturating_sub(1)..(x + 2).min(w) {
-                    any |= src[rr * w + c];
-                }
-            }
-            dst[y * w + x] = any;
-        }
-    }
+/// Whether `rgb` lies in the finder's HSV band: the reference test of the segmentation.
+fn in_band(p: &MarkerParams, rgb: [u8; 3]) -> bool {
+    let c = Hsv::from_rgb(rgb);
+    c.h >= p.hue_deg.0 && c.h <= p.hue_deg.1 && c.s >= p.min_saturation && c.v >= p.min_value
 }
 
 #[cfg(test)]
@@ -504,9 +562,87 @@ mod tests {
         }
         m.set(15, 15, true);
         m.set(16, 15, true);
-        let mut s = Mask::new(20, 20);
-        open3(&mut m, &mut s, Rect::full(20, 20));
+        let (mut s, mut l) = (Mask::new(20, 20), Mask::new(20, 20));
+        open3(&mut m, &mut s, &mut l, &[Rect::full(20, 20)]);
         assert_eq!(m.count(), 36);
         assert!(!m.get(15, 15));
+    }
+
+    /// The reference opening: erosion then dilation of the whole mask, pixels outside
+    /// the image unset.
+    fn open_reference(m: &Mask) -> Mask {
+        let (w, h) = m.size();
+        let at = |m: &Mask, x: i64, y: i64| {
+            x >= 0 && y >= 0 && x < w as i64 && y < h as i64 && m.get(x as usize, y as usize)
+        };
+        let mut eroded = Mask::new(w, h);
+        let mut out = Mask::new(w, h);
+        for y in 0..h as i64 {
+            for x in 0..w as i64 {
+                let all = (-1..=1).all(|dy| (-1..=1).all(|dx| at(m, x + dx, y + dy)));
+                eroded.set(x as usize, y as usize, all);
+            }
+        }
+        for y in 0..h as i64 {
+            for x in 0..w as i64 {
+                let any = (-1..=1).any(|dy| (-1..=1).any(|dx| at(&eroded, x + dx, y + dy)));
+                out.set(x as usize, y as usize, any);
+            }
+        }
+        out
+    }
+
+    proptest::proptest! {
+        /// The opening over a few (overlapping, clipped) rectangles of a mask that is
+        /// unset outside them equals the whole-mask reference.
+        #[test]
+        fn opening_in_rectangles_matches_the_whole_mask_reference(
+            w in 1usize..40,
+            h in 1usize..40,
+            rects in proptest::collection::vec((0usize..45, 0usize..45, 0usize..20, 0usize..20), 0..5),
+            seed in proptest::prelude::any::<u64>(),
+        ) {
+            let rects: Vec<Rect> = rects
+                .iter()
+                .map(|&(x, y, rw, rh)| Rect { x0: x.min(w), y0: y.min(h), x1: (x + rw).min(w), y1: (y + rh).min(h) })
+                .collect();
+            let mut s = seed | 1;
+            let mut m = Mask::new(w, h);
+            for r in &rects {
+                for y in r.y0..r.y1 {
+                    for x in r.x0..r.x1 {
+                        s ^= s << 13;
+                        s ^= s >> 7;
+                        s ^= s << 17;
+                        m.set(x, y, s % 4 != 0);
+                    }
+                }
+            }
+            let want = open_reference(&m);
+            let (mut scratch, mut line) = (Mask::new(w, h), Mask::new(w, h));
+            open3(&mut m, &mut scratch, &mut line, &rects);
+            proptest::prop_assert_eq!(m.data(), want.data());
+        }
+    }
+
+    /// Every colour: a hue band above 240° needs green strictly the smallest channel,
+    /// which is what lets `segment` reject the other pixels before converting.
+    #[test]
+    fn magenta_needs_green_least() {
+        let p = MarkerParams {
+            hue_deg: (240.001, 360.0),
+            min_saturation: 0.0,
+            min_value: 0.0,
+            ..MarkerParams::default()
+        };
+        for r in 0..=255u8 {
+            for g in 0..=255u8 {
+                for b in 0..=255u8 {
+                    if g >= r || g >= b {
+                        assert!(!in_band(&p, [r, g, b]), "{r} {g} {b}");
+                    }
+                }
+            }
+        }
     }
 }

@@ -10,7 +10,9 @@
 //!    image; a square of [`WheelParams::window_half_px`] around it.
 //! 3. **Shi–Tomasi corners** in the previous frame's window, **pyramidal Lucas–Kanade**
 //!    forward to this frame and back, inconsistent tracks dropped
-//!    ([`crate::perception::flow`]).
+//!    ([`crate::perception::flow`]). Each frame's pyramid is built only around the
+//!    windows of this frame and the previous one ([`WheelParams::pyramid_margin_px`]),
+//!    with the whole frame's values there.
 //! 4. **Per-feature steps**: both ends of a track are back-projected onto their frame's
 //!    tread cylinder and expressed in that wheel's own frame (centre at the origin, axis
 //!    y, forward x), so axle roll, drop and steering between the frames do not read as
@@ -127,13 +129,23 @@ pub struct WheelParams {
     pub white_level: f32,
     /// Half-size of the correction patch, px.
     pub white_half_px: usize,
+    /// Build each frame's pyramid only around the observation windows (this frame's and
+    /// the previous frame's, grown by this margin at full resolution, px), or over the
+    /// whole frame (`None`). The pixels built are exactly the whole frame's; a track
+    /// whose Lucas–Kanade window would leave them is treated as leaving the image (lost
+    /// at full resolution, unrefined at a coarser level), so the margin must exceed a
+    /// frame's motion on the tread plus the coarsest level's window (48 px gives the
+    /// 3-level, r = 4 tracker about 18 px of motion at every level; the sequences'
+    /// treads move a few pixels a frame).
+    pub pyramid_margin_px: Option<usize>,
 }
 
 impl Default for WheelParams {
     /// A 41×41 window, up to 40 corners (3×3 box, quality 0.02, 4 px apart), 9×9 LK
     /// windows over 3 levels with a 0.3 px forward–backward tolerance, RANSAC at
-    /// 0.01 rad over 40 draws with at least 4 inliers, coasting up to 4 frames, and a
-    /// 5×5 correction patch white above grey 170.
+    /// 0.01 rad over 40 draws with at least 4 inliers, coasting up to 4 frames, a
+    /// 5×5 correction patch white above grey 170, and pyramids built 48 px around the
+    /// windows.
     fn default() -> Self {
         Self {
             window_half_px: 20.0,
@@ -156,6 +168,7 @@ impl Default for WheelParams {
             coast_frames: 4,
             white_level: 170.0,
             white_half_px: 2,
+            pyramid_margin_px: Some(48),
         }
     }
 }
@@ -266,12 +279,11 @@ impl WheelTracker {
         axles: &[AxleState; 2],
         mut draw: impl FnMut(usize) -> usize,
     ) -> [WheelStep; 4] {
-        std::mem::swap(&mut self.prev, &mut self.next);
-        self.next.build_from_rgb(frame);
         let (w, h) = (frame.width(), frame.height());
         let camera_from_body = geometry.body_from_camera.transpose();
         let mut out = [WheelStep::default(); 4];
-        for (k, result) in out.iter_mut().enumerate() {
+        // Each wheel's tread cylinder and observation window this frame.
+        let placed = std::array::from_fn::<_, 4, _>(|k| {
             let axle = k / 2;
             let (cyl, rot) = self
                 .layout
@@ -281,8 +293,46 @@ impl WheelTracker {
             let front = forward.dot(&(geometry.camera - cyl.centre)) > 0.0;
             let w60 = cyl.window_centre(forward, front);
             let window = geometry.model.project(&(camera_from_body * (w60 - geometry.camera)));
-            result.window = window;
             let roi = window.map(|c| Roi::around(c[0] - 0.5, c[1] - 0.5, self.params.window_half_px, w, h));
+            (cyl, rot, window, roi)
+        });
+        std::mem::swap(&mut self.prev, &mut self.next);
+        match self.params.pyramid_margin_px {
+            None => self.next.build_from_rgb(frame),
+            Some(margin) => {
+                // This frame's pixels are read around this frame's windows (the next
+                // frame's corners, the white patch) and around the previous frame's
+                // (where this frame's tracks land): one rectangle per wheel spanning
+                // both, grown by the margin.
+                let mut rects = [Roi::default(); 4];
+                let mut n = 0;
+                for (k, placed) in placed.iter().enumerate() {
+                    let before = if self.has_prev { self.wheels[k].roi } else { None };
+                    let span = match (placed.3, before) {
+                        (Some(a), Some(b)) => Some(Roi {
+                            x0: a.x0.min(b.x0),
+                            y0: a.y0.min(b.y0),
+                            x1: a.x1.max(b.x1),
+                            y1: a.y1.max(b.y1),
+                        }),
+                        (a, b) => a.or(b),
+                    };
+                    if let Some(r) = span {
+                        rects[n] = Roi {
+                            x0: r.x0.saturating_sub(margin),
+                            y0: r.y0.saturating_sub(margin),
+                            x1: (r.x1 + margin).min(w),
+                            y1: (r.y1 + margin).min(h),
+                        };
+                        n += 1;
+                    }
+                }
+                self.next.build_from_rgb_in(frame, &rects[..n]);
+            }
+        }
+        for (k, result) in out.iter_mut().enumerate() {
+            let (cyl, rot, window, roi) = placed[k];
+            result.window = window;
             if self.has_prev
                 && let (Some(prev_roi), Some(prev_cyl)) = (self.wheels[k].roi, self.wheels[k].cylinder)
             {
