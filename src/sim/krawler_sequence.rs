@@ -463,7 +463,17 @@ pub fn generate(spec: &SequenceSpec, profile: &Profile, seed: u64) -> Result<Vec
             SegmentKind::Articulate if s.speed_scale == 0.0 => (0.0, [0.0, 0.0], 1.0, 1.0),
             SegmentKind::Articulate => (s.speed_scale * m.speed_mps, [0.0, 0.0], 2.0, 0.0),
         };
-        // Record this frame, then advance to the next.
+        // The axles on the terrain under them (and rocked), then record this frame and
+        // advance to the next.
+        for axle in 0..2 {
+            let s_axle = travelled - if axle == 0 { 0.0 } else { drive.wheelbase };
+            let (r, d) = terrain(s_axle, &phases[axle]);
+            let rr = (0.6 * rock_t + rock_phase[axle]).sin();
+            let rd = (0.45 * rock_t + rock_phase[2 + axle]).sin();
+            state.roll[axle] = m.terrain_roll_deg.to_radians() * (rough * r + 2.0 * rock * rr);
+            state.drop[axle] = rest.drop[axle] + m.terrain_drop_m * (rough * d + 2.0 * rock * rd);
+        }
+        state.steer = steer;
         out.push(TruthFrame {
             t,
             state,
@@ -512,15 +522,6 @@ pub fn generate(spec: &SequenceSpec, profile: &Profile, seed: u64) -> Result<Vec
         rough += (rough_cmd - rough) * g;
         rock += (rock_cmd - rock) * g;
         rock_t += dt * rock;
-        for axle in 0..2 {
-            let s_axle = travelled - if axle == 0 { 0.0 } else { drive.wheelbase };
-            let (r, d) = terrain(s_axle, &phases[axle]);
-            let rr = (0.6 * rock_t + rock_phase[axle]).sin();
-            let rd = (0.45 * rock_t + rock_phase[2 + axle]).sin();
-            state.roll[axle] = m.terrain_roll_deg.to_radians() * (rough * r + 2.0 * rock * rr);
-            state.drop[axle] = rest.drop[axle] + m.terrain_drop_m * (rough * d + 2.0 * rock * rd);
-        }
-        state.steer = steer;
     }
     Ok(out)
 }
@@ -587,6 +588,46 @@ mod tests {
         }
         assert_eq!(p, plan(&s, 3));
         assert_ne!(p, plan(&s, 4));
+    }
+
+    /// Every state moves smoothly from frame to frame (from the first), stays within the
+    /// steering limit, and the sweep reaches it; the wheels turn both ways over a run.
+    #[test]
+    fn generated_states_are_smooth_and_within_limits() {
+        let profile = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/autokrawler.toml")).unwrap();
+        let s = SequenceSpec::load("dataset1").unwrap();
+        let frames = generate(&s, &profile, 1).unwrap();
+        assert_eq!(frames.len(), 2460);
+        let max = 30f64.to_radians() + 1e-12;
+        let mut peak = 0.0f64;
+        for w in frames.windows(2) {
+            let (a, b) = (&w[0].state, &w[1].state);
+            for k in 0..2 {
+                assert!(
+                    (a.roll[k] - b.roll[k]).abs() < 0.5f64.to_radians(),
+                    "{} s: roll",
+                    w[1].t
+                );
+                assert!((a.drop[k] - b.drop[k]).abs() < 0.002, "{} s: drop", w[1].t);
+                assert!(
+                    (a.steer[k] - b.steer[k]).abs() <= 2f64.to_radians() + 1e-12,
+                    "{} s",
+                    w[1].t
+                );
+                assert!(b.steer[k].abs() <= max);
+                peak = peak.max(b.steer[k].abs());
+            }
+            for k in 0..4 {
+                assert!((a.wheel[k] - b.wheel[k]).abs() < 0.05, "{} s: wheel {k}", w[1].t);
+            }
+        }
+        assert!(peak > 29f64.to_radians(), "the sweep reaches the limit: {peak}");
+        let steps: Vec<f64> = frames
+            .windows(2)
+            .map(|w| w[1].state.wheel[0] - w[0].state.wheel[0])
+            .collect();
+        assert!(steps.iter().any(|d| *d > 0.005) && steps.iter().any(|d| *d < -0.005));
+        assert_eq!(frames, generate(&s, &profile, 1).unwrap());
     }
 
     #[test]
