@@ -5,6 +5,7 @@ pub mod calibrate;
 pub mod calibrate_steering;
 pub mod check;
 pub mod detect;
+pub mod estimate;
 pub mod merge;
 pub mod replay;
 pub mod sim_cmds;

@@ -3,6 +3,7 @@
 
 pub mod camera;
 pub mod krawler;
+pub mod krawler_sequence;
 pub mod lighting;
 pub mod lighting_random;
 pub mod render;
