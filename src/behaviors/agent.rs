@@ -31,7 +31,8 @@ pub enum BuildError {
 
 /// Builds the agent a profile selects: Bujold's for ratio steering or a potential field on
 /// a two-block flap; RAPOSA's for the seven-state servo, on a pyramid or, through the
-/// two-block adapter ([`super::raposa::source`]), on a two-block flap.
+/// two-block adapter ([`super::raposa::source`]), on a two-block flap; Axel's for the
+/// two-arc approach on circle fiducials.
 ///
 /// # Errors
 /// [`BuildError`] when the profile's approach has no implementation or lacks what it needs.
@@ -43,6 +44,7 @@ pub fn agent_for(profile: &Profile) -> Result<Box<dyn Agent>, BuildError> {
         ApproachKind::SevenState if profile.fiducial.pyramid.is_some() || profile.fiducial.two_block.is_some() => {
             Ok(Box::new(super::raposa::agent(profile)?))
         }
+        ApproachKind::TwoArc if profile.fiducial.circles.is_some() => Ok(Box::new(super::axel::agent(profile)?)),
         approach => Err(BuildError::NoBehavior {
             profile: profile.name.clone(),
             approach,

@@ -5,12 +5,13 @@
 //! out) and the docking mission. Every robot's agent is a [`Composed`]: its shared memory
 //! (the perceptual schemas, run once per tick) and the tree its profile's
 //! `[behavior.tree]` declares, built by a [`registry::Registry`] of named schemas from
-//! `common` (any robot), `bujold` and `raposa`. It is itself a
+//! `common` (any robot), `bujold`, `raposa` and `axel`. It is itself a
 //! [`Behavior`](crate::schemas::Behavior), so the reactive loop, the threaded runtime and
 //! the simulator all drive it the same way. `examples/compose.rs` composes a user's robot
 //! from its own schemas and the crate's.
 
 pub mod agent;
+pub mod axel;
 pub mod bujold;
 pub mod common;
 pub mod composed;

@@ -11,6 +11,8 @@ pub mod command;
 pub mod differential;
 pub mod odometry;
 pub mod skid_steer;
+pub mod tether_length;
+pub mod two_arc;
 pub mod vector;
 
 pub use ackermann::{BodyVelocity, DoubleAckermann};

@@ -1,6 +1,6 @@
 //! The papers' published figures, for side-by-side tables printed by `marsupial trials`.
 //! A scenario opts in with `compare = "bujold-table1"` (or `"bujold-table2"`,
-//! `"raposa-table1"`, `"raposa-range"`, `"raposa-wide"`).
+//! `"raposa-table1"`, `"raposa-range"`, `"raposa-wide"`, `"axel-field"`).
 
 use super::campaign::{RunRecord, summarise};
 use serde::{Deserialize, Serialize};
@@ -20,7 +20,14 @@ pub enum PaperTable {
     RaposaRange,
     /// Seed 001 §III: 80°, 90° and 110° starts at about 1.5 m.
     RaposaWide,
+    /// Seed 000 §V-B: 29 of 40 field runs docked, 20 of 24 away from the workspace
+    /// boundary. Starts labelled `b…` are boundary starts (7 m, or beyond 40°), reported
+    /// apart; every other start is away from the boundary (`fig10` among them).
+    AxelField,
 }
+
+/// Seed 000 §V-B: (docked, runs) overall and away from the workspace boundary.
+pub const AXEL_FIELD: [(&str, usize, usize); 2] = [("all starts", 29, 40), ("away from the boundary", 20, 24)];
 
 /// Seed 004 Table Ia: start groups and the autonomous mean time to dock, s.
 pub const BUJOLD_TABLE_1A: [(&[&str], f64); 10] = [
@@ -232,6 +239,39 @@ pub fn comparison(table: PaperTable, records: &[RunRecord]) -> String {
                     "{a:>9.0}  {n:>4}  {ok:>6}  {:>17}  {:>19}",
                     span(&|r| r.time_s),
                     span(&|r| r.manoeuvres as f64)
+                );
+            }
+        }
+        PaperTable::AxelField => {
+            let _ = writeln!(s, "versus seed 000 §V-B (field runs in the JPL Mars Yard)");
+            let _ = writeln!(s, "starts                    runs  docked  ours     | paper");
+            let boundary = |r: &&RunRecord| r.start.starts_with('b');
+            let groups: [(&str, Vec<&RunRecord>); 4] = [
+                ("all starts", records.iter().collect()),
+                (
+                    "away from the boundary",
+                    records.iter().filter(|r| !boundary(r)).collect(),
+                ),
+                ("boundary (7 m, > 40°)", records.iter().filter(boundary).collect()),
+                (
+                    "fig10 (4 m, α 15°, h 0°)",
+                    records.iter().filter(|r| r.start == "fig10").collect(),
+                ),
+            ];
+            for (name, rs) in groups {
+                if rs.is_empty() {
+                    continue;
+                }
+                let (n, ok, _) = stats(&rs);
+                let paper = match AXEL_FIELD.iter().find(|p| p.0 == name) {
+                    Some((_, d, t)) => format!("{d}/{t} = {:.0} %", 100.0 * *d as f64 / *t as f64),
+                    None if name.starts_with("boundary") => "9/16 = 56 % (29 − 20 of 40 − 24)".into(),
+                    None => "docked (Fig. 10)".into(),
+                };
+                let _ = writeln!(
+                    s,
+                    "{name:<25} {n:>4}  {ok:>6}  {:>5.0} %  | {paper}",
+                    100.0 * ok as f64 / n.max(1) as f64
                 );
             }
         }

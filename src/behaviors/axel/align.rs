@@ -1,0 +1,193 @@
+//! `axel.align`: the alignment and mating regions (seed 000 §IV). Each cycle stops,
+//! looks and plans the two-arc manoeuvre to the **look pose**: on the module's axis,
+//! facing it, the arm's tip `look_m` from the cone's mouth, the penultimate step from
+//! which the paper's stereo pose was trusted to end the docking (§IV). It drives one
+//! step of at most `step_m`, then looks again. At the look pose (within `arrive_m`) it
+//! checks the alignment: the heading within `behavior.two_arc.heading_tolerance_deg`
+//! (±5°, §V-B) and the gate of `[success]` (the tip's lateral offset and the arm's angle
+//! to the cone's axis); aligned, it commits to mating (event `aligned`, the pose kept in
+//! [`Memory::commit`]). Misaligned at the look pose, past it, or with no plan within the
+//! turn limit, it reverses `reverse_m` (paying the tether out) and retries; after
+//! `behavior.max_retries` realignments (our choice: the paper had no limit and saw one
+//! oscillation) the docking fails with `retries_exhausted`. Beyond the alignment radius
+//! (after slipping or reversing) it hands back to the approach (event `far`); with no
+//! trusted pose for `lost_looks` looks, to the acquisition (event `lost`).
+
+use super::approach::one_step;
+use super::cycle::{Cycle, CycleParams, Decision};
+use super::memory::{Memory, Sighting, Trust};
+use crate::arbiter::Blackboard;
+use crate::geometry::{Pose2, wrap_angle};
+use crate::kinematics::two_arc::{Arc, Polar, plan};
+use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, Step};
+use serde::Deserialize;
+use std::f64::consts::PI;
+
+/// `axel.align`'s params.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct AlignParams {
+    /// The arm's tip this far from the cone's mouth at the look pose, m.
+    pub look_m: f64,
+    /// At the look pose within this distance, m.
+    pub arrive_m: f64,
+    /// Longest step between looks, m.
+    pub step_m: f64,
+    /// Reverse this far to realign, m.
+    pub reverse_m: f64,
+    /// Beyond the alignment radius by this much, hand back to the approach, m.
+    pub far_margin_m: f64,
+    /// Looks without a trusted pose before the module counts as lost.
+    pub lost_looks: u32,
+    /// The sense-plan-act timing.
+    pub cycle: CycleParams,
+    /// What a pose must be to be planned on.
+    pub trust: Trust,
+}
+
+impl Default for AlignParams {
+    fn default() -> Self {
+        Self {
+            look_m: 0.5,
+            arrive_m: 0.08,
+            step_m: 0.6,
+            reverse_m: 0.6,
+            far_margin_m: 0.3,
+            lost_looks: 3,
+            cycle: CycleParams::default(),
+            trust: Trust::default(),
+        }
+    }
+}
+
+/// See the module docs.
+pub struct Align {
+    name: String,
+    mem: Blackboard<Memory>,
+    params: AlignParams,
+    cycle: Cycle,
+    unseen: u32,
+}
+
+impl Align {
+    /// A leaf named `name`.
+    pub fn new(name: &str, mem: Blackboard<Memory>, params: AlignParams) -> Self {
+        Self {
+            name: name.into(),
+            mem,
+            params,
+            cycle: Cycle::new(params.cycle, params.trust),
+            unseen: 0,
+        }
+    }
+}
+
+/// Whether the rover at module-frame `pose` may commit to mating: its heading within
+/// `heading_tolerance` of the axis, and the arm's tip within `gate_lateral` of the axis
+/// with the arm within `gate_heading` of it.
+pub fn aligned(pose: &Pose2, arm: f64, heading_tolerance: f64, gate_lateral: f64, gate_heading: f64) -> bool {
+    let h = wrap_angle(pose.theta - PI).abs();
+    let tip = pose.to_world(arm, 0.0);
+    h <= heading_tolerance && h <= gate_heading && tip.1.abs() <= gate_lateral
+}
+
+fn decide(m: &mut Memory, p: &AlignParams, s: Sighting) -> Decision {
+    let g = m.geometry;
+    let polar = Polar::from_pose(&s.pose);
+    if polar.r > g.regions.alignment_radius + p.far_margin_m {
+        return Decision::Event("far");
+    }
+    let look = Pose2::new(g.tether.arm + p.look_m, 0.0, PI);
+    let at_look = s.pose.distance(&look) <= p.arrive_m;
+    let past = s.pose.x < look.x - p.arrive_m;
+    if at_look
+        && aligned(
+            &s.pose,
+            g.tether.arm,
+            g.heading_tolerance,
+            g.gate_lateral,
+            g.gate_heading,
+        )
+    {
+        m.commit = Some(s.pose);
+        return Decision::Event("aligned");
+    }
+    let planned = if at_look || past {
+        None
+    } else {
+        plan(&s.pose, &look, &g.plan).ok()
+    };
+    match planned {
+        Some(pl) => Decision::Arc {
+            arc: one_step(&pl.arcs, p.step_m),
+            from: s.pose,
+        },
+        None => {
+            // Reverse and realign (seed 000 §II, §V-B), a bounded number of times.
+            m.retries += 1;
+            if m.retries > g.max_retries {
+                return Decision::Done(Outcome::Failed(FailureReason::RetriesExhausted));
+            }
+            Decision::Arc {
+                arc: Arc {
+                    curvature: 0.0,
+                    length: -p.reverse_m,
+                },
+                from: s.pose,
+            }
+        }
+    }
+}
+
+impl Behavior for Align {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, inputs: &Inputs<'_>) {
+        self.unseen = 0;
+        self.cycle.restart(inputs.now);
+    }
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        let mut m = self.mem.lock();
+        let p = self.params;
+        let unseen = &mut self.unseen;
+        Some(self.cycle.tick(&mut m, "align", |m, seen| match seen {
+            Some(s) => {
+                *unseen = 0;
+                decide(m, &p, s)
+            }
+            None => {
+                *unseen += 1;
+                if *unseen >= p.lost_looks {
+                    Decision::Event("lost")
+                } else {
+                    Decision::Turn(0.0)
+                }
+            }
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_gate_checks_heading_and_the_tips_offset() {
+        let arm = 0.55;
+        let d5 = 5f64.to_radians();
+        let on_axis = Pose2::new(1.05, 0.0, PI);
+        assert!(aligned(&on_axis, arm, d5, 0.05, d5));
+        // 6° off: refused by the ±5°.
+        let turned = Pose2::new(1.05, 0.0, PI + 6f64.to_radians());
+        assert!(!aligned(&turned, arm, d5, 0.05, d5));
+        // Square to the axis but 8 cm to the side: the tip misses the gate.
+        let beside = Pose2::new(1.05, 0.08, PI);
+        assert!(!aligned(&beside, arm, d5, 0.05, d5));
+        // 3° off, axle 4 cm aside, tip pointing back at the axis: within.
+        let converging = Pose2::new(1.05, 0.04, PI + 3f64.to_radians());
+        assert!(aligned(&converging, arm, d5, 0.05, d5));
+    }
+}

@@ -1,0 +1,162 @@
+//! `axel.approach`: the approach region (seed 000 §IV). Each cycle stops, looks, plans
+//! the two-arc manoeuvre from the measured pose to the alignment region's entry on the
+//! module's axis (facing the module, `inside_m` within the alignment radius), and drives
+//! ONE step of it: the first arc, cut at `step_m`, reeling by the tether's change of
+//! length along it. In the alignment region it hands over (event `near`); with no trusted
+//! pose for `lost_looks` looks in a row it goes back to acquiring (event `lost`). From
+//! far to the side, where no S within the turn limit reaches the entry, it aims at the
+//! mating radius on the axis instead; when no plan keeps the module in view it turns in
+//! place to centre the module and looks again.
+
+use super::cycle::{Cycle, CycleParams, Decision};
+use super::memory::{Memory, Trust};
+use crate::arbiter::Blackboard;
+use crate::geometry::Pose2;
+use crate::kinematics::two_arc::{Arc, Polar, Region, TwoArc, keeps_in_view, plan};
+use crate::schemas::{Behavior, Inputs, Step};
+use serde::Deserialize;
+use std::f64::consts::PI;
+
+/// `axel.approach`'s params.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ApproachParams {
+    /// Longest step between looks, m.
+    pub step_m: f64,
+    /// The goal lies this far inside the alignment radius, m.
+    pub inside_m: f64,
+    /// Looks without a trusted pose before the module counts as lost.
+    pub lost_looks: u32,
+    /// The sense-plan-act timing.
+    pub cycle: CycleParams,
+    /// What a pose must be to be planned on.
+    pub trust: Trust,
+}
+
+impl Default for ApproachParams {
+    fn default() -> Self {
+        Self {
+            step_m: 1.5,
+            inside_m: 0.5,
+            lost_looks: 3,
+            cycle: CycleParams::default(),
+            trust: Trust::default(),
+        }
+    }
+}
+
+/// The first arc of a plan cut at `step` m; when the first arc is negligible, the second.
+pub(super) fn one_step(arcs: &[Arc; 2], step: f64) -> Arc {
+    let a = if arcs[0].length.abs() >= 0.02 { arcs[0] } else { arcs[1] };
+    Arc {
+        curvature: a.curvature,
+        length: a.length.signum() * a.length.abs().min(step),
+    }
+}
+
+/// The single arc from `pose` through the axis point (`x`, 0), cut at `step` m: `None`
+/// when the point is not ahead.
+fn toward(pose: &Pose2, x: f64, step: f64) -> Option<Arc> {
+    let (lx, ly) = pose.to_local(x, 0.0);
+    if lx <= 0.0 {
+        return None;
+    }
+    let d2 = lx * lx + ly * ly;
+    let curvature = 2.0 * ly / d2;
+    let turn = 2.0 * ly.atan2(lx);
+    let length = if curvature.abs() < 1e-9 {
+        d2.sqrt()
+    } else {
+        turn / curvature
+    };
+    Some(Arc {
+        curvature,
+        length: length.min(step),
+    })
+}
+
+/// See the module docs.
+pub struct Approach {
+    name: String,
+    mem: Blackboard<Memory>,
+    params: ApproachParams,
+    cycle: Cycle,
+    unseen: u32,
+}
+
+impl Approach {
+    /// A leaf named `name`.
+    pub fn new(name: &str, mem: Blackboard<Memory>, params: ApproachParams) -> Self {
+        Self {
+            name: name.into(),
+            mem,
+            params,
+            cycle: Cycle::new(params.cycle, params.trust),
+            unseen: 0,
+        }
+    }
+}
+
+impl Behavior for Approach {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, inputs: &Inputs<'_>) {
+        self.unseen = 0;
+        self.cycle.restart(inputs.now);
+    }
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        let mut m = self.mem.lock();
+        let p = self.params;
+        let unseen = &mut self.unseen;
+        Some(self.cycle.tick(&mut m, "approach", |m, seen| {
+            let Some(s) = seen else {
+                *unseen += 1;
+                return if *unseen >= p.lost_looks {
+                    Decision::Event("lost")
+                } else {
+                    Decision::Turn(0.0)
+                };
+            };
+            *unseen = 0;
+            let g = m.geometry;
+            let polar = Polar::from_pose(&s.pose);
+            if matches!(g.regions.classify(&polar), Region::Alignment | Region::Mating) {
+                return Decision::Event("near");
+            }
+            // The alignment region's entry on the axis; from far to the side, where no
+            // S within the turn limit reaches it, a goal farther in along the axis.
+            let entry = (g.regions.alignment_radius - p.inside_m).max(g.regions.mating_radius);
+            let planned = [entry, g.regions.mating_radius]
+                .into_iter()
+                .find_map(|x| plan(&s.pose, &Pose2::new(x, 0.0, PI), &g.plan).ok());
+            match planned {
+                Some(pl) => Decision::Arc {
+                    arc: one_step(&pl.arcs, p.step_m),
+                    from: s.pose,
+                },
+                // No two-arc plan keeps the module in view (square to the axis far to
+                // the side, the S would turn it out): one arc toward the entry point,
+                // whatever the heading it ends in, if that keeps it; otherwise face the
+                // module and look again.
+                None => match toward(&s.pose, entry, p.step_m) {
+                    Some(arc)
+                        if keeps_in_view(
+                            &TwoArc {
+                                arcs: [arc, Arc::default()],
+                            },
+                            &s.pose,
+                            g.plan.fov_half_angle,
+                            g.plan.check_step_m,
+                        ) =>
+                    {
+                        Decision::Arc { arc, from: s.pose }
+                    }
+                    _ => Decision::Turn(polar.bearing()),
+                },
+            }
+        }))
+    }
+}

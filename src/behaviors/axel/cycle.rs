@@ -1,0 +1,201 @@
+//! The sense-plan-act cycle Axel's sensing schemas share (seed 000 §II, §V-B: "stop,
+//! take images, plan, take one step"): settle stopped, look until a trusted pose arrives
+//! (or give up looking), let the schema decide, then execute ONE motion by odometry (an
+//! arc, reeling by the tether's change of length along it, or a turn in place) and start
+//! over. A rover that kept moving while it looked would plan on frames blurred by its own
+//! motion and a pose already out of date by the time it plans; the paper stopped, and so
+//! do we.
+
+use super::memory::{Memory, Sighting, Trust};
+use crate::geometry::{Pose2, Twist, wrap_angle};
+use crate::kinematics::two_arc::Arc;
+use crate::schemas::{DriveCommand, Outcome, Step};
+use serde::Deserialize;
+
+/// Timing of the cycle (node params).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CycleParams {
+    /// Standing still before looking, s (the base's lag and the tether's swing settle).
+    pub settle_s: f64,
+    /// Longest look for a trusted pose, s.
+    pub look_s: f64,
+}
+
+impl Default for CycleParams {
+    fn default() -> Self {
+        Self {
+            settle_s: 0.6,
+            look_s: 1.2,
+        }
+    }
+}
+
+/// What a schema decides once it looked.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Decision {
+    /// Drive this arc (module frame start `from`), then look again.
+    Arc {
+        /// The arc.
+        arc: Arc,
+        /// Where it starts, module frame (for the tether's change of length).
+        from: Pose2,
+    },
+    /// Turn in place by this much, rad (counter-clockwise positive), then look again.
+    Turn(f64),
+    /// End this state with the event.
+    Event(&'static str),
+    /// End the docking with this outcome.
+    Done(Outcome),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum State {
+    Settle {
+        since: f64,
+    },
+    Look {
+        since: f64,
+    },
+    Arc {
+        twist: Twist,
+        reel: f64,
+        left: f64,
+        last: Pose2,
+    },
+    Turn {
+        omega: f64,
+        left: f64,
+        last: f64,
+    },
+}
+
+/// The cycle's state (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cycle {
+    state: State,
+    params: CycleParams,
+    trust: Trust,
+}
+
+impl Cycle {
+    /// A cycle with `params`, trusting sightings by `trust`.
+    pub fn new(params: CycleParams, trust: Trust) -> Self {
+        Self {
+            state: State::Settle { since: 0.0 },
+            params,
+            trust,
+        }
+    }
+
+    /// Starts over at `now`: settle, then look.
+    pub fn restart(&mut self, now: f64) {
+        self.state = State::Settle { since: now };
+    }
+
+    /// One tick: settle, look, ask `decide` (with the trusted sighting, or `None` when the
+    /// look found none), then drive what it decided. Feedback names `phase`.
+    pub fn tick(
+        &mut self,
+        m: &mut Memory,
+        phase: &'static str,
+        decide: impl FnOnce(&mut Memory, Option<Sighting>) -> Decision,
+    ) -> Step {
+        let now = m.now;
+        match self.state {
+            State::Settle { since } => {
+                if now - since >= self.params.settle_s {
+                    self.state = State::Look { since: now };
+                    m.sighting = None;
+                    m.looking = true;
+                }
+                m.hold(phase)
+            }
+            State::Look { since } => {
+                let trusted = m.sighting.filter(|s| s.t >= since && self.trust.accepts(s));
+                if trusted.is_none() && now - since < self.params.look_s {
+                    return m.hold(phase);
+                }
+                m.looking = false;
+                match decide(m, trusted) {
+                    Decision::Arc { arc, from } => self.begin_arc(m, arc, &from, phase),
+                    Decision::Turn(angle) => {
+                        let omega = 0.5 * m.geometry.max_turn_rate * angle.signum();
+                        self.state = State::Turn {
+                            omega,
+                            left: angle.abs(),
+                            last: m.odo.theta,
+                        };
+                        m.drive(DriveCommand::Turn { omega }, 0.0, phase)
+                    }
+                    Decision::Event(e) => {
+                        self.restart(now);
+                        m.hold(phase).with_event(e)
+                    }
+                    Decision::Done(o) => m.hold(phase).finishing(o),
+                }
+            }
+            State::Arc {
+                twist,
+                reel,
+                left,
+                last,
+            } => {
+                let left = left - m.odo.distance(&last);
+                if left <= 0.0 {
+                    self.restart(now);
+                    return m.hold(phase);
+                }
+                self.state = State::Arc {
+                    twist,
+                    reel,
+                    left,
+                    last: m.odo,
+                };
+                m.drive(DriveCommand::Twist(twist), reel, phase)
+            }
+            State::Turn { omega, left, last } => {
+                let left = left - wrap_angle(m.odo.theta - last).abs();
+                if left <= 0.0 {
+                    self.restart(now);
+                    return m.hold(phase);
+                }
+                self.state = State::Turn {
+                    omega,
+                    left,
+                    last: m.odo.theta,
+                };
+                m.drive(DriveCommand::Turn { omega }, 0.0, phase)
+            }
+        }
+    }
+
+    /// Starts driving `arc` from module-frame `from`: at the arc speed, slower where the
+    /// turn-rate limit needs it or where the reel could not keep up with the tether's
+    /// change of length, reeling at the rate that follows that change over the arc.
+    fn begin_arc(&mut self, m: &mut Memory, arc: Arc, from: &Pose2, phase: &'static str) -> Step {
+        let g = &m.geometry;
+        let mut speed = if arc.curvature.abs() > 1e-9 {
+            g.arc_speed.min(0.9 * g.max_turn_rate / arc.curvature.abs())
+        } else {
+            g.arc_speed
+        };
+        // The tether changes by |ΔL| over |s|: at `speed` the reel must turn at
+        // speed·|ΔL|/|s|, no faster than it can.
+        let per_m = g.tether.change_along(from, &arc).abs() / arc.length.abs().max(1e-9);
+        if per_m * speed > g.max_reel_rate {
+            speed = g.max_reel_rate / per_m;
+        }
+        let v = speed * arc.length.signum();
+        let twist = Twist::new(v, v * arc.curvature);
+        let reel = g.tether.reel_rate(from, &arc, speed);
+        m.arcs += 1;
+        self.state = State::Arc {
+            twist,
+            reel,
+            left: arc.length.abs(),
+            last: m.odo,
+        };
+        m.drive(DriveCommand::Twist(twist), reel, phase)
+    }
+}

@@ -1,0 +1,140 @@
+//! `axel.mate`: the mating (seed 000 §II, §IV). Committed at the look pose
+//! ([`Memory::commit`]), the markers now too close to identify, the rover drives blind
+//! by odometry straight in until its arm's tip is `standoff_m` from the cone's mouth,
+//! reeling in by the tether's change of length; then it puts its wheels in free rotation
+//! and reels in until the reel's paid-out length is `behavior.two_arc.reel_in_m` short
+//! of the exposed length at the mouth (about 25 cm into the module, §II), the tether
+//! pulling the arm into the cone. The reel's own length reading decides, so slack left
+//! from the approach is taken up first. Whether it seated is the
+//! cone's business (the simulator's judge ends the run when it does); the paper had no
+//! sensor to confirm it and ended on the penultimate pose, so once the reel has wound in
+//! its length the schema reports `docked` as the paper's robot would. A stall is the
+//! separate `axel.stall` leaf's (by the reel's current).
+
+use super::memory::Memory;
+use crate::arbiter::Blackboard;
+use crate::geometry::Pose2;
+use crate::kinematics::two_arc::Arc;
+use crate::schemas::{
+    Auxiliary, Behavior, DriveCommand, FailureReason, Inputs, MotorOutput, Outcome, Step, TetherCommand,
+};
+use serde::Deserialize;
+
+/// `axel.mate`'s params.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MateParams {
+    /// The blind drive ends with the tip this far from the mouth, m.
+    pub standoff_m: f64,
+    /// Speed of the blind drive, m/s (slow in the mating region, §IV).
+    pub speed_mps: f64,
+}
+
+impl Default for MateParams {
+    fn default() -> Self {
+        Self {
+            standoff_m: 0.05,
+            speed_mps: 0.04,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Phase {
+    Close { left: f64, last: Pose2, reel: f64 },
+    Reel { until: f64 },
+}
+
+/// See the module docs.
+pub struct Mate {
+    name: String,
+    mem: Blackboard<Memory>,
+    params: MateParams,
+    phase: Phase,
+}
+
+impl Mate {
+    /// A leaf named `name`.
+    pub fn new(name: &str, mem: Blackboard<Memory>, params: MateParams) -> Self {
+        Self {
+            name: name.into(),
+            mem,
+            params,
+            phase: Phase::Reel { until: f64::INFINITY },
+        }
+    }
+}
+
+impl Behavior for Mate {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, _inputs: &Inputs<'_>) {
+        let m = self.mem.lock();
+        let g = m.geometry;
+        let Some(at) = m.commit else {
+            self.phase = Phase::Reel { until: f64::INFINITY };
+            return;
+        };
+        let left = (at.x - g.tether.arm - self.params.standoff_m).max(0.0);
+        let arc = Arc {
+            curvature: 0.0,
+            length: left,
+        };
+        self.phase = Phase::Close {
+            left,
+            last: m.odo,
+            reel: g.tether.reel_rate(&at, &arc, self.params.speed_mps),
+        };
+    }
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        let m = self.mem.lock();
+        let g = m.geometry;
+        match self.phase {
+            Phase::Close { left, last, reel } => {
+                let left = left - m.odo.distance(&last);
+                if left > 0.0 {
+                    self.phase = Phase::Close {
+                        left,
+                        last: m.odo,
+                        reel,
+                    };
+                    return Some(m.drive(
+                        DriveCommand::Straight {
+                            v: self.params.speed_mps,
+                        },
+                        reel,
+                        "mate_close",
+                    ));
+                }
+                // The exposed length with the tip at the mouth, less the reel-in.
+                let mouth = Pose2::new(g.tether.arm, 0.0, std::f64::consts::PI);
+                self.phase = Phase::Reel {
+                    until: (g.tether.length_at(&mouth) - g.reel_in).max(0.0),
+                };
+                Some(m.hold("mate_close"))
+            }
+            Phase::Reel { until } => {
+                if m.commit.is_none() {
+                    // Entered without a committed pose: nothing aligned to mate.
+                    return Some(
+                        m.hold("mate")
+                            .finishing(Outcome::Failed(FailureReason::FailedToControl)),
+                    );
+                }
+                let reeled = m.reel.is_some_and(|r| r.length <= until);
+                let out = MotorOutput::drive(DriveCommand::Stop).with_aux(Auxiliary {
+                    tether: Some(TetherCommand {
+                        reel_rate: g.max_reel_rate,
+                        free_wheel: true,
+                    }),
+                    ..Default::default()
+                });
+                let step = Step::running(out, m.feedback("mate_reel"));
+                Some(if reeled { step.finishing(Outcome::Docked) } else { step })
+            }
+        }
+    }
+}

@@ -1,0 +1,355 @@
+//! What Axel's schemas share: the circle-fiducial perceptual schema (both cameras'
+//! detectors, the module's model, the stereo rig), this tick's odometry and reel reading,
+//! the planning geometry taken from the profile, the retry counter and the arc counter.
+//!
+//! Perception is sense-plan-act as in the paper (seed 000 §II): it runs only while a
+//! schema asks to look ([`Memory::looking`]), which the schemas do only with the rover
+//! stopped and settled, so a pose is never measured from a moving rover's frames. Each
+//! look yields a [`Sighting`]: the rover's pose in the module frame with the pose's
+//! quality figures. A schema trusts a sighting only by its quality ([`Trust`]).
+
+use crate::behaviors::BuildError;
+use crate::behaviors::composed::SharedMemory;
+use crate::geometry::Pose2;
+use crate::kinematics::tether_length::TetherGeometry;
+use crate::kinematics::two_arc::{PlanParams, Regions};
+use crate::perception::circles::{
+    CircleDetector, CircleModel, CircleParams, CorrespondenceParams, MarkObservations, ModulePose, PoseBuffers,
+    PoseParams, PoseSource, RigCamera, correspond, module_pose,
+};
+use crate::profile::Profile;
+use crate::schemas::{
+    AgentStats, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Step, TetherCommand, TetherReading,
+};
+use serde::Deserialize;
+
+/// The reel's current above which a driven rover's tether counts as taut, A: the top of
+/// the 0.5–1.0 A the paper's reel drew in vision-guided docking (seed 000 §V-C).
+pub const TAUT_CURRENT_A: f64 = 1.0;
+
+/// One pose measurement: where the rover is in the module frame, and how good it is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sighting {
+    /// Loop time of the frames, s.
+    pub t: f64,
+    /// The rover's pose in the module frame (mouth at the origin, face looking +x).
+    pub pose: Pose2,
+    /// Stereo or mono.
+    pub source: PoseSource,
+    /// Marks the pose came from.
+    pub marks: usize,
+    /// RMS reprojection of the posed model against the detections, px.
+    pub reprojection_px: f64,
+    /// RMS metric residual of the fit, m.
+    pub residual_m: f64,
+}
+
+/// The quality a sighting must have to be planned on (node params `trust`, ours: the
+/// paper accepted any pose its correspondence produced, and its monocular poses, with no
+/// distortion model, misled it, §V-E).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Trust {
+    /// Largest RMS reprojection error, px.
+    pub reprojection_px: f64,
+    /// Largest RMS metric residual, m.
+    pub residual_m: f64,
+    /// Fewest marks.
+    pub marks: usize,
+    /// Accept a monocular pose (one camera saw the module).
+    pub mono: bool,
+}
+
+impl Default for Trust {
+    fn default() -> Self {
+        Self {
+            reprojection_px: 3.0,
+            residual_m: 0.05,
+            marks: 5,
+            mono: true,
+        }
+    }
+}
+
+impl Trust {
+    /// True when `s` is good enough to plan on.
+    pub fn accepts(&self, s: &Sighting) -> bool {
+        s.marks >= self.marks
+            && s.reprojection_px <= self.reprojection_px
+            && s.residual_m <= self.residual_m
+            && (self.mono || s.source == PoseSource::Stereo)
+            && s.pose.is_finite()
+    }
+}
+
+/// The circle pipeline for both cameras, every buffer owned and reused.
+struct Perception {
+    detectors: [CircleDetector; 2],
+    model: CircleModel,
+    cams: [RigCamera; 2],
+    corr: CorrespondenceParams,
+    params: PoseParams,
+    buf: PoseBuffers,
+}
+
+impl Perception {
+    fn from_profile(profile: &Profile) -> Result<Self, BuildError> {
+        let err = |what: String| BuildError::Profile {
+            profile: profile.name.clone(),
+            what,
+        };
+        if profile.cameras.len() < 2 {
+            return Err(err("Axel's behavior needs the stereo pair: two [[cameras]]".into()));
+        }
+        let detector = |i: usize| {
+            let c = &profile.cameras[i];
+            CircleDetector::new(c.width_px, c.height_px, CircleParams::for_image(c.width_px))
+        };
+        let cam = |i: usize| RigCamera::from_profile(profile, i).map_err(|e| err(e.to_string()));
+        Ok(Self {
+            detectors: [detector(0), detector(1)],
+            model: CircleModel::from_profile(profile).map_err(|e| err(e.to_string()))?,
+            cams: [cam(0)?, cam(1)?],
+            corr: CorrespondenceParams::default(),
+            params: PoseParams::default(),
+            buf: PoseBuffers::new(),
+        })
+    }
+
+    /// The module's pose from this tick's frames, if both cameras have one and the rig
+    /// makes a pose of what they saw.
+    fn look(&mut self, inputs: &Inputs<'_>) -> Option<(f64, ModulePose)> {
+        let mut obs = [MarkObservations::new(self.model.len()); 2];
+        let mut stamp = f64::NEG_INFINITY;
+        for (i, o) in obs.iter_mut().enumerate() {
+            let Some(frame) = inputs.camera(i) else { continue };
+            stamp = stamp.max(frame.stamp);
+            let Ok(marks) = self.detectors[i].detect(&frame.image) else {
+                continue;
+            };
+            if let Ok(fit) = correspond(&self.model, marks, &self.corr) {
+                *o = MarkObservations::from_fit(&fit, marks);
+            }
+        }
+        let pose = module_pose(
+            &self.model,
+            [&self.cams[0], &self.cams[1]],
+            [&obs[0], &obs[1]],
+            &self.params,
+            &mut self.buf,
+        )
+        .ok()?;
+        Some((stamp, pose))
+    }
+}
+
+/// The planning geometry every schema shares, from the profile.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Geometry {
+    /// The regions (`[behavior.two_arc]` radii, `[dock]` approach radius and angle).
+    pub regions: Regions,
+    /// The tether's anchor and the arm (`[tether]`).
+    pub tether: TetherGeometry,
+    /// The planner's limits; the field of view is the cameras'.
+    pub plan: PlanParams,
+    /// Speed along arcs, m/s (`behavior.two_arc.arc_speed_mps`).
+    pub arc_speed: f64,
+    /// The base's turn-rate limit, rad/s.
+    pub max_turn_rate: f64,
+    /// The reel's top rate, m/s.
+    pub max_reel_rate: f64,
+    /// Heading tolerance before reeling, rad (`behavior.two_arc.heading_tolerance_deg`,
+    /// seed 000 §V-B ±5°).
+    pub heading_tolerance: f64,
+    /// Tether reeled in past the cone's mouth while mating, m (`behavior.two_arc.reel_in_m`).
+    pub reel_in: f64,
+    /// The commitment gate before mating: the arm tip's largest lateral offset from the
+    /// cone's axis, m (`success.lateral_tolerance_m`).
+    pub gate_lateral: f64,
+    /// The commitment gate before mating: the arm's largest angle to the cone's axis, rad
+    /// (`success.heading_tolerance_deg`).
+    pub gate_heading: f64,
+    /// Retries allowed (`behavior.max_retries`, our choice).
+    pub max_retries: u32,
+}
+
+impl Geometry {
+    /// The geometry of an Axel profile (`[dock]`, `[tether]`, `[behavior.two_arc]`, two
+    /// cameras).
+    ///
+    /// # Errors
+    /// [`BuildError::Profile`] naming the missing table.
+    pub fn from_profile(profile: &Profile, fov_half_angle: f64) -> Result<Self, BuildError> {
+        let err = |what: &str| BuildError::Profile {
+            profile: profile.name.clone(),
+            what: format!("Axel's behavior needs {what}"),
+        };
+        let dock = profile.dock.as_ref().ok_or_else(|| err("[dock]"))?;
+        let tether = profile.tether.ok_or_else(|| err("[tether]"))?;
+        let gains = profile.behavior.two_arc.ok_or_else(|| err("[behavior.two_arc]"))?;
+        let limits = profile.drive.limits();
+        Ok(Self {
+            regions: Regions {
+                mating_radius: gains.mating_radius_m,
+                alignment_radius: gains.alignment_radius_m,
+                approach_radius: dock.approach_radius_m,
+                approach_half_angle: dock.approach_half_angle_deg.to_radians(),
+            },
+            tether: TetherGeometry::new(tether.anchor_depth_m, tether.arm_m),
+            plan: PlanParams {
+                fov_half_angle,
+                ..PlanParams::default()
+            },
+            arc_speed: gains.arc_speed_mps,
+            max_turn_rate: limits.max_turn_rate,
+            max_reel_rate: tether.max_reel_rate_mps,
+            heading_tolerance: gains.heading_tolerance_deg.to_radians(),
+            reel_in: gains.reel_in_m,
+            gate_lateral: profile.success.lateral_tolerance_m,
+            gate_heading: profile.success.heading_tolerance_deg.to_radians(),
+            max_retries: profile.behavior.max_retries,
+        })
+    }
+
+    /// The camera's half field of view, rad: the bearing of the image's side edge at its
+    /// middle row, through camera 0's model and mount.
+    pub fn camera_half_fov(profile: &Profile) -> Option<f64> {
+        let c = profile.cameras.first()?;
+        let rig = RigCamera::from_profile(profile, 0).ok()?;
+        let ray = rig.ray([0.0, c.height_px as f64 / 2.0]);
+        Some(ray.y.atan2(ray.x).abs())
+    }
+}
+
+/// Axel's shared memory (see the module docs).
+pub struct Memory {
+    perception: Perception,
+    /// The planning geometry.
+    pub geometry: Geometry,
+    /// A schema asks perception to run on the next ticks' frames (set while stopped).
+    pub looking: bool,
+    /// The latest sighting (kept until the next look replaces it).
+    pub sighting: Option<Sighting>,
+    /// Loop time of this tick, s.
+    pub now: f64,
+    /// Odometry pose of this tick.
+    pub odo: Pose2,
+    /// The reel's reading this tick.
+    pub reel: Option<TetherReading>,
+    /// Realignments (reverse and retry) used this docking.
+    pub retries: u32,
+    /// Arcs driven this docking.
+    pub arcs: u32,
+    /// The sign of the acquisition's turn (+1 counter-clockwise): toward the side the
+    /// module was last seen on.
+    pub search_sign: f64,
+    /// A trusted pose was seen this docking.
+    pub seen: bool,
+    /// The pose the alignment committed to mating from (the penultimate look).
+    pub commit: Option<Pose2>,
+}
+
+impl Memory {
+    /// The memory for an Axel profile.
+    ///
+    /// # Errors
+    /// [`BuildError::Profile`] when the profile lacks the cameras, fiducial, dock, tether
+    /// or two-arc gains.
+    pub fn from_profile(profile: &Profile) -> Result<Self, BuildError> {
+        let fov = Geometry::camera_half_fov(profile).ok_or_else(|| BuildError::Profile {
+            profile: profile.name.clone(),
+            what: "Axel's behavior needs a camera".into(),
+        })?;
+        Ok(Self {
+            perception: Perception::from_profile(profile)?,
+            geometry: Geometry::from_profile(profile, fov)?,
+            looking: false,
+            sighting: None,
+            now: 0.0,
+            odo: Pose2::default(),
+            reel: None,
+            retries: 0,
+            arcs: 0,
+            search_sign: 1.0,
+            seen: false,
+            commit: None,
+        })
+    }
+
+    /// A stopped base, the reel held (neither slack nor pulling), feedback `phase`.
+    pub fn hold(&self, phase: &'static str) -> Step {
+        let out = MotorOutput::stop().with_aux(crate::schemas::Auxiliary {
+            tether: Some(TetherCommand {
+                reel_rate: 0.0,
+                free_wheel: false,
+            }),
+            ..Default::default()
+        });
+        Step::running(out, self.feedback(phase))
+    }
+
+    /// Driving `drive` while reeling at `reel_rate` (m/s, positive in), wheels driven.
+    /// The planned rate is the linear approximation's; when the wheels slip the tether
+    /// shortens less than planned, so while the reel's current says the tether is taut
+    /// ([`TAUT_CURRENT_A`]) it does not reel in (a current-limited reel: no tension sensor).
+    pub fn drive(&self, drive: DriveCommand, reel_rate: f64, phase: &'static str) -> Step {
+        let taut = self.reel.is_some_and(|r| r.motor_current_a >= TAUT_CURRENT_A);
+        let rate = if taut { reel_rate.min(0.0) } else { reel_rate };
+        let out = MotorOutput::drive(drive).with_aux(crate::schemas::Auxiliary {
+            tether: Some(TetherCommand {
+                reel_rate: rate.clamp(-self.geometry.max_reel_rate, self.geometry.max_reel_rate),
+                free_wheel: false,
+            }),
+            ..Default::default()
+        });
+        Step::running(out, self.feedback(phase))
+    }
+
+    /// Feedback for `phase` with this docking's retries.
+    pub fn feedback(&self, phase: &'static str) -> Feedback {
+        Feedback {
+            phase,
+            elapsed: self.now,
+            retries: self.retries,
+        }
+    }
+}
+
+impl SharedMemory for Memory {
+    fn perceive(&mut self, inputs: &Inputs<'_>) {
+        self.now = inputs.now;
+        if let Some(o) = inputs.odometry {
+            self.odo = o.value.pose;
+        }
+        self.reel = inputs.tether.map(|t| t.value);
+        if !self.looking {
+            return;
+        }
+        if let Some((t, pose)) = self.perception.look(inputs) {
+            let [x, y, theta] = pose.rover_in_module();
+            self.sighting = Some(Sighting {
+                t,
+                pose: Pose2::new(x, y, theta),
+                source: pose.source,
+                marks: pose.marks_used,
+                reprojection_px: pose.reprojection_px,
+                residual_m: pose.rms_residual_m,
+            });
+        }
+    }
+
+    fn begin(&mut self, _mission: &Mission) -> Result<(), MissionError> {
+        self.looking = false;
+        self.sighting = None;
+        self.retries = 0;
+        self.arcs = 0;
+        self.search_sign = 1.0;
+        self.seen = false;
+        self.commit = None;
+        Ok(())
+    }
+
+    fn stats(&self) -> AgentStats {
+        AgentStats { manoeuvres: self.arcs }
+    }
+}

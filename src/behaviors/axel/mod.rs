@@ -1,0 +1,86 @@
+//! Axel's tether-assisted docking (seed 000) as a composition: the schemas of this
+//! folder, one file each, combined by the arbiters the way `profiles/axel.toml` declares
+//! in `[behavior.tree]`.
+//!
+//! The shipped tree (seed 000 §II, §IV, Fig. 4):
+//!
+//! * **axel** (priority): the reel's `stall` guard (motor current, never tension)
+//!   subsumes the **docking** (sequencer):
+//!   `acquire` (turn and look until the circle marks give a trusted pose; the module may
+//!   start outside the view) → `approach` (sense-plan-act: stop, look, plan the two-arc
+//!   manoeuvre, drive one arc step reeling by the tether's change of length) → `align`
+//!   (the same within the alignment radius, to the look pose on the axis; reverse and
+//!   realign when misaligned near the cone, bounded retries) → `mate` (blind to the
+//!   cone, wheels free, reel in), with `lost` and `far` leading back.
+//!
+//! Typed failures: `target_never_detected` / `target_lost` (acquisition timed out),
+//! `retries_exhausted` (alignment), `stuck_contact` (stall), `timeout` (a state overran
+//! `behavior.phase_timeout_s`). The planning is the core's
+//! ([`crate::kinematics::two_arc`], [`crate::kinematics::tether_length`]); the shared
+//! [`Memory`] runs the circle perception only while a schema looks, stopped.
+
+pub mod acquire;
+pub mod align;
+pub mod approach;
+pub mod cycle;
+pub mod mate;
+pub mod memory;
+pub mod stall;
+
+use super::agent::BuildError;
+use super::composed::Composed;
+use super::registry::{LeafArgs, Registry};
+use crate::arbiter::Blackboard;
+use crate::profile::Profile;
+pub use memory::Memory;
+
+/// Registers Axel's schemas (`axel.acquire`, `axel.approach`, `axel.align`, `axel.mate`,
+/// `axel.stall`) in `registry`; each takes its tuning from its node's `params`.
+pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
+    registry
+        .register("axel.acquire", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+            Ok(Box::new(acquire::Acquire::new(
+                a.node,
+                m.clone(),
+                a.params()?,
+                a.profile.behavior.search_timeout_s,
+            )))
+        })
+        .register("axel.approach", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+            Ok(Box::new(approach::Approach::new(a.node, m.clone(), a.params()?)))
+        })
+        .register("axel.align", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+            Ok(Box::new(align::Align::new(a.node, m.clone(), a.params()?)))
+        })
+        .register("axel.mate", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+            Ok(Box::new(mate::Mate::new(a.node, m.clone(), a.params()?)))
+        })
+        .register("axel.stall", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+            Ok(Box::new(stall::Stall::new(a.node, m.clone(), a.params()?)))
+        });
+}
+
+/// Axel's robot: the circle perception in the shared [`Memory`] and the tree of
+/// `[behavior.tree]`.
+pub type AxelAgent = Composed<Memory>;
+
+/// Builds Axel's robot from a profile with `[fiducial.circles]`, two cameras, `[dock]`,
+/// `[tether]`, `[behavior.two_arc]` and a `[behavior.tree]` of Axel's schemas (or the
+/// user's, registered in `registry`).
+///
+/// # Errors
+/// [`BuildError`] when something it needs is missing or the tree does not build.
+pub fn agent_with(profile: &Profile, registry: &Registry<Blackboard<Memory>>) -> Result<AxelAgent, BuildError> {
+    Composed::build(profile, registry, Memory::from_profile(profile)?)
+}
+
+/// Builds Axel's robot with Axel's own schemas (see [`agent_with`]).
+///
+/// # Errors
+/// As [`agent_with`].
+pub fn agent(profile: &Profile) -> Result<AxelAgent, BuildError> {
+    let mut registry = Registry::new();
+    super::common::register(&mut registry);
+    register(&mut registry);
+    agent_with(profile, &registry)
+}

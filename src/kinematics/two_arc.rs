@@ -1,0 +1,447 @@
+//! Axel's planning geometry (seed 000 §IV): polar coordinates about the central module,
+//! the approach / alignment / mating regions, and the two-arc manoeuvre.
+//!
+//! Everything here is in the **module frame**: the module's face at x = 0 looking along
+//! +x, the cone's mouth at the origin. A rover pose there is (x, y, θ); its polar form is
+//! r (distance from the mouth), α (its angle about the module's axis) and h, its heading
+//! measured **from the module's axis** (h = 0: heading −x, parallel to the axis, whatever
+//! α; so at α = 40°, h = 0 the module sits 40° off the rover's heading, at the edge of
+//! the view).
+//!
+//! A two-arc manoeuvre is two constant-curvature arcs (a straight is the zero-curvature
+//! arc) that take the rover from its pose to a goal (x, y, h). Two arcs are the fewest
+//! that control position and heading; the problem is under-constrained, so the planner
+//! enumerates the family and keeps the one minimising distance travelled plus turning,
+//! rejecting those whose intermediate headings lose the module from the cameras' view
+//! (seed 000 §IV-A-1). The family is parametrised by the heading φ at the junction:
+//! given φ, each arc's heading change is fixed, and an arc of length s turning by Δ
+//! moves the rover by the chord s·sinc(Δ/2) along θ + Δ/2, so the two lengths solve a
+//! 2×2 linear system. A negative length drives the arc in reverse (a cusp between two
+//! arcs is allowed). Pure functions, no allocation.
+
+use crate::geometry::{Pose2, wrap_angle};
+use std::f64::consts::PI;
+use thiserror::Error;
+
+/// A rover pose in polar form about the module (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Polar {
+    /// Distance from the cone's mouth to the rover's axle, m.
+    pub r: f64,
+    /// The axle's angle about the module's axis, rad (counter-clockwise from +x).
+    pub alpha: f64,
+    /// The rover's heading from the module's axis, rad (0: heading −x).
+    pub h: f64,
+}
+
+impl Polar {
+    /// The polar form of a module-frame pose.
+    pub fn from_pose(pose: &Pose2) -> Self {
+        Self {
+            r: pose.x.hypot(pose.y),
+            alpha: pose.y.atan2(pose.x),
+            h: wrap_angle(pose.theta - PI),
+        }
+    }
+
+    /// The module-frame pose of this polar form.
+    pub fn to_pose(&self) -> Pose2 {
+        Pose2::new(
+            self.r * self.alpha.cos(),
+            self.r * self.alpha.sin(),
+            wrap_angle(self.h + PI),
+        )
+    }
+
+    /// The module's bearing from the rover's heading, rad: 0 dead ahead, α − h in the
+    /// paper's terms (what the cameras' field of view bounds).
+    pub fn bearing(&self) -> f64 {
+        wrap_angle(self.alpha - self.h)
+    }
+}
+
+/// Which of the docking regions a rover is in (seed 000 §IV, Fig. 7).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Region {
+    /// Within the mating radius: precise, slow, recheck then reel.
+    Mating,
+    /// Within the alignment radius: refine the alignment on the way in.
+    Alignment,
+    /// Within the approach radius and angle: approach, reverse and realign freely.
+    Approach,
+    /// Beyond the approach radius or angle: the workspace the paper did not test.
+    Outside,
+}
+
+/// The regions' radii and the approach angle (profile `[behavior.two_arc]` radii,
+/// `[dock]` `approach_radius_m` and `approach_half_angle_deg`). The paper gives no
+/// region radii: the profile's are ours.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Regions {
+    /// Radius of the mating region, m.
+    pub mating_radius: f64,
+    /// Radius of the alignment region, m.
+    pub alignment_radius: f64,
+    /// Radius of the approach region (the workspace), m.
+    pub approach_radius: f64,
+    /// Largest |α| of the approach region, rad.
+    pub approach_half_angle: f64,
+}
+
+impl Regions {
+    /// The region of polar pose `p`: by radius inside the approach region; outside it
+    /// beyond the approach radius or angle.
+    pub fn classify(&self, p: &Polar) -> Region {
+        if p.r <= self.mating_radius {
+            Region::Mating
+        } else if p.r <= self.alignment_radius {
+            Region::Alignment
+        } else if p.r <= self.approach_radius && p.alpha.abs() <= self.approach_half_angle {
+            Region::Approach
+        } else {
+            Region::Outside
+        }
+    }
+}
+
+/// A constant-curvature arc: `length` m along the rover's heading (negative reverses)
+/// with `curvature` 1/m (positive turns left when driving forward; 0 is straight).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Arc {
+    /// Signed curvature, 1/m.
+    pub curvature: f64,
+    /// Signed length, m (negative: driven in reverse).
+    pub length: f64,
+}
+
+/// sin(x)/x, continuous at 0.
+fn sinc(x: f64) -> f64 {
+    if x.abs() < 1e-6 { 1.0 - x * x / 6.0 } else { x.sin() / x }
+}
+
+impl Arc {
+    /// The heading change along the whole arc, rad.
+    pub fn turn(&self) -> f64 {
+        self.curvature * self.length
+    }
+
+    /// The pose `s` m (signed, same sign as the length) along the arc from `from`.
+    pub fn at(&self, from: &Pose2, s: f64) -> Pose2 {
+        let d = self.curvature * s;
+        let chord = s * sinc(d / 2.0);
+        let dir = from.theta + d / 2.0;
+        Pose2::new(from.x + chord * dir.cos(), from.y + chord * dir.sin(), from.theta + d)
+    }
+
+    /// The pose at the arc's end.
+    pub fn end(&self, from: &Pose2) -> Pose2 {
+        self.at(from, self.length)
+    }
+}
+
+/// Two arcs, driven one after the other.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct TwoArc {
+    /// The arcs, in driving order.
+    pub arcs: [Arc; 2],
+}
+
+impl TwoArc {
+    /// The pose at the manoeuvre's end.
+    pub fn end(&self, from: &Pose2) -> Pose2 {
+        self.arcs[1].end(&self.arcs[0].end(from))
+    }
+
+    /// Distance travelled, m.
+    pub fn distance(&self) -> f64 {
+        self.arcs[0].length.abs() + self.arcs[1].length.abs()
+    }
+
+    /// Total turning, rad.
+    pub fn turning(&self) -> f64 {
+        self.arcs[0].turn().abs() + self.arcs[1].turn().abs()
+    }
+}
+
+/// What the planner optimises and must respect.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanParams {
+    /// Tightest turn, m (a differential base can pivot about one wheel: half its track).
+    pub min_radius_m: f64,
+    /// Cost of turning, m per rad, added to the distance travelled.
+    pub turn_weight_m_per_rad: f64,
+    /// The cameras' half field of view, rad: the module must stay within it.
+    pub fov_half_angle: f64,
+    /// Junction headings tried, evenly over the full turn.
+    pub headings: usize,
+    /// Allow arcs driven in reverse.
+    pub allow_reverse: bool,
+    /// Spacing of the view check along the arcs, m.
+    pub check_step_m: f64,
+}
+
+impl Default for PlanParams {
+    fn default() -> Self {
+        Self {
+            min_radius_m: 0.5,
+            turn_weight_m_per_rad: 0.5,
+            fov_half_angle: 45f64.to_radians(),
+            headings: 720,
+            allow_reverse: true,
+            check_step_m: 0.05,
+        }
+    }
+}
+
+/// Why no manoeuvre was planned.
+#[derive(Debug, Clone, Copy, PartialEq, Error)]
+pub enum PlanError {
+    /// A pose or parameter is not finite, or `headings` is 0.
+    #[error("the start, goal or planner parameters are not finite")]
+    NonFinite,
+    /// No two-arc manoeuvre within the curvature limit keeps the module in view.
+    #[error("no two-arc manoeuvre within the turn limit keeps the module in view")]
+    Infeasible,
+}
+
+/// The module's bearing from `pose`'s heading, rad (the module at the origin).
+fn module_bearing(pose: &Pose2) -> f64 {
+    wrap_angle((-pose.y).atan2(-pose.x) - pose.theta)
+}
+
+/// True when the module stays within the view along `plan` from `from`: at every check
+/// point its bearing is within the half field of view, or, where the start already had
+/// it beyond (at the edge of the view), no farther out than at the start. A rover that
+/// sees the module keeps it; one at the edge does not lose it further.
+pub fn keeps_in_view(plan: &TwoArc, from: &Pose2, fov_half_angle: f64, step_m: f64) -> bool {
+    let limit = fov_half_angle.max(module_bearing(from).abs()) + 1e-9;
+    let mut p = *from;
+    for arc in &plan.arcs {
+        let n = (arc.length.abs() / step_m.max(1e-3)).ceil().max(1.0) as usize;
+        for k in 1..=n {
+            let q = arc.at(&p, arc.length * k as f64 / n as f64);
+            if module_bearing(&q).abs() > limit {
+                return false;
+            }
+        }
+        p = arc.end(&p);
+    }
+    true
+}
+
+/// The two arcs through junction heading `phi` from `from` to `goal`, if any: the lengths
+/// solve s₁·c₁ + s₂·c₂ = goal − from, with cᵢ each arc's unit-length chord.
+fn through(from: &Pose2, goal: &Pose2, phi: f64) -> Option<TwoArc> {
+    let d1 = wrap_angle(phi - from.theta);
+    let d2 = wrap_angle(goal.theta - phi);
+    let (k1, k2) = (sinc(d1 / 2.0), sinc(d2 / 2.0));
+    let (a1, a2) = (from.theta + d1 / 2.0, phi + d2 / 2.0);
+    let c1 = (k1 * a1.cos(), k1 * a1.sin());
+    let c2 = (k2 * a2.cos(), k2 * a2.sin());
+    let (dx, dy) = (goal.x - from.x, goal.y - from.y);
+    let det = c1.0 * c2.1 - c1.1 * c2.0;
+    let (s1, s2) = if det.abs() < 1e-9 {
+        // Parallel chords (the start and goal headings are equal): only a goal along them
+        // is reachable. An S (turn, then turn back) shares the length out evenly, the
+        // widest arcs; a heading change of 0 on either side leaves one arc.
+        let n1 = c1.0.hypot(c1.1);
+        let n2 = c2.0.hypot(c2.1);
+        let u = (c1.0 / n1, c1.1 / n1);
+        let along = dx * u.0 + dy * u.1;
+        if (dx - along * u.0).hypot(dy - along * u.1) > 1e-6 {
+            return None;
+        }
+        let sigma = (c2.0 * u.0 + c2.1 * u.1).signum();
+        match (d1.abs() < 1e-12, d2.abs() < 1e-12) {
+            (_, true) => (along / n1, 0.0),
+            (true, false) => (0.0, along / (sigma * n2)),
+            (false, false) => (along / (2.0 * n1), along / (2.0 * sigma * n2)),
+        }
+    } else {
+        ((dx * c2.1 - dy * c2.0) / det, (c1.0 * dy - c1.1 * dx) / det)
+    };
+    let arc = |d: f64, s: f64| Arc {
+        curvature: if s.abs() < 1e-12 { 0.0 } else { d / s },
+        length: s,
+    };
+    // A heading change with no length is a pivot in place: not an arc.
+    if (s1.abs() < 1e-9 && d1.abs() > 1e-9) || (s2.abs() < 1e-9 && d2.abs() > 1e-9) {
+        return None;
+    }
+    Some(TwoArc {
+        arcs: [arc(d1, s1), arc(d2, s2)],
+    })
+}
+
+/// The two-arc manoeuvre from `from` to `goal` (module frame) minimising distance plus
+/// weighted turning among those within the curvature limit (and forward-only unless
+/// reverse is allowed) that keep the module in view ([`keeps_in_view`]).
+///
+/// # Errors
+/// [`PlanError::NonFinite`] for non-finite input, [`PlanError::Infeasible`] when no
+/// candidate qualifies.
+pub fn plan(from: &Pose2, goal: &Pose2, params: &PlanParams) -> Result<TwoArc, PlanError> {
+    let finite = from.is_finite()
+        && goal.is_finite()
+        && params.min_radius_m.is_finite()
+        && params.turn_weight_m_per_rad.is_finite()
+        && params.fov_half_angle.is_finite()
+        && params.check_step_m.is_finite();
+    if !finite || params.headings == 0 {
+        return Err(PlanError::NonFinite);
+    }
+    let kmax = 1.0 / params.min_radius_m.max(1e-6);
+    let mut best: Option<(f64, TwoArc)> = None;
+    // The junction headings: the grid, plus the start's and goal's own (single arcs) and
+    // the one whose chord points at the goal (the S between equal headings, which a grid
+    // would only miss).
+    let grid = (0..params.headings).map(|i| -PI + 2.0 * PI * i as f64 / params.headings as f64);
+    let toward = 2.0 * (goal.y - from.y).atan2(goal.x - from.x) - from.theta;
+    for phi in grid.chain([from.theta, goal.theta, toward]) {
+        let Some(cand) = through(from, goal, phi) else { continue };
+        if cand.arcs.iter().any(|a| a.curvature.abs() > kmax + 1e-9) {
+            continue;
+        }
+        if !params.allow_reverse && cand.arcs.iter().any(|a| a.length < 0.0) {
+            continue;
+        }
+        let cost = cand.distance() + params.turn_weight_m_per_rad * cand.turning();
+        if best.is_some_and(|(c, _)| c <= cost) {
+            continue;
+        }
+        if keeps_in_view(&cand, from, params.fov_half_angle, params.check_step_m) {
+            best = Some((cost, cand));
+        }
+    }
+    best.map(|(_, p)| p).ok_or(PlanError::Infeasible)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn close(a: &Pose2, b: &Pose2) -> bool {
+        (a.x - b.x).abs() < 1e-6 && (a.y - b.y).abs() < 1e-6 && wrap_angle(a.theta - b.theta).abs() < 1e-6
+    }
+
+    #[test]
+    fn polar_round_trips_and_h_is_from_the_axis() {
+        let p = Polar {
+            r: 4.0,
+            alpha: 15f64.to_radians(),
+            h: 0.0,
+        };
+        let pose = p.to_pose();
+        assert!((pose.theta.abs() - PI).abs() < 1e-12, "h = 0 heads −x: {pose:?}");
+        let q = Polar::from_pose(&pose);
+        assert!((q.r - 4.0).abs() < 1e-12 && (q.alpha - p.alpha).abs() < 1e-12 && q.h.abs() < 1e-12);
+        // At α 40°, h 0 the module is 40° off the heading: the edge of a 90° view.
+        let edge = Polar {
+            r: 6.0,
+            alpha: 40f64.to_radians(),
+            h: 0.0,
+        };
+        assert!((edge.bearing() - 40f64.to_radians()).abs() < 1e-12);
+        assert!((module_bearing(&edge.to_pose()) - 40f64.to_radians()).abs() < 1e-9);
+    }
+
+    #[test]
+    fn regions_by_radius_and_angle() {
+        let g = Regions {
+            mating_radius: 1.5,
+            alignment_radius: 3.0,
+            approach_radius: 7.0,
+            approach_half_angle: 40f64.to_radians(),
+        };
+        let at = |r: f64, a: f64| {
+            g.classify(&Polar {
+                r,
+                alpha: a.to_radians(),
+                h: 0.0,
+            })
+        };
+        assert_eq!(at(1.0, 60.0), Region::Mating);
+        assert_eq!(at(2.0, 0.0), Region::Alignment);
+        assert_eq!(at(6.0, 30.0), Region::Approach);
+        assert_eq!(at(6.0, 45.0), Region::Outside);
+        assert_eq!(at(7.5, 0.0), Region::Outside);
+    }
+
+    #[test]
+    fn the_fig10_start_plans_an_s_that_keeps_the_module_in_view() {
+        // Seed 000 Fig. 10: 4 m, α 15°, h 0°, to the axis 1.5 m out facing the module.
+        let from = Polar {
+            r: 4.0,
+            alpha: 15f64.to_radians(),
+            h: 0.0,
+        }
+        .to_pose();
+        let goal = Pose2::new(1.5, 0.0, PI);
+        let p = plan(&from, &goal, &PlanParams::default()).expect("a plan");
+        assert!(close(&p.end(&from), &goal), "{p:?}");
+        // An S: the two arcs turn opposite ways, and nothing reverses.
+        assert!(p.arcs[0].turn() * p.arcs[1].turn() < 0.0, "{p:?}");
+        assert!(p.arcs.iter().all(|a| a.length >= 0.0));
+        assert!(keeps_in_view(&p, &from, 45f64.to_radians(), 0.01));
+        // No longer than the straight line plus a little.
+        assert!(
+            p.distance() < 1.1 * from.x.hypot(from.y) - 1.5 + 0.5,
+            "{}",
+            p.distance()
+        );
+    }
+
+    #[test]
+    fn a_goal_straight_ahead_is_one_straight() {
+        let from = Pose2::new(4.0, 0.0, PI);
+        let goal = Pose2::new(1.5, 0.0, PI);
+        let p = plan(&from, &goal, &PlanParams::default()).expect("a plan");
+        assert!((p.distance() - 2.5).abs() < 1e-9 && p.turning() < 1e-9, "{p:?}");
+    }
+
+    #[test]
+    fn a_view_that_cannot_be_kept_is_refused() {
+        // The goal lies behind: any way there turns the module out of a 10° view.
+        let from = Pose2::new(3.0, 0.0, PI);
+        let goal = Pose2::new(4.0, 2.0, 0.0);
+        let params = PlanParams {
+            fov_half_angle: 10f64.to_radians(),
+            ..PlanParams::default()
+        };
+        assert_eq!(plan(&from, &goal, &params), Err(PlanError::Infeasible));
+        assert_eq!(
+            plan(&Pose2::new(f64::NAN, 0.0, 0.0), &goal, &params),
+            Err(PlanError::NonFinite)
+        );
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Random feasible goals (the end of a random two-arc manoeuvre within the turn
+        /// limit): the plan ends at the goal, within the limit, no costlier than the
+        /// manoeuvre that made the goal.
+        #[test]
+        fn plans_reach_random_feasible_goals(
+            x in -3.0f64..3.0, y in -3.0f64..3.0, th in -PI..PI,
+            k1 in -1.9f64..1.9, s1 in -3.0f64..3.0, k2 in -1.9f64..1.9, s2 in -3.0f64..3.0,
+        ) {
+            let from = Pose2::new(x, y, th);
+            let made = TwoArc { arcs: [Arc { curvature: k1, length: s1 }, Arc { curvature: k2, length: s2 }] };
+            // Heading changes beyond ±180° wrap: the planner's arcs turn at most half a turn.
+            prop_assume!((k1 * s1).abs() < 3.0 && (k2 * s2).abs() < 3.0);
+            let goal = made.end(&from);
+            let params = PlanParams { fov_half_angle: PI, headings: 720, ..PlanParams::default() };
+            let p = plan(&from, &goal, &params);
+            prop_assert!(p.is_ok(), "{from:?} → {goal:?}: {p:?}");
+            let p = p.unwrap();
+            prop_assert!(close(&p.end(&from), &goal), "{p:?} ends at {:?}", p.end(&from));
+            for arc in &p.arcs {
+                prop_assert!(arc.curvature.abs() <= 1.0 / params.min_radius_m + 1e-9);
+            }
+            let cost = |t: &TwoArc| t.distance() + params.turn_weight_m_per_rad * t.turning();
+            prop_assert!(cost(&p) <= 1.05 * cost(&made) + 0.1, "{} > {}", cost(&p), cost(&made));
+        }
+    }
+}
