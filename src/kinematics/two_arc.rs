@@ -172,7 +172,8 @@ pub struct PlanParams {
     pub turn_weight_m_per_rad: f64,
     /// The cameras' half field of view, rad: the module must stay within it.
     pub fov_half_angle: f64,
-    /// Junction headings tried, evenly over the full turn.
+    /// Junction headings tried, evenly over the full turn; as many first-arc curvatures
+    /// are tried, evenly within the limit (see [`plan`]).
     pub headings: usize,
     /// Allow arcs driven in reverse.
     pub allow_reverse: bool,
@@ -291,29 +292,82 @@ pub fn plan(from: &Pose2, goal: &Pose2, params: &PlanParams) -> Result<TwoArc, P
         return Err(PlanError::NonFinite);
     }
     let kmax = 1.0 / params.min_radius_m.max(1e-6);
-    let mut best: Option<(f64, TwoArc)> = None;
-    // The junction headings: the grid, plus the start's and goal's own (single arcs) and
-    // the one whose chord points at the goal (the S between equal headings, which a grid
-    // would only miss).
-    let grid = (0..params.headings).map(|i| -PI + 2.0 * PI * i as f64 / params.headings as f64);
-    let toward = 2.0 * (goal.y - from.y).atan2(goal.x - from.x) - from.theta;
-    for phi in grid.chain([from.theta, goal.theta, toward]) {
-        let Some(cand) = through(from, goal, phi) else { continue };
+    // A candidate's cost, before the view check (`None`: no such manoeuvre, or beyond
+    // the curvature limit, or reversing when that is not allowed).
+    let candidate = |phi: f64| -> Option<(f64, TwoArc)> {
+        let cand = through(from, goal, phi)?;
         if cand.arcs.iter().any(|a| a.curvature.abs() > kmax + 1e-9) {
-            continue;
+            return None;
         }
         if !params.allow_reverse && cand.arcs.iter().any(|a| a.length < 0.0) {
-            continue;
+            return None;
         }
-        let cost = cand.distance() + params.turn_weight_m_per_rad * cand.turning();
+        Some((cand.distance() + params.turn_weight_m_per_rad * cand.turning(), cand))
+    };
+    let mut best: Option<(f64, TwoArc)> = None;
+    let mut consider = |phi: f64| {
+        let Some((cost, cand)) = candidate(phi) else { return };
         if best.is_some_and(|(c, _)| c <= cost) {
-            continue;
+            return;
         }
         if keeps_in_view(&cand, from, params.fov_half_angle, params.check_step_m) {
             best = Some((cost, cand));
         }
+    };
+    // The junction headings: the grid, plus the start's and goal's own (single arcs) and
+    // the one whose chord points at the goal (the S between equal headings, which a grid
+    // would only miss).
+    let n = params.headings;
+    let step = 2.0 * PI / n as f64;
+    let at = |i: usize| -PI + step * i as f64;
+    let toward = 2.0 * (goal.y - from.y).atan2(goal.x - from.x) - from.theta;
+    for phi in [from.theta, goal.theta, toward] {
+        consider(phi);
+    }
+    for i in 0..n {
+        consider(at(i));
+    }
+    // Where the start and goal headings nearly agree the chords are nearly parallel, and
+    // the lengths stay sane only in a valley of junction headings narrower than any grid
+    // of them. So the family is also walked by the first arc's curvature, which is well
+    // conditioned there: for each k₁ on a grid within the limit, the junction heading of
+    // the two-arc manoeuvre whose first arc has that curvature.
+    for i in 0..n {
+        let k1 = kmax * (2.0 * (i as f64 + 0.5) / n as f64 - 1.0);
+        if let Some(phi) = junction_for_curvature(from, goal, k1) {
+            consider(phi);
+        }
     }
     best.map(|(_, p)| p).ok_or(PlanError::Infeasible)
+}
+
+/// The junction heading of the two-arc manoeuvre from `from` to `goal` whose first arc
+/// has curvature `k1` (≠ 0), if one exists. With signed radii rᵢ = 1/kᵢ and left
+/// normals nᵢ, the arcs' centres are C₁ = p₀ + r₁·n₀ and C₂ = p_g + r₂·n_g, and the arcs
+/// meet tangentially when |C₂ − C₁| = |r₁ − r₂|, which is linear in r₂:
+/// r₂ = (r₁² − |A|²) / (2·(A·n_g + r₁)) with A = p_g − C₁. The junction lies on the line of
+/// centres, J = C₁ + r₁·u with u = (C₂ − C₁)/(r₁ − r₂), and the heading there is that of
+/// a circle of radius r₁ whose radius vector is r₁·u.
+fn junction_for_curvature(from: &Pose2, goal: &Pose2, k1: f64) -> Option<f64> {
+    if k1.abs() < 1e-12 {
+        return None;
+    }
+    let r1 = 1.0 / k1;
+    let n0 = (-from.theta.sin(), from.theta.cos());
+    let ng = (-goal.theta.sin(), goal.theta.cos());
+    let c1 = (from.x + r1 * n0.0, from.y + r1 * n0.1);
+    let a = (goal.x - c1.0, goal.y - c1.1);
+    let den = 2.0 * (a.0 * ng.0 + a.1 * ng.1 + r1);
+    if den.abs() < 1e-12 {
+        return None;
+    }
+    let r2 = (r1 * r1 - (a.0 * a.0 + a.1 * a.1)) / den;
+    if (r1 - r2).abs() < 1e-12 || !r2.is_finite() {
+        return None;
+    }
+    let c2 = (goal.x + r2 * ng.0, goal.y + r2 * ng.1);
+    let u = ((c2.0 - c1.0) / (r1 - r2), (c2.1 - c1.1) / (r1 - r2));
+    Some(u.0.atan2(-u.1))
 }
 
 #[cfg(test)]
