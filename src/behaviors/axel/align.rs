@@ -66,7 +66,6 @@ pub struct Align {
     mem: Blackboard<Memory>,
     params: AlignParams,
     cycle: Cycle,
-    unseen: u32,
 }
 
 impl Align {
@@ -77,7 +76,6 @@ impl Align {
             mem,
             params,
             cycle: Cycle::new(params.cycle, params.trust),
-            unseen: 0,
         }
     }
 }
@@ -145,28 +143,16 @@ impl Behavior for Align {
     }
 
     fn enter(&mut self, inputs: &Inputs<'_>) {
-        self.unseen = 0;
-        self.cycle.restart(inputs.now);
+        self.cycle.begin(inputs.now);
     }
 
     fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
         let mut m = self.mem.lock();
         let p = self.params;
-        let unseen = &mut self.unseen;
-        Some(self.cycle.tick(&mut m, "align", |m, seen| match seen {
-            Some(s) => {
-                *unseen = 0;
-                decide(m, &p, s)
-            }
-            None => {
-                *unseen += 1;
-                if *unseen >= p.lost_looks {
-                    Decision::Event("lost")
-                } else {
-                    Decision::Turn(0.0)
-                }
-            }
-        }))
+        Some(
+            self.cycle
+                .tick_seeing(&mut m, "align", p.lost_looks, |m, s| decide(m, &p, s)),
+        )
     }
 }
 

@@ -81,7 +81,6 @@ pub struct Approach {
     mem: Blackboard<Memory>,
     params: ApproachParams,
     cycle: Cycle,
-    unseen: u32,
 }
 
 impl Approach {
@@ -92,7 +91,6 @@ impl Approach {
             mem,
             params,
             cycle: Cycle::new(params.cycle, params.trust),
-            unseen: 0,
         }
     }
 }
@@ -103,24 +101,13 @@ impl Behavior for Approach {
     }
 
     fn enter(&mut self, inputs: &Inputs<'_>) {
-        self.unseen = 0;
-        self.cycle.restart(inputs.now);
+        self.cycle.begin(inputs.now);
     }
 
     fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
         let mut m = self.mem.lock();
         let p = self.params;
-        let unseen = &mut self.unseen;
-        Some(self.cycle.tick(&mut m, "approach", |m, seen| {
-            let Some(s) = seen else {
-                *unseen += 1;
-                return if *unseen >= p.lost_looks {
-                    Decision::Event("lost")
-                } else {
-                    Decision::Turn(0.0)
-                };
-            };
-            *unseen = 0;
+        Some(self.cycle.tick_seeing(&mut m, "approach", p.lost_looks, |m, s| {
             let g = m.geometry;
             let polar = Polar::from_pose(&s.pose);
             if matches!(g.regions.classify(&polar), Region::Alignment | Region::Mating) {

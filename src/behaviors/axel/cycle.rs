@@ -76,6 +76,8 @@ pub struct Cycle {
     state: State,
     params: CycleParams,
     trust: Trust,
+    /// Looks in a row without a trusted pose ([`Cycle::tick_seeing`]).
+    unseen: u32,
 }
 
 impl Cycle {
@@ -85,7 +87,14 @@ impl Cycle {
             state: State::Settle { since: 0.0 },
             params,
             trust,
+            unseen: 0,
         }
+    }
+
+    /// Begins a state at `now`: settle, then look, with no looks counted yet.
+    pub fn begin(&mut self, now: f64) {
+        self.unseen = 0;
+        self.restart(now);
     }
 
     /// Starts over at `now`: settle, then look.
@@ -168,6 +177,35 @@ impl Cycle {
                 m.drive(DriveCommand::Turn { omega }, 0.0, phase)
             }
         }
+    }
+
+    /// [`Cycle::tick`] for a schema that plans only on a trusted pose: `decide` gets the
+    /// sighting; a look without one looks again, and `lost_looks` of them in a row end
+    /// the state with event `lost`.
+    pub fn tick_seeing(
+        &mut self,
+        m: &mut Memory,
+        phase: &'static str,
+        lost_looks: u32,
+        decide: impl FnOnce(&mut Memory, Sighting) -> Decision,
+    ) -> Step {
+        let mut unseen = self.unseen;
+        let step = self.tick(m, phase, |m, seen| match seen {
+            Some(s) => {
+                unseen = 0;
+                decide(m, s)
+            }
+            None => {
+                unseen += 1;
+                if unseen >= lost_looks {
+                    Decision::Event("lost")
+                } else {
+                    Decision::Turn(0.0)
+                }
+            }
+        });
+        self.unseen = unseen;
+        step
     }
 
     /// Starts driving `arc` from module-frame `from`: at the arc speed, slower where the
