@@ -232,6 +232,8 @@ pub struct Memory {
     pub sighting: Option<Sighting>,
     /// Loop time of this tick, s.
     pub now: f64,
+    /// Loop time of this docking's first tick, s (feedback's elapsed time counts from it).
+    pub run_start: Option<f64>,
     /// Odometry pose of this tick.
     pub odo: Pose2,
     /// The reel's reading this tick.
@@ -266,6 +268,7 @@ impl Memory {
             looking: false,
             sighting: None,
             now: 0.0,
+            run_start: None,
             odo: Pose2::default(),
             reel: None,
             retries: 0,
@@ -309,7 +312,7 @@ impl Memory {
     pub fn feedback(&self, phase: &'static str) -> Feedback {
         Feedback {
             phase,
-            elapsed: self.now,
+            elapsed: self.now - self.run_start.unwrap_or(self.now),
             retries: self.retries,
         }
     }
@@ -318,6 +321,7 @@ impl Memory {
 impl SharedMemory for Memory {
     fn perceive(&mut self, inputs: &Inputs<'_>) {
         self.now = inputs.now;
+        self.run_start.get_or_insert(inputs.now);
         if let Some(o) = inputs.odometry {
             self.odo = o.value.pose;
         }
@@ -339,6 +343,7 @@ impl SharedMemory for Memory {
     }
 
     fn begin(&mut self, _mission: &Mission) -> Result<(), MissionError> {
+        self.run_start = None;
         self.looking = false;
         self.sighting = None;
         self.retries = 0;
