@@ -7,7 +7,7 @@
 use super::memory::Memory;
 use super::region2::{plan, robot_in_ball_frame};
 use crate::arbiter::Blackboard;
-use crate::schemas::{Behavior, Inputs, Status, Step};
+use crate::schemas::{Behavior, Inputs, Step};
 
 /// See the module docs.
 pub struct Align {
@@ -47,12 +47,6 @@ impl Behavior for Align {
             reverse = pl.reverse,
             "region II: rotate −β, travel d, rotate φ"
         );
-        m.manoeuvres += 1;
-        m.settling = false;
-        m.plan = Some(pl);
-        let omega = m.vision_turn * pl.rotation.signum();
-        let mut step = m.turn(omega, "state_7");
-        step.status = Status::Event("planned");
-        Some(step)
+        Some(m.start_manoeuvre(pl))
     }
 }

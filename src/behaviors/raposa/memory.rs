@@ -226,6 +226,17 @@ impl Memory {
         self.drive(Twist::new(0.0, omega), phase)
     }
 
+    /// Starts executing a region-II plan (the `region_2` sequence runs it): counts the
+    /// manoeuvre, ends the settling, keeps the plan and ends the planning state with
+    /// event `planned`, already turning toward −β at the vision-tracked rate (state 7).
+    pub fn start_manoeuvre(&mut self, plan: Region2Plan) -> Step {
+        self.manoeuvres += 1;
+        self.settling = false;
+        self.plan = Some(plan);
+        let omega = self.vision_turn * plan.rotation.signum();
+        self.turn(omega, "state_7").with_event("planned")
+    }
+
     /// The state-1 approach law on this tick's ellipse (`far`: at the constant far speed,
     /// state 3); stands still without one.
     pub fn approach(&self, far: bool, phase: &'static str) -> Step {

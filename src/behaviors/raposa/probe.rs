@@ -18,7 +18,7 @@ use super::memory::Memory;
 use super::params::ProbeParams;
 use super::region2::{plan_to, robot_in_ball_frame};
 use crate::arbiter::Blackboard;
-use crate::schemas::{Behavior, Inputs, Status, Step};
+use crate::schemas::{Behavior, Inputs, Step};
 
 /// See the module docs.
 pub struct Probe {
@@ -71,13 +71,7 @@ impl Behavior for Probe {
             "probe: around the ball, side unknown"
         );
         m.probes += 1;
-        m.manoeuvres += 1;
-        m.settling = false;
-        m.plan = Some(pl);
-        let omega = m.vision_turn * pl.rotation.signum();
-        let mut step = m.turn(omega, "state_7");
-        step.status = Status::Event("planned");
-        Some(step)
+        Some(m.start_manoeuvre(pl))
     }
 }
 
