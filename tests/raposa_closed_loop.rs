@@ -5,37 +5,43 @@
 //! paper's dead zone (0.33 m, far off the axis, where only the ball is in view), which
 //! the paper never docked: by probing around the ball until the pair shows its side.
 
+mod common;
+
 use marsupial::behaviors::agent_for;
 use marsupial::sim::campaign;
 use marsupial::sim::scenario::Scenario;
-use std::path::Path;
 
-type Outcome = (Vec<campaign::RunRecord>, campaign::Summary, f64, f64);
-
-/// Runs the profile from `points` (distance m, angle °), one trial each; the records, the
-/// summary and the profile's lateral (m) and heading (°) tolerances.
-fn run(tag: &str, points: &[(f64, f64)]) -> Outcome {
+/// Runs the profile from `points` (distance m, angle °), one trial each, and checks that
+/// every run docked within the profile's tolerance; the records, in the points' order.
+fn docked_from(tag: &str, points: &[(f64, f64)]) -> Vec<campaign::RunRecord> {
     let dir = std::env::temp_dir().join(format!("marsupial-raposa-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let profile = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/raposa.toml");
-    let s = dir.join("s.toml");
     let list: Vec<String> = points
         .iter()
         .map(|(d, a)| format!("{{ distance_m = {d}, angle_deg = {a} }}"))
         .collect();
-    std::fs::write(
-        &s,
-        format!(
-            "name = \"raposa-{tag}\"\nprofile = \"{}\"\nseed = 5\ntrials = 1\ntimeout_s = 300.0\n[starts]\nposition_jitter_m = 0.02\nheading_jitter_deg = 2.0\npoints = [{}]\n[imprint]\nenabled = false\n",
-            profile.display(),
+    let s = common::scenario_file(
+        &dir,
+        &format!("raposa-{tag}"),
+        "raposa.toml",
+        &format!(
+            "seed = 5\ntrials = 1\ntimeout_s = 300.0\n[starts]\nposition_jitter_m = 0.02\nheading_jitter_deg = 2.0\npoints = [{}]\n[imprint]\nenabled = false\n",
             list.join(", ")
         ),
-    )
-    .unwrap();
+    );
     let p = campaign::prepare(Scenario::load(&s).unwrap()).unwrap();
     let (records, summary) = campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap();
     let tol = p.loaded.profile.success;
-    (records, summary, tol.lateral_tolerance_m, tol.heading_tolerance_deg)
+    for (r, (_, a)) in records.iter().zip(points) {
+        assert!(
+            r.success,
+            "start {} ({a}°): {} after {:.1} s",
+            r.start, r.outcome, r.time_s
+        );
+        assert!(r.entrance_lateral_m.unwrap().abs() <= tol.lateral_tolerance_m);
+        assert!(r.entrance_heading_deg.unwrap().abs() <= tol.heading_tolerance_deg);
+    }
+    assert_eq!(summary.overall.successes, points.len());
+    records
 }
 
 #[test]
@@ -50,22 +56,13 @@ fn docks_from_starts_across_regions_one_and_two() {
         (1.5, 60.0),
         (1.5, -90.0),
     ];
-    let (records, summary, lateral, heading) = run("loop", &points);
-    for (r, (_, a)) in records.iter().zip(points) {
-        assert!(
-            r.success,
-            "start {} ({a}°): {} after {:.1} s",
-            r.start, r.outcome, r.time_s
-        );
-        assert!(r.entrance_lateral_m.unwrap().abs() <= lateral);
-        assert!(r.entrance_heading_deg.unwrap().abs() <= heading);
+    for (r, (_, a)) in docked_from("loop", &points).iter().zip(points) {
         if a.abs() >= 30.0 {
             assert!(r.manoeuvres >= 1, "start {} ({a}°) docked without region II", r.start);
         } else {
             assert_eq!(r.manoeuvres, 0, "start {} ({a}°) is region I", r.start);
         }
     }
-    assert_eq!(summary.overall.successes, points.len());
 }
 
 /// The paper's points 1 and 3 (0.33 m, ±70°) and one between them and the axis: only the
@@ -73,20 +70,11 @@ fn docks_from_starts_across_regions_one_and_two() {
 #[test]
 fn docks_from_the_dead_zone_by_probing() {
     let points: [(f64, f64); 3] = [(0.33, -70.0), (0.33, 70.0), (0.4, -62.0)];
-    let (records, summary, lateral, heading) = run("dead-zone", &points);
-    for (r, (_, a)) in records.iter().zip(points) {
-        assert!(
-            r.success,
-            "start {} ({a}°): {} after {:.1} s",
-            r.start, r.outcome, r.time_s
-        );
-        assert!(r.entrance_lateral_m.unwrap().abs() <= lateral);
-        assert!(r.entrance_heading_deg.unwrap().abs() <= heading);
+    for (r, (_, a)) in docked_from("dead-zone", &points).iter().zip(points) {
         assert!(
             r.manoeuvres >= 1,
             "start {} ({a}°) docked without moving around",
             r.start
         );
     }
-    assert_eq!(summary.overall.successes, points.len());
 }
