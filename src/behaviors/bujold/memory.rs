@@ -433,3 +433,41 @@ pub fn raised() -> Auxiliary {
         ..Auxiliary::default()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::perception::ColorMode;
+
+    /// A found pair 60 px tall at the image centre with `left` and `right` pixels.
+    fn pair(now: f64, left: u64, right: u64) -> TwoBlockPercept {
+        TwoBlockPercept {
+            found: true,
+            left_px: left,
+            right_px: right,
+            total_px: left + right,
+            left_centroid: [113.0, 96.0],
+            right_centroid: [143.0, 96.0],
+            left_bbox: [98, 66, 127, 125],
+            right_bbox: [128, 66, 157, 125],
+            ..TwoBlockPercept::not_found(now, ColorMode::Table, (256, 192))
+        }
+    }
+
+    /// A frame whose block ratio jumps (one block flashed) keeps the filtered viewing
+    /// angle and gives no planning view; the consistent frames around it do.
+    #[test]
+    fn a_flashed_block_moves_neither_the_angle_nor_the_plan() {
+        let profile = Profile::load("profiles/bujold.toml".as_ref()).unwrap();
+        let mut m = Memory::from_profile(&profile).unwrap();
+        m.digest(&Inputs::empty(0.0), &pair(0.0, 2250, 2250));
+        assert!(m.planning.is_some());
+        let alpha = m.alpha_filtered.unwrap();
+        m.digest(&Inputs::empty(0.1), &pair(0.1, 1000, 2250));
+        assert!(m.planning.is_none(), "the flashed frame is not planned on");
+        assert!(m.view.is_some(), "its bearing still steers");
+        assert_eq!(m.alpha_filtered, Some(alpha));
+        m.digest(&Inputs::empty(0.2), &pair(0.2, 2260, 2240));
+        assert!(m.planning.is_some());
+    }
+}
