@@ -359,6 +359,10 @@ impl SctThresholds {
         let clamp = |x: f64| x.clamp(EPS, FRAC_PI_2 - EPS);
         let ceil = |x: f64| (x - 1e-9).ceil().max(0.0);
         let l2 = r.min_l.max(1.0).powi(2);
+        // The range's tangents, once: the tables are rebuilt whenever adaptation moves a
+        // range (most frames), and the compiler does not hoist `tan` out of the loop.
+        let (tan_b0, tan_b1) = (clamp(b0).tan(), clamp(b1).tan());
+        let (tan2_a0, tan2_a1) = (clamp(a0).tan().powi(2), clamp(a1).tan().powi(2));
         for v in 0..256usize {
             let x = v as f64;
             // B ≥ b₀: g ≥ r·tan b₀; at r = 0 any g ≥ 1 gives B = π/2.
@@ -367,27 +371,23 @@ impl SctThresholds {
             } else if v == 0 {
                 1
             } else {
-                ceil(x * clamp(b0).tan()).min(256.0) as u16
+                ceil(x * tan_b0).min(256.0) as u16
             };
             // B ≤ b₁: r ≥ g·cot b₁.
             t.r_min[v] = if b1 >= FRAC_PI_2 {
                 0
             } else {
-                ceil(x / clamp(b1).tan()).min(256.0) as u16
+                ceil(x / tan_b1).min(256.0) as u16
             };
             // A ≥ a₀ and brightness: r² + g² ≥ max(b²·tan² a₀, L² − b²).
-            let lo_a = if a0 <= 0.0 {
-                0.0
-            } else {
-                ceil(x * x * clamp(a0).tan().powi(2))
-            };
+            let lo_a = if a0 <= 0.0 { 0.0 } else { ceil(x * x * tan2_a0) };
             let lo_l = ceil(l2 - x * x);
             t.rg2_min[v] = lo_a.max(lo_l).min(u32::MAX as f64) as u32;
             // A ≤ a₁: r² + g² ≤ b²·tan² a₁.
             t.rg2_max[v] = if a1 >= FRAC_PI_2 {
                 u32::MAX
             } else {
-                (x * x * clamp(a1).tan().powi(2) + 1e-9).floor().min(u32::MAX as f64) as u32
+                (x * x * tan2_a1 + 1e-9).floor().min(u32::MAX as f64) as u32
             };
         }
         t
