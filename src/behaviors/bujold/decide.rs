@@ -14,7 +14,11 @@ use crate::schemas::{Behavior, FailureReason, Inputs, MotorOutput, Step};
 
 /// The at-dock decision: average the views, predict the lateral error where the rear
 /// will reach the entrance, and back in only if that and the heading are within
-/// `fraction` of the profile's tolerances. The rear sits `rear_behind_camera` behind the
+/// `fraction` of the profile's tolerances, and the heading also at least `heading_margin`
+/// inside its tolerance. The heading is the viewing angle α, from the blocks' pixel ratio,
+/// less the fiducial's bearing; the bearing is a centroid and sharp, but α carries the
+/// ratio's error, which partial shadows and flashes bias by up to 2–4° at the gate. The
+/// back-in is blind, so that error must fit inside the tolerance. The rear sits `rear_behind_camera` behind the
 /// camera along the heading θ and backs a further `to_go` to the entrance, so its lateral
 /// error there is the camera's, d·sin α, less (rear_behind_camera + to_go)·sin θ.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,6 +42,7 @@ pub fn at_dock_decision(
     tol_lateral: f64,
     tol_heading: f64,
     fraction: f64,
+    heading_margin: f64,
 ) -> Decision {
     let n = samples.len().max(1) as f64;
     let alpha = samples.iter().map(|s| s.alpha).sum::<f64>() / n;
@@ -48,7 +53,7 @@ pub fn at_dock_decision(
     Decision {
         back_in: !samples.is_empty()
             && lateral_at_entrance.abs() <= fraction * tol_lateral
-            && heading.abs() <= fraction * tol_heading,
+            && heading.abs() <= (fraction * tol_heading).min(tol_heading - heading_margin),
         alpha,
         heading,
         distance,
@@ -121,6 +126,7 @@ impl Behavior for Decide {
             self.tol_lateral,
             self.tol_heading,
             self.params.tolerance_fraction,
+            self.params.heading_margin_deg.to_radians(),
         );
         tracing::debug!(target: "marsupial::behavior", now = m.now, back_in = d.back_in, alpha_deg = d.alpha.to_degrees(), heading_deg = d.heading.to_degrees(), distance = d.distance, lateral_m = d.lateral_at_entrance, "at-dock decision");
         if d.back_in {
@@ -169,7 +175,7 @@ mod tests {
     }
 
     fn decide(samples: &[FiducialView], tol_heading: f64) -> Decision {
-        at_dock_decision(samples, 0.15, 0.02, tol_heading, 0.8)
+        at_dock_decision(samples, 0.15, 0.02, tol_heading, 0.8, 0.0)
     }
 
     #[test]
@@ -195,6 +201,21 @@ mod tests {
         assert!((d.lateral_at_entrance - expected).abs() < 1e-12, "{d:?}");
         assert!(!d.back_in, "{d:?}");
         assert!(!decide(&[], 0.1).back_in);
+    }
+
+    #[test]
+    fn the_heading_margin_narrows_the_heading_gate_only() {
+        let tol = 5f64.to_radians();
+        let margin = 2f64.to_radians();
+        // 3.5° is inside 80 % of 5° but not 2° inside 5°.
+        let skewed = [view(3.5, 3.5); 5];
+        assert!(decide(&skewed, tol).back_in);
+        assert!(!at_dock_decision(&skewed, 0.15, 0.02, tol, 0.8, margin).back_in);
+        assert!(at_dock_decision(&[view(2.9, 2.9); 5], 0.15, 0.02, tol, 0.8, margin).back_in);
+        // A margin smaller than the fraction's leaves the fraction in charge.
+        let small = 0.5f64.to_radians();
+        assert!(!at_dock_decision(&[view(4.2, 4.2); 5], 0.15, 0.02, tol, 0.8, small).back_in);
+        assert!(at_dock_decision(&[view(3.9, 3.9); 5], 0.15, 0.02, tol, 0.8, small).back_in);
     }
 
     #[test]

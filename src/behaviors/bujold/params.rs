@@ -145,6 +145,10 @@ pub struct DecideParams {
     pub lost_after_s: f64,
     /// Back in only within this fraction of the profile's success tolerances.
     pub tolerance_fraction: f64,
+    /// And only with the heading at least this far inside its tolerance, degrees: the
+    /// error of the heading estimate at the gate, which the blind back-in cannot correct.
+    /// Default 0 (the fraction alone).
+    pub heading_margin_deg: f64,
 }
 
 impl Default for DecideParams {
@@ -153,6 +157,7 @@ impl Default for DecideParams {
             frames: 5,
             lost_after_s: 3.0,
             tolerance_fraction: 0.8,
+            heading_margin_deg: 0.0,
         }
     }
 }
