@@ -360,6 +360,20 @@ fn bench_krawler(c: &mut Criterion) {
             black_box(s)
         })
     });
+    let mount = marsupial::perception::krawler::MountParams::default();
+    let half_spacing = marsupial::perception::krawler::rotation::PLATE_MARKER_Y_M;
+    g.bench_function("mount_fit_four_plate_markers", |b| {
+        b.iter(|| {
+            let plate = [at[0], at[1], at[4], at[5]].map(Some);
+            black_box(marsupial::perception::krawler::fit_mount(
+                &geometry,
+                black_box(plate),
+                [(0.0, 0.25); 2],
+                half_spacing,
+                &mount,
+            ))
+        })
+    });
     g.bench_function("grey_pyramids_two_frames", |b| {
         b.iter(|| {
             pa.build_from_rgb(black_box(&frames[0].view()));

@@ -43,6 +43,7 @@ fn the_command_writes_its_files_with_sane_errors() {
         seed: None,
         profile: profile_path(),
         json: false,
+        no_mount_compensation: false,
     };
     let mut printed = Vec::new();
     let s = run(&opts, &mut printed).unwrap();
@@ -134,6 +135,7 @@ fn bad_sequence_files_name_the_field() {
         seed: None,
         profile: profile_path(),
         json: true,
+        no_mount_compensation: false,
     };
     let e = run(&opts, &mut Vec::new()).unwrap_err();
     assert!(e.contains("missing.toml"), "{e}");

@@ -6,7 +6,8 @@
 //! For each frame of the sequence ([`crate::sim::krawler_sequence`]) the gear is built
 //! from the true state, rendered by the belly fisheye with sensor noise (and the
 //! sequence's error knobs: lost frames, mount vibration, mud on a marker, a light
-//! change), and estimated. `--out DIR` gets:
+//! change in level and colour, the body's shadow on the gear, the mount's plates in
+//! view, the floor moving under the rover), and estimated. `--out DIR` gets:
 //! * `frames.csv`: per delivered frame, the truth and estimate of each degree of freedom
 //!   (roll and steering in degrees, drop in mm, θ in rad from the first frame) and the
 //!   estimate's validity, and the commanded steering;
@@ -21,6 +22,7 @@
 //! Truth is exact here; the paper's came from IMUs, potentiometers and an encoder.
 
 use crate::geometry::Pose2;
+use crate::kinematics::ackermann::DoubleAckermann;
 use crate::perception::RgbImage;
 use crate::perception::krawler::{
     AxleGeometry, AxleState, ExpectedMarker, GearLayout, KrawlerEstimate, KrawlerParams, KrawlerStateSchema,
@@ -28,13 +30,12 @@ use crate::perception::krawler::{
 };
 use crate::profile::Profile;
 use crate::sim::camera::camera_pose;
-use crate::sim::krawler::{KrawlerState, build, expected_markers};
-use crate::sim::krawler_sequence::{SequenceSpec, TruthFrame, drive_of, generate, odometry};
-use crate::sim::lighting::LightState;
+use crate::sim::krawler::{GearExtras, GroundPose, KrawlerState, build_with, expected_markers};
+use crate::sim::krawler_sequence::{LightChange, SequenceSpec, TruthFrame, drive_of, generate, odometry, shaken};
 use crate::sim::plot::{Series, paths_svg, time_series_svg};
 use crate::sim::render::{CameraPose, Renderer, SensorParams};
 use crate::sim::rng::Rng;
-use nalgebra::{Point3, Rotation3, Vector3};
+use nalgebra::Point3;
 use std::fmt::Write as _;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -58,6 +59,10 @@ pub struct EstimateOptions {
     /// Print summary.json instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Turn off the mount-vibration compensation (every frame read with the nominal
+    /// mount, as the paper does): for before/after figures.
+    #[arg(long)]
+    pub no_mount_compensation: bool,
 }
 
 /// The ten degrees of freedom's names, in [`KrawlerState`] order.
@@ -132,6 +137,8 @@ pub struct EstimateSummary {
     pub paper_dataset: Option<usize>,
     /// The error knobs that were on.
     pub errors: Vec<String>,
+    /// Whether the estimator compensated the mount's vibration.
+    pub mount_compensation: bool,
 }
 
 impl EstimateSummary {
@@ -192,6 +199,7 @@ impl EstimateSummary {
             },
             "paper": paper,
             "errors": self.errors,
+            "mount_compensation": self.mount_compensation,
         })
     }
 
@@ -237,7 +245,7 @@ impl EstimateSummary {
         );
         let _ = writeln!(
             s,
-            "frames {} delivered of {}; seed {}; errors: {}",
+            "frames {} delivered of {}; seed {}; errors: {}; mount compensation {}",
             self.delivered,
             self.frames,
             self.seed,
@@ -245,7 +253,8 @@ impl EstimateSummary {
                 "none".to_string()
             } else {
                 self.errors.join(", ")
-            }
+            },
+            if self.mount_compensation { "on" } else { "off" }
         );
         let _ = writeln!(
             s,
@@ -296,17 +305,6 @@ struct Record {
     estimate: KrawlerEstimate,
 }
 
-/// The camera pose shaken by the mount's vibration: a random small rotation (SD `deg`)
-/// and displacement (SD `mm`).
-fn shaken(base: &CameraPose, deg: f64, mm: f64, rng: &mut Rng) -> CameraPose {
-    let r = Vector3::new(rng.normal(), rng.normal(), rng.normal()) * deg.to_radians();
-    let d = Vector3::new(rng.normal(), rng.normal(), rng.normal()) * (mm / 1000.0);
-    CameraPose {
-        rotation: Rotation3::new(r).matrix() * base.rotation,
-        position: base.position + d,
-    }
-}
-
 /// Paints mud over marker `marker` of the gear: a brown patch 1.6 times the marker's
 /// side, centred where it projects.
 fn mud(
@@ -341,7 +339,13 @@ fn mud(
 }
 
 /// Runs the estimator over the sequence's frames.
-fn run_frames(spec: &SequenceSpec, profile: &Profile, truth: &[TruthFrame], seed: u64) -> Result<Vec<Record>, String> {
+fn run_frames(
+    spec: &SequenceSpec,
+    profile: &Profile,
+    truth: &[TruthFrame],
+    seed: u64,
+    params: KrawlerParams,
+) -> Result<Vec<Record>, String> {
     let pe = |e: &dyn std::fmt::Display| format!("profile `{}`: {e}", profile.name);
     let cam = profile.cameras.first().ok_or_else(|| pe(&"no camera"))?;
     let geometry = AxleGeometry::from_profile(profile, 0).map_err(|e| pe(&e))?;
@@ -356,15 +360,7 @@ fn run_frames(spec: &SequenceSpec, profile: &Profile, truth: &[TruthFrame], seed
         steer: rest.steer[a],
     });
     let (w, h) = (cam.width_px, cam.height_px);
-    let mut schema = KrawlerStateSchema::new(
-        (w, h),
-        geometry.clone(),
-        layout,
-        polys,
-        KrawlerParams::default(),
-        start,
-        axles,
-    );
+    let mut schema = KrawlerStateSchema::new((w, h), geometry.clone(), layout, polys, params, start, axles);
     let mut renderer = Renderer::new(geometry.model.clone(), w, h, seed);
     let base = camera_pose(&Pose2::new(0.0, 0.0, 0.0), &cam.mount);
     let dt = truth.get(1).map_or(1.0 / cam.fps, |f| f.t - truth[0].t);
@@ -374,6 +370,11 @@ fn run_frames(spec: &SequenceSpec, profile: &Profile, truth: &[TruthFrame], seed
     };
     let side = profile.fiducial.markers.map_or(0.03, |m| m.side_m);
     let knobs = spec.errors;
+    // The rover's true path over the floor, when the floor is fixed to the world.
+    let ground = match (knobs.moving_ground, drive_of(profile)) {
+        (true, Some(drive)) => true_path(&drive, truth),
+        _ => Vec::new(),
+    };
     let mut ransac = Rng::named(seed, "krawler-ransac");
     let mut errors = Rng::named(seed, "krawler-errors");
     let mut image = RgbImage::default();
@@ -387,19 +388,18 @@ fn run_frames(spec: &SequenceSpec, profile: &Profile, truth: &[TruthFrame], seed
         } else {
             base
         };
-        let level = match knobs.light {
-            Some(l) if f.t >= l.at_s => l.level as f32,
-            _ => 1.0,
+        let light = LightChange::light_at(knobs.light.as_ref(), f.t);
+        let extras = GearExtras {
+            shadow: knobs.self_shadow.and_then(|s| s.at(f.t)),
+            mount_plates: knobs.mount_plates,
+            ground: ground.get(i).map(|p| GroundPose {
+                x: p[0],
+                y: p[1],
+                heading: p[2],
+            }),
         };
-        let gear = build(profile, &f.state).map_err(|e| pe(&e))?;
-        renderer.render(
-            &gear.scene,
-            &pose,
-            &LightState::uniform(level),
-            &sensor,
-            i as u64,
-            &mut image,
-        );
+        let gear = build_with(profile, &f.state, &extras).map_err(|e| pe(&e))?;
+        renderer.render(&gear.scene, &pose, &light, &sensor, i as u64, &mut image);
         if let Some(m) = knobs.mud
             && f.t >= m.start_s
             && f.t < m.start_s + m.duration_s
@@ -441,6 +441,23 @@ fn estimate_value(e: &KrawlerEstimate, k: usize) -> (f64, bool) {
     (v, d.valid)
 }
 
+/// Each frame's time step to the next (0 after the last) and body speed.
+fn steps_of(truth: &[TruthFrame]) -> (Vec<f64>, Vec<f64>) {
+    let dts = truth
+        .windows(2)
+        .map(|w| w[1].t - w[0].t)
+        .chain(std::iter::once(0.0))
+        .collect();
+    (dts, truth.iter().map(|f| f.speed).collect())
+}
+
+/// The rover's true path (x, y, heading per frame) from the truth's speeds and steering.
+fn true_path(drive: &DoubleAckermann, truth: &[TruthFrame]) -> Vec<[f64; 3]> {
+    let (dts, speed) = steps_of(truth);
+    let steer: Vec<[f64; 2]> = truth.iter().map(|f| f.state.steer).collect();
+    odometry(drive, &dts, &speed, &steer)
+}
+
 /// The result of a run: the summary, and the per-frame tables and plots.
 pub struct EstimateRun {
     /// The figures.
@@ -450,14 +467,28 @@ pub struct EstimateRun {
     paths: [Vec<[f64; 3]>; 3],
 }
 
-/// Generates the sequence, renders and estimates every frame, and measures.
+/// Generates the sequence, renders and estimates every frame with the estimator's
+/// default settings, and measures.
 ///
 /// # Errors
 /// A message naming the field for a bad sequence file, or the profile's problem.
 pub fn estimate(spec: &SequenceSpec, profile: &Profile, seed: u64) -> Result<EstimateRun, String> {
+    estimate_with(spec, profile, seed, KrawlerParams::default())
+}
+
+/// As [`estimate`], with the estimator's settings `params`.
+///
+/// # Errors
+/// As [`estimate`].
+pub fn estimate_with(
+    spec: &SequenceSpec,
+    profile: &Profile,
+    seed: u64,
+    params: KrawlerParams,
+) -> Result<EstimateRun, String> {
     let drive = drive_of(profile).ok_or_else(|| format!("profile `{}` has no double-Ackermann drive", profile.name))?;
     let truth = generate(spec, profile, seed)?;
-    let records = run_frames(spec, profile, &truth, seed)?;
+    let records = run_frames(spec, profile, &truth, seed, params)?;
     let first = &truth[0];
     let mut dof = [DofError::default(); 10];
     let mut valid_sum = [0.0f64; 10];
@@ -489,13 +520,7 @@ pub fn estimate(spec: &SequenceSpec, profile: &Profile, seed: u64) -> Result<Est
     }
     // Odometry: every frame, speed from the truth; the estimated steering held between
     // delivered frames.
-    let dts: Vec<f64> = truth
-        .windows(2)
-        .map(|w| w[1].t - w[0].t)
-        .chain(std::iter::once(0.0))
-        .collect();
-    let speed: Vec<f64> = truth.iter().map(|f| f.speed).collect();
-    let true_steer: Vec<[f64; 2]> = truth.iter().map(|f| f.state.steer).collect();
+    let (dts, speed) = steps_of(&truth);
     let cmd_steer: Vec<[f64; 2]> = truth.iter().map(|f| f.steer_cmd).collect();
     let mut est_steer = Vec::with_capacity(truth.len());
     let mut held = [0.0f64; 2];
@@ -506,7 +531,7 @@ pub fn estimate(spec: &SequenceSpec, profile: &Profile, seed: u64) -> Result<Est
         }
         est_steer.push(held);
     }
-    let p_true = odometry(&drive, &dts, &speed, &true_steer);
+    let p_true = true_path(&drive, &truth);
     let p_est = odometry(&drive, &dts, &speed, &est_steer);
     let p_cmd = odometry(&drive, &dts, &speed, &cmd_steer);
     let drift = |p: &[[f64; 3]]| {
@@ -534,6 +559,7 @@ pub fn estimate(spec: &SequenceSpec, profile: &Profile, seed: u64) -> Result<Est
         odo_commanded: drift(&p_cmd),
         paper_dataset: spec.paper_dataset,
         errors: spec.errors.active(),
+        mount_compensation: params.mount.enabled,
     };
     Ok(EstimateRun {
         summary,
@@ -653,7 +679,9 @@ pub fn run(opts: &EstimateOptions, out: &mut dyn Write) -> Result<EstimateSummar
     let profile = Profile::load(&opts.profile).map_err(|e| e.to_string())?;
     let seed = opts.seed.unwrap_or(spec.seed);
     let started = std::time::Instant::now();
-    let result = estimate(&spec, &profile, seed)?;
+    let mut params = KrawlerParams::default();
+    params.mount.enabled = !opts.no_mount_compensation;
+    let result = estimate_with(&spec, &profile, seed, params)?;
     let elapsed = started.elapsed().as_secs_f64();
     if let Some(dir) = &opts.out {
         result.write(dir)?;

@@ -10,7 +10,7 @@
 use super::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount, PerceptionSpec, Profile};
 use super::{PyramidPerceptionSpec, TwoBlockSpec};
 use crate::perception::circles::{CircleModel, MarkRotation, RigCamera};
-use crate::perception::krawler::rotation::{HUB_BELOW_PLATE_M, TREAD_WIDTH_M};
+use crate::perception::krawler::rotation::{HUB_BELOW_PLATE_M, PLATE_MARKER_Y_M, TREAD_WIDTH_M};
 use crate::perception::krawler::{AxleGeometry, GearLayout, SteeringPoly};
 use crate::perception::{
     CameraModel, CastParams, ColorModelParams, Fisheye, HsvLimits, MountAngles, PairLimits, Pinhole, PyramidGeometry,
@@ -283,7 +283,8 @@ impl AxleGeometry {
 impl GearLayout {
     /// The wheels of a double-Ackermann profile: its track and wheel radius, with the
     /// tread's width and the hubs' height below the marker plane the estimates
-    /// [`TREAD_WIDTH_M`] and [`HUB_BELOW_PLATE_M`] (the profile does not carry them).
+    /// [`TREAD_WIDTH_M`] and [`HUB_BELOW_PLATE_M`], and the plate markers'
+    /// [`PLATE_MARKER_Y_M`] (the profile does not carry them).
     ///
     /// # Errors
     /// [`VisionError::Profile`] without `drive.wheel_radius_m`.
@@ -297,6 +298,7 @@ impl GearLayout {
             wheel_radius,
             tread_half_width: TREAD_WIDTH_M / 2.0,
             hub_below_plate: HUB_BELOW_PLATE_M,
+            marker_half_spacing: PLATE_MARKER_Y_M,
         })
     }
 }

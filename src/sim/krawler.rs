@@ -35,6 +35,13 @@
 //! our x = ±wheelbase/2, and its roll ψ about y is our roll about x (same sign for a
 //! right-handed rotation about the forward axis: positive lifts the left wheel).
 //!
+//! **Error sources** ([`GearExtras`], for [`crate::sim::krawler_sequence`]'s knobs): the
+//! body's shadow on the gear ([`SelfShadow`]), the camera mount's four thin plates in
+//! view, and a floor fixed to the world so that it moves under the rover. The shadow is
+//! applied to the materials, not traced: each primitive (a tread face, a box side) and
+//! each painted marker is lit or shadowed as a whole by where its centre lies, so the
+//! shadow's edge on a tread is stepped by the 7.5° faces.
+//!
 //! Simplified: both wheels of an axle steer by the same angle (the paper's assumption, one
 //! λ per axle), so the tie rod is drawn between the arms' ends and its length is not held
 //! rigid (it lengthens by 1.1 cm, 2 %, at ±30°); the steering arms themselves are not
@@ -97,8 +104,9 @@ struct Gear {
 const WHEEL_WIDTH: f64 = crate::perception::krawler::rotation::TREAD_WIDTH_M;
 /// Steering-arm length from kingpin to tie-rod end, m (estimate).
 pub const ARM: f64 = 0.09;
-/// Markers sit this far either side of the axle's centre line, m (estimate).
-const MARKER_Y: f64 = 0.1;
+/// Markers sit this far either side of the axle's centre line, m (estimate, shared with
+/// the estimator).
+const MARKER_Y: f64 = crate::perception::krawler::rotation::PLATE_MARKER_Y_M;
 /// Tread faces per wheel: enough that the prism is the paper's cylinder to 0.2 % of the
 /// radius (with 16, points between the faces' edges sat up to 2 % inside it, and the
 /// estimator, which intersects rays with the cylinder, under-counted θ by 3 %).
@@ -167,6 +175,80 @@ pub struct KrawlerScene {
 /// [`SimError::Unsupported`] for a profile without a double-Ackermann drive, a wheel
 /// radius, a camera, or eight `[fiducial.markers]`.
 pub fn build(profile: &Profile, state: &KrawlerState) -> Result<KrawlerScene, SimError> {
+    build_with(profile, state, &GearExtras::default())
+}
+
+/// The body's shadow on the gear (seed 003 §VI's self-shadowing): a straight band across
+/// the body frame's xy plane (the shadow of a part of the body, such as a strut, under a
+/// low sun), the gear inside it darkened. Applied through the gear's materials (each
+/// primitive, and each painted marker, shaded by where its centre lies), so it falls on
+/// the robot's own parts only; the ground is not shadowed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SelfShadow {
+    /// Unit normal of the band's edges in the body's xy plane.
+    pub normal: [f64; 2],
+    /// The band's centre line's offset along the normal, m.
+    pub offset: f64,
+    /// The band's width, m: points p with |normal·p − offset| < width/2 are in shadow.
+    pub width: f64,
+    /// Light removed in the shadow (0–1).
+    pub strength: f32,
+}
+
+impl SelfShadow {
+    /// The shading factor at body point `p`: 1 lit, 1 − strength in shadow.
+    pub fn shade(&self, p: &Point3<f64>) -> f32 {
+        if (self.normal[0] * p.x + self.normal[1] * p.y - self.offset).abs() < self.width / 2.0 {
+            1.0 - self.strength
+        } else {
+            1.0
+        }
+    }
+}
+
+/// The ground under the rover, moved: the rover at `(x, y)` with `heading` (rad) on a
+/// world-fixed floor, so the floor's texture flows through the image as the rover drives.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct GroundPose {
+    /// The rover's position on the floor, m.
+    pub x: f64,
+    /// See `x`.
+    pub y: f64,
+    /// The rover's heading, rad.
+    pub heading: f64,
+}
+
+/// What a sequence's error knobs add to the gear's scene (all off by default: the scene
+/// [`build`] gives).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct GearExtras {
+    /// The body's shadow on the gear.
+    pub shadow: Option<SelfShadow>,
+    /// The camera mount's four thin plates in view (seed 003 Fig. 3).
+    pub mount_plates: bool,
+    /// A floor fixed to the world instead of to the body.
+    pub ground: Option<GroundPose>,
+}
+
+/// The camera mount's plates, m (estimates): each runs from this far from the optical
+/// axis...
+const PLATE_INNER: f64 = 0.03;
+/// ...to this far...
+const PLATE_OUTER: f64 = 0.12;
+/// ...from this far below the lens's plane up to [`PLATE_TOP_GAP`] below it (the rest of
+/// the plate, up to the body, is outside the fisheye's view), and is this thick.
+const PLATE_BELOW: f64 = 0.03;
+/// See [`PLATE_BELOW`].
+const PLATE_TOP_GAP: f64 = 0.002;
+/// See [`PLATE_BELOW`].
+const PLATE_THICK: f64 = 0.004;
+
+/// [`build`] with a sequence's `extras`: the body's shadow on the gear, the mount's
+/// plates, a floor fixed to the world.
+///
+/// # Errors
+/// As [`build`].
+pub fn build_with(profile: &Profile, state: &KrawlerState, extras: &GearExtras) -> Result<KrawlerScene, SimError> {
     let g = Gear::of(profile)?;
     let marker_albedo = paint(g.marker_color);
     let metal_albedo = albedo([90, 92, 95], 1.0);
@@ -307,11 +389,108 @@ pub fn build(profile: &Profile, state: &KrawlerState) -> Result<KrawlerScene, Si
             }
         }
     }
+    if let Some(shadow) = &extras.shadow {
+        for p in &mut prims {
+            shade_prim(p, shadow);
+        }
+    }
+    if extras.mount_plates {
+        // Four plates in the planes x = cx and y = cy through the camera's centre, a cross
+        // seen edge-on: thin slivers radiating from the image's centre.
+        let c = &profile.cameras[0].mount;
+        let (z0, z1) = (g.camera_z - PLATE_BELOW, g.camera_z - PLATE_TOP_GAP);
+        let t = PLATE_THICK / 2.0;
+        for (dx, dy) in [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)] {
+            let (a, b) = (PLATE_INNER, PLATE_OUTER);
+            let (x0, x1) = if dx > 0.0 {
+                (a, b)
+            } else if dx < 0.0 {
+                (-b, -a)
+            } else {
+                (-t, t)
+            };
+            let (y0, y1) = if dy > 0.0 {
+                (a, b)
+            } else if dy < 0.0 {
+                (-b, -a)
+            } else {
+                (-t, t)
+            };
+            prims.extend(boxed(
+                Point3::new(c.x_m + x0, c.y_m + y0, z0),
+                Point3::new(c.x_m + x1, c.y_m + y1, z1),
+                Material::Solid(albedo([70, 70, 74], 1.0)),
+                Tag::Own,
+            ));
+        }
+    }
+    let mut scene = Scene::on_floor(prims);
+    if let Some(ground) = &extras.ground {
+        // The floor as a large world-fixed sheet just above the body-fixed one, its
+        // centre and axes seen from the rover. The renderer draws front to back by
+        // centre distance, so the centre is kept far away (at world (−GROUND_AWAY, 0)),
+        // behind every part of the gear; the sheet reaches well past the rover.
+        let (s, c) = ground.heading.sin_cos();
+        let to_body = |wx: f64, wy: f64| Vector3::new(c * wx + s * wy, -s * wx + c * wy, 0.0);
+        let origin = to_body(-GROUND_AWAY - ground.x, -ground.y);
+        scene.prims.push(Prim::new(
+            Shape::Rect {
+                centre: Point3::new(origin.x, origin.y, 5e-4),
+                u: to_body(1.0, 0.0),
+                v: to_body(0.0, 1.0),
+                half: [GROUND_HALF, GROUND_HALF],
+            },
+            scene.ground.clone(),
+            Tag::Backdrop,
+        ));
+    }
     Ok(KrawlerScene {
-        scene: Scene::on_floor(prims),
+        scene,
         markers,
         correction,
     })
+}
+
+/// How far the world-fixed floor's centre is from the world's origin, m.
+const GROUND_AWAY: f64 = 100.0;
+/// Half the side of the world-fixed floor, m: it reaches 100 m past the world's origin,
+/// far beyond anything the belly camera sees over the longest sequence's path.
+const GROUND_HALF: f64 = 2.0 * GROUND_AWAY;
+
+/// `p` darkened where `shadow` falls on it: by its centre, and each painted square by its
+/// own centre (so a shadow edge between a plate's two markers hides one of them).
+fn shade_prim(p: &mut Prim, shadow: &SelfShadow) {
+    let centre = p.shape.centre();
+    let f = shadow.shade(&centre);
+    let scale = |c: [f32; 3], f: f32| c.map(|v| v * f);
+    p.material = match &p.material {
+        Material::Solid(c) => Material::Solid(scale(*c, f)),
+        Material::Noise { base, contrast, cell } => Material::Noise {
+            base: scale(*base, f),
+            contrast: *contrast,
+            cell: *cell,
+        },
+        Material::Squares { base, squares } => {
+            let frame = p.shape.plane();
+            Material::Squares {
+                base: scale(*base, f),
+                squares: squares
+                    .iter()
+                    .map(|sq| {
+                        let at = frame
+                            .as_ref()
+                            .map_or(centre, |fr| fr.origin + fr.u * f64::from(sq.a) + fr.v * f64::from(sq.b));
+                        PaintedSquare {
+                            albedo: scale(sq.albedo, shadow.shade(&at)),
+                            ..*sq
+                        }
+                    })
+                    .collect::<Vec<_>>()
+                    .into(),
+            }
+        }
+        other => other.clone(),
+    };
 }
 
 /// Where each of the eight markers of the gear in `state` projects in camera 0 of
@@ -391,4 +570,133 @@ fn transform(mut p: Prim, iso: &Isometry3<f64>) -> Prim {
         },
     };
     p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn profile() -> Profile {
+        Profile::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/autokrawler.toml")).unwrap()
+    }
+
+    fn rest() -> (Profile, KrawlerState) {
+        let p = profile();
+        let s = KrawlerState {
+            roll: [0.05, -0.03],
+            steer: [0.2, -0.1],
+            wheel: [0.3, 1.1, 2.0, 4.0],
+            ..KrawlerState::rest(&p).unwrap()
+        };
+        (p, s)
+    }
+
+    /// Every albedo a material holds (its base, then each painted square's), red channel.
+    fn reds(m: &Material) -> Vec<f32> {
+        match m {
+            Material::Solid(c) | Material::Noise { base: c, .. } => vec![c[0]],
+            Material::Squares { base, squares } => std::iter::once(base[0])
+                .chain(squares.iter().map(|s| s.albedo[0]))
+                .collect(),
+            _ => vec![],
+        }
+    }
+
+    #[test]
+    fn with_the_extras_off_the_scene_is_the_plain_one() {
+        let (p, s) = rest();
+        let a = build(&p, &s).unwrap();
+        let b = build_with(&p, &s, &GearExtras::default()).unwrap();
+        assert_eq!(format!("{:?}", a.scene), format!("{:?}", b.scene));
+        assert_eq!(a.markers, b.markers);
+    }
+
+    /// A band over the left side darkens exactly the parts (and the painted squares) whose
+    /// centres are inside it, by its strength.
+    #[test]
+    fn the_shadow_falls_on_the_gear_inside_its_band_only() {
+        let (p, s) = rest();
+        // Over y = 0.075…0.325: the left markers and the left wheels, not the right.
+        let shadow = SelfShadow {
+            normal: [0.0, 1.0],
+            offset: 0.2,
+            width: 0.25,
+            strength: 0.5,
+        };
+        let plain = build(&p, &s).unwrap();
+        let shaded = build_with(
+            &p,
+            &s,
+            &GearExtras {
+                shadow: Some(shadow),
+                ..GearExtras::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(plain.scene.prims.len(), shaded.scene.prims.len());
+        let (mut dark, mut lit) = (0, 0);
+        for (a, b) in plain.scene.prims.iter().zip(&shaded.scene.prims) {
+            let want = shadow.shade(&a.shape.centre());
+            let (ra, rb) = (reds(&a.material), reds(&b.material));
+            assert!((rb[0] - ra[0] * want).abs() < 1e-6);
+            if want < 1.0 {
+                dark += 1;
+            } else {
+                lit += 1;
+            }
+            if ra.len() == 3 {
+                // A plate or rod top: the left square (b = +MARKER_Y) is in the band, the
+                // right one is not, whatever the base.
+                assert!((rb[1] - ra[1] * 0.5).abs() < 1e-6, "left marker shadowed");
+                assert_eq!(rb[2], ra[2], "right marker lit");
+            }
+        }
+        assert!(dark > 0 && lit > dark, "{dark} dark, {lit} lit");
+    }
+
+    #[test]
+    fn the_plates_and_the_moving_ground_add_their_parts() {
+        let (p, s) = rest();
+        let plain = build(&p, &s).unwrap().scene.prims.len();
+        let plates = build_with(
+            &p,
+            &s,
+            &GearExtras {
+                mount_plates: true,
+                ..GearExtras::default()
+            },
+        )
+        .unwrap();
+        let one_box = boxed(
+            Point3::origin(),
+            Point3::new(1.0, 1.0, 1.0),
+            Material::Solid([0.5; 3]),
+            Tag::Own,
+        )
+        .len();
+        assert_eq!(plates.scene.prims.len(), plain + 4 * one_box, "four boxes");
+        let pose = GroundPose {
+            x: 1.0,
+            y: -0.5,
+            heading: std::f64::consts::FRAC_PI_2,
+        };
+        let ground = build_with(
+            &p,
+            &s,
+            &GearExtras {
+                ground: Some(pose),
+                ..GearExtras::default()
+            },
+        )
+        .unwrap();
+        let sheet = ground.scene.prims.last().unwrap();
+        // Seen from a rover at (1, −0.5) heading along the world's +y, the sheet's centre
+        // at world (−100, 0) is 0.5 m ahead and 101 m to the left, body (0.5, 101), and
+        // the world's x axis points to the body's right.
+        let Shape::Rect { centre, u, .. } = sheet.shape else {
+            panic!("a rectangle")
+        };
+        assert!((centre - Point3::new(0.5, 101.0, 5e-4)).norm() < 1e-9, "{centre}");
+        assert!((u - Vector3::new(0.0, -1.0, 0.0)).norm() < 1e-12, "{u}");
+    }
 }

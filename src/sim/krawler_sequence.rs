@@ -23,15 +23,20 @@
 //! their own (the rover lifted by hand, as in a lab).
 //!
 //! **Error sources** ([`ErrorKnobs`], all off by default): frame-rate drops, mount
-//! vibration, a marker under mud for a while, a step change in the light. Self-shadowing,
-//! the mount plates in view and ground moving under the rover are not modelled yet.
+//! vibration, a marker under mud for a while, a step change in the light (its level and
+//! its colour), the body's shadow sweeping over the gear (markers lost in it, and its
+//! edge crossing the treads), the camera mount's thin plates in view, and the floor
+//! moving under the rover (fixed to the world instead of riding with the body).
 
 use super::rng::Rng;
 use crate::config::{self, ConfigError, Validate, Validator};
 use crate::kinematics::DriveModel;
 use crate::kinematics::ackermann::DoubleAckermann;
 use crate::profile::Profile;
-use crate::sim::krawler::KrawlerState;
+use crate::sim::krawler::{KrawlerState, SelfShadow};
+use crate::sim::lighting::{Illuminant, LightState, Lighting, LightingRun};
+use crate::sim::render::CameraPose;
+use nalgebra::{Rotation3, Vector3};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -140,14 +145,101 @@ fn ten() -> f64 {
     10.0
 }
 
-/// A step change of the light level.
+/// A step change of the light: its level, and optionally its colour.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightChange {
     /// When, s.
     pub at_s: f64,
     /// The new level (1 is the starting light).
+    #[serde(default = "one")]
     pub level: f64,
+    /// The new light's colour (the starting light is neutral daylight); none keeps it.
+    #[serde(default)]
+    pub illuminant: Option<Illuminant>,
+}
+
+impl LightChange {
+    /// The light at time `t` (s): uniform neutral light of level 1 before the change,
+    /// then the new level in the new colour.
+    pub fn light_at(change: Option<&Self>, t: f64) -> LightState {
+        match change {
+            Some(l) if t >= l.at_s => match l.illuminant {
+                None => LightState::uniform(l.level as f32),
+                Some(illuminant) => {
+                    let mut state = LightState::uniform(l.level as f32);
+                    let lighting = Lighting {
+                        intensity: l.level,
+                        illuminant,
+                        ambient: 1.0,
+                        sun: 0.0,
+                        sun_dir: Vector3::z(),
+                        glare: 0.0,
+                        change_per_hour: 0.0,
+                        session_s: 0.0,
+                        flashers: Vec::new(),
+                        shadows: Vec::new(),
+                        clouds: None,
+                        self_shadow: false,
+                    };
+                    LightingRun::new(lighting, &mut Rng::new(0), 0.0).fill(t, &mut state);
+                    state
+                }
+            },
+            _ => LightState::uniform(1.0),
+        }
+    }
+}
+
+/// The body's shadow sweeping across the gear (a band, [`SelfShadow`]): its edge turned
+/// `angle_deg` from the body's x axis, crossing from the left (+y) side to the right at a
+/// steady rate over `duration_s` from `start_s`, as when the rover turns under a low sun.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SelfShadowSpec {
+    /// From, s.
+    pub start_s: f64,
+    /// For how long, s (the band crosses the whole gear, 1.4 m, in this time).
+    #[serde(default = "ten")]
+    pub duration_s: f64,
+    /// Light removed in the shadow (0–1).
+    #[serde(default = "shadow_strength")]
+    pub strength: f64,
+    /// The band's width, m.
+    #[serde(default = "shadow_width")]
+    pub width_m: f64,
+    /// The band's edges' angle from the body's x axis, degrees.
+    #[serde(default = "shadow_angle")]
+    pub angle_deg: f64,
+}
+
+fn shadow_strength() -> f64 {
+    0.7
+}
+
+fn shadow_width() -> f64 {
+    0.25
+}
+
+fn shadow_angle() -> f64 {
+    20.0
+}
+
+impl SelfShadowSpec {
+    /// The band at time `t`, s (`None` outside the knob's interval).
+    pub fn at(&self, t: f64) -> Option<SelfShadow> {
+        let f = (t - self.start_s) / self.duration_s;
+        if !(0.0..1.0).contains(&f) {
+            return None;
+        }
+        let a = self.angle_deg.to_radians();
+        Some(SelfShadow {
+            normal: [-a.sin(), a.cos()],
+            offset: 0.7 - 1.4 * f,
+            width: self.width_m,
+            strength: self.strength as f32,
+        })
+    }
 }
 
 /// The error sources the paper names, as knobs (all off by default).
@@ -166,6 +258,13 @@ pub struct ErrorKnobs {
     pub mud: Option<MudSpec>,
     /// A light change.
     pub light: Option<LightChange>,
+    /// The body's shadow sweeping over the gear.
+    pub self_shadow: Option<SelfShadowSpec>,
+    /// The camera mount's four thin plates in view.
+    pub mount_plates: bool,
+    /// The floor fixed to the world, moving under the rover as it drives (off: the
+    /// floor rides with the body, as it did before this knob).
+    pub moving_ground: bool,
 }
 
 impl ErrorKnobs {
@@ -190,7 +289,24 @@ impl ErrorKnobs {
             ));
         }
         if let Some(l) = self.light {
-            out.push(format!("light ×{} at {:.0} s", l.level, l.at_s));
+            match l.illuminant {
+                Some(i) => out.push(format!("light ×{} {i:?} at {:.0} s", l.level, l.at_s)),
+                None => out.push(format!("light ×{} at {:.0} s", l.level, l.at_s)),
+            }
+        }
+        if let Some(s) = self.self_shadow {
+            out.push(format!(
+                "self-shadow {:.0} % {:.0}–{:.0} s",
+                s.strength * 100.0,
+                s.start_s,
+                s.start_s + s.duration_s
+            ));
+        }
+        if self.mount_plates {
+            out.push("mount plates in view".into());
+        }
+        if self.moving_ground {
+            out.push("ground moving under the rover".into());
         }
         out
     }
@@ -273,6 +389,13 @@ impl Validate for SequenceSpec {
         if let Some(l) = &e.light {
             v.non_negative("errors.light.at_s", l.at_s);
             v.range("errors.light.level", l.level, 0.01, 10.0);
+        }
+        if let Some(s) = &e.self_shadow {
+            v.non_negative("errors.self_shadow.start_s", s.start_s);
+            v.positive("errors.self_shadow.duration_s", s.duration_s);
+            v.range("errors.self_shadow.strength", s.strength, 0.0, 1.0);
+            v.range("errors.self_shadow.width_m", s.width_m, 0.01, 2.0);
+            v.range("errors.self_shadow.angle_deg", s.angle_deg, -90.0, 90.0);
         }
     }
 }
@@ -526,6 +649,18 @@ pub fn generate(spec: &SequenceSpec, profile: &Profile, seed: u64) -> Result<Vec
     Ok(out)
 }
 
+/// The camera pose `base` shaken by the mount's vibration: a random small rotation about
+/// the body's axes (each SD `deg` degrees) and displacement (each SD `mm` millimetres),
+/// drawn from `rng`, independent frame to frame.
+pub fn shaken(base: &CameraPose, deg: f64, mm: f64, rng: &mut Rng) -> CameraPose {
+    let r = Vector3::new(rng.normal(), rng.normal(), rng.normal()) * deg.to_radians();
+    let d = Vector3::new(rng.normal(), rng.normal(), rng.normal()) * (mm / 1000.0);
+    CameraPose {
+        rotation: Rotation3::new(r).matrix() * base.rotation,
+        position: base.position + d,
+    }
+}
+
 /// The double-Ackermann geometry of a profile, for odometry.
 pub fn drive_of(profile: &Profile) -> Option<DoubleAckermann> {
     match profile.drive.model() {
@@ -628,6 +763,57 @@ mod tests {
             .collect();
         assert!(steps.iter().any(|d| *d > 0.005) && steps.iter().any(|d| *d < -0.005));
         assert_eq!(frames, generate(&s, &profile, 1).unwrap());
+    }
+
+    #[test]
+    fn the_shadow_sweeps_its_band_across_the_gear_while_it_lasts() {
+        let spec = SelfShadowSpec {
+            start_s: 10.0,
+            duration_s: 4.0,
+            strength: 0.7,
+            width_m: 0.25,
+            angle_deg: 0.0,
+        };
+        assert!(spec.at(9.9).is_none() && spec.at(14.0).is_none());
+        let offsets: Vec<f64> = [10.0, 12.0, 13.9].iter().map(|&t| spec.at(t).unwrap().offset).collect();
+        assert!((offsets[0] - 0.7).abs() < 1e-12 && offsets[1].abs() < 1e-12 && offsets[2] < -0.6);
+        assert_eq!(spec.at(11.0).unwrap().normal, [0.0, 1.0]);
+    }
+
+    #[test]
+    fn a_light_change_sets_level_and_colour_from_its_time() {
+        let level = LightChange {
+            at_s: 2.0,
+            level: 0.5,
+            illuminant: None,
+        };
+        assert_eq!(LightChange::light_at(Some(&level), 1.9), LightState::uniform(1.0));
+        assert_eq!(LightChange::light_at(Some(&level), 2.0), LightState::uniform(0.5));
+        assert_eq!(LightChange::light_at(None, 5.0), LightState::uniform(1.0));
+        let warm = LightChange {
+            illuminant: Some(Illuminant::Tungsten),
+            ..level
+        };
+        let e = LightChange::light_at(Some(&warm), 3.0).irradiance(&Vector3::z());
+        let want = Illuminant::Tungsten.rgb().map(|c| c * 0.5);
+        for c in 0..3 {
+            assert!((e[c] - want[c]).abs() < 1e-6, "{e:?} against {want:?}");
+        }
+        let spec = SequenceSpec::parse(
+            "name = \"t\"\nduration_s = 1\n[errors.light]\nat_s = 0.5\nilluminant = \"dusk\"\n",
+            Path::new("t.toml"),
+        )
+        .unwrap();
+        assert_eq!(spec.errors.light.unwrap().level, 1.0, "the level defaults to unchanged");
+        assert!(
+            SequenceSpec::parse(
+                "name = \"t\"\nduration_s = 1\n[errors.light]\nat_s = 0.5\nilluminant = \"green\"\n",
+                Path::new("t.toml"),
+            )
+            .unwrap_err()
+            .to_string()
+            .contains("illuminant")
+        );
     }
 
     #[test]

@@ -2,7 +2,8 @@
 //!
 //! The paper's pipeline, one stage per module: [`markers`], the perceptual step that
 //! finds the eight magenta markers (HSV segmentation, a 3×3 opening, connected
-//! components, blob centres) and gives each its identity; [`axle`], axle roll ψ and drop
+//! components, blob centres) and gives each its identity; [`mount`], the camera's own
+//! shake on its mount from the plate markers (ours, not the paper's); [`axle`], axle roll ψ and drop
 //! d from each plate-marker pair by ray-plane intersection; [`steering`], λ from the
 //! tie-rod markers' distance ratio through a calibrated polynomial; [`wheel`], the
 //! geometry and statistics of wheel rotation from tracked tread features; [`rotation`],
@@ -13,6 +14,7 @@
 
 pub mod axle;
 pub mod markers;
+pub mod mount;
 pub mod rotation;
 pub mod schema;
 pub mod steering;
@@ -20,6 +22,7 @@ pub mod wheel;
 
 pub use axle::{AxleGeometry, AxlePose};
 pub use markers::{Blob, ExpectedMarker, MarkerFinder, MarkerParams, Markers};
+pub use mount::{MountOffset, MountParams, fit_mount};
 pub use rotation::{AxleState, GearLayout, WheelParams, WheelStep, WheelTracker};
 pub use schema::{Dof, KrawlerEstimate, KrawlerParams, KrawlerStateSchema};
 pub use steering::{SteeringFit, SteeringFitError, SteeringPoly, fit_steering};

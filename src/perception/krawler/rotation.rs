@@ -65,6 +65,10 @@ pub const TREAD_WIDTH_M: f64 = 0.08;
 /// estimate; the simulator builds its axles so.
 pub const HUB_BELOW_PLATE_M: f64 = 0.021;
 
+/// How far each plate marker sits either side of its axle's centre line, m: an estimate;
+/// the simulator builds its plates so.
+pub const PLATE_MARKER_Y_M: f64 = 0.1;
+
 /// Where the wheels sit on their axle: what the paper calls the swivel joints'
 /// positions in the axle frame and the wheels' centres in the swivel frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -77,6 +81,9 @@ pub struct GearLayout {
     pub tread_half_width: f64,
     /// How far the wheels' centres sit below the plate markers' plane, m.
     pub hub_below_plate: f64,
+    /// How far each plate marker sits either side of its axle's centre line, m (what
+    /// the mount compensation measures the camera's motion against).
+    pub marker_half_spacing: f64,
 }
 
 impl GearLayout {
@@ -223,6 +230,9 @@ pub struct WheelTracker {
     tracked: Vec<Option<[f64; 2]>>,
     steps: Vec<f64>,
     wheels: [WheelMemory; 4],
+    /// The previous frame's camera mount (body_from_camera, centre): its tracks' first
+    /// ends are back-projected with it.
+    prev_mount: (Matrix3<f64>, Point3<f64>),
 }
 
 impl WheelTracker {
@@ -241,6 +251,7 @@ impl WheelTracker {
             tracked: vec![None; n],
             steps: Vec::with_capacity(n),
             wheels: [WheelMemory::default(); 4],
+            prev_mount: (Matrix3::identity(), Point3::origin()),
         }
     }
 
@@ -270,6 +281,8 @@ impl WheelTracker {
 
     /// Takes a new frame with its axles' states (front, rear): measures each wheel's step
     /// from the previous frame, adds it to θ, and applies the white marker's correction.
+    /// `geometry` is this frame's (its mount moved by the vibration compensation, if any):
+    /// the previous frame's end of each track is back-projected with the previous frame's.
     /// `draw(n)` gives an index below n from the caller's generator (RANSAC). Frames must
     /// all have the size given to [`WheelTracker::new`] (the geometry's image).
     pub fn update(
@@ -370,6 +383,7 @@ impl WheelTracker {
             memory.cylinder = Some((cyl, rot));
         }
         self.has_prev = true;
+        self.prev_mount = (geometry.body_from_camera, geometry.camera);
         out
     }
 
@@ -397,15 +411,19 @@ impl WheelTracker {
             radius: self.layout.wheel_radius,
             half_width: self.layout.tread_half_width,
         };
-        let local = |px: [f64; 2], (cyl, rot): (&WheelCylinder, &Matrix3<f64>)| {
-            let ray = geometry.body_from_camera * geometry.model.ray(px[0] + 0.5, px[1] + 0.5);
-            let p = cyl.on_tread(geometry.camera, ray)?;
+        let local = |px: [f64; 2],
+                     (cyl, rot): (&WheelCylinder, &Matrix3<f64>),
+                     (body_from_camera, camera): (&Matrix3<f64>, &Point3<f64>)| {
+            let ray = body_from_camera * geometry.model.ray(px[0] + 0.5, px[1] + 0.5);
+            let p = cyl.on_tread(*camera, ray)?;
             Some(Point3::from(rot.transpose() * (p - cyl.centre)))
         };
+        let prev_mount = (&self.prev_mount.0, &self.prev_mount.1);
+        let this_mount = (&geometry.body_from_camera, &geometry.camera);
         self.steps.clear();
         for (p, q) in self.points.iter().zip(&self.tracked[..n]) {
             let Some(q) = q else { continue };
-            if let (Some(a), Some(b)) = (local(*p, (&prev.0, &prev.1)), local(*q, next)) {
+            if let (Some(a), Some(b)) = (local(*p, (&prev.0, &prev.1), prev_mount), local(*q, next, this_mount)) {
                 self.steps.push(unit.step_angle(a, b));
             }
         }

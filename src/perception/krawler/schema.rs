@@ -6,12 +6,15 @@
 //!    last seen (at its seen size). A marker partly hidden, touching the frame's edge or
 //!    not corroborated by its axle is missing, never guessed; its prediction stays where
 //!    it was last seen.
-//! 2. **Roll ψ and drop d** of an axle from its two plate markers ([`AxleGeometry`]):
+//! 2. **Mount shake** ([`fit_mount`]): the camera's small rotation and shift on its
+//!    mount this frame, from the four plate markers (ours: the paper names mount
+//!    vibration as an error source); every later stage uses the mount so moved.
+//! 3. **Roll ψ and drop d** of an axle from its two plate markers ([`AxleGeometry`]):
 //!    valid only when both are found this frame.
-//! 3. **Steering λ** from the tie-rod markers' ratio on the roll-corrected plane and the
+//! 4. **Steering λ** from the tie-rod markers' ratio on the roll-corrected plane and the
 //!    axle's calibration ([`SteeringPoly`]): valid only when all four of the axle's
 //!    markers are found.
-//! 4. **Wheel rotations θ** ([`WheelTracker`]) on tread cylinders placed by this frame's
+//! 5. **Wheel rotations θ** ([`WheelTracker`]) on tread cylinders placed by this frame's
 //!    ψ, d and λ, or, for an axle whose markers were lost, by its last valid ones (the
 //!    paper: "flow operations are performed using the prior state of the rover"). θ
 //!    starts at 0 on the first frame; it is valid in a frame whose step was measured
@@ -26,6 +29,7 @@
 
 use super::axle::AxleGeometry;
 use super::markers::{ExpectedMarker, MarkerFinder, MarkerParams, Markers};
+use super::mount::{MountOffset, MountParams, fit_mount};
 use super::rotation::{AxleState, GearLayout, WheelParams, WheelStep, WheelTracker};
 use super::steering::SteeringPoly;
 use crate::perception::VisionError;
@@ -56,6 +60,9 @@ pub struct KrawlerEstimate {
     pub markers: Markers,
     /// Each wheel's tracking figures this frame.
     pub wheels: [WheelStep; 4],
+    /// The camera's offset from its nominal mount this frame (zero when the
+    /// compensation is off or could not be fitted).
+    pub mount: MountOffset,
 }
 
 /// The thresholds of every stage.
@@ -65,12 +72,19 @@ pub struct KrawlerParams {
     pub markers: MarkerParams,
     /// The wheel stage's.
     pub wheel: WheelParams,
+    /// The mount-vibration compensation's.
+    pub mount: MountParams,
 }
 
 /// The AutoKrawler's state estimator (seed 003); owns every buffer.
 #[derive(Debug, Clone)]
 pub struct KrawlerStateSchema {
     geometry: AxleGeometry,
+    /// `geometry` with this frame's mount offset applied (a copy made once, its mount
+    /// overwritten each frame).
+    shaken: AxleGeometry,
+    mount: MountParams,
+    half_spacing: f64,
     polys: [SteeringPoly; 2],
     finder: MarkerFinder,
     wheels: WheelTracker,
@@ -94,7 +108,10 @@ impl KrawlerStateSchema {
     ) -> Self {
         let (width, height) = size;
         Self {
+            shaken: geometry.clone(),
             geometry,
+            mount: params.mount,
+            half_spacing: layout.marker_half_spacing,
             polys,
             finder: MarkerFinder::new(width, height, params.markers),
             wheels: WheelTracker::new(width, height, layout, params.wheel),
@@ -138,11 +155,21 @@ impl KrawlerStateSchema {
             markers,
             ..KrawlerEstimate::default()
         };
+        let at = &markers.at;
+        let start = self.axles.map(|a| (a.roll, a.drop));
+        est.mount = fit_mount(
+            &self.geometry,
+            [at[0], at[1], at[4], at[5]],
+            start,
+            self.half_spacing,
+            &self.mount,
+        )
+        .unwrap_or_default();
+        est.mount.apply(&self.geometry, &mut self.shaken);
         for axle in 0..2 {
             let o = axle * 4;
-            let at = &markers.at;
             let pose = match (at[o], at[o + 1]) {
-                (Some(a1), Some(a2)) => self.geometry.axle_pose(axle, a1, a2),
+                (Some(a1), Some(a2)) => self.shaken.axle_pose(axle, a1, a2),
                 _ => None,
             };
             let held = &mut self.axles[axle];
@@ -150,7 +177,7 @@ impl KrawlerStateSchema {
                 held.roll = p.roll;
                 held.drop = p.drop;
                 if let (Some(b1), Some(b2)) = (at[o + 2], at[o + 3])
-                    && let Some(x) = self.geometry.steering_ratio(&p, [b1, b2])
+                    && let Some(x) = self.shaken.steering_ratio(&p, [b1, b2])
                 {
                     held.steer = self.polys[axle].steer(x);
                     est.steer[axle].valid = true;
@@ -166,7 +193,7 @@ impl KrawlerStateSchema {
             };
             est.steer[axle].value = held.steer;
         }
-        est.wheels = self.wheels.update(frame, &self.geometry, &self.axles, draw);
+        est.wheels = self.wheels.update(frame, &self.shaken, &self.axles, draw);
         let theta = self.wheels.theta();
         for ((dof, value), step) in est.wheel.iter_mut().zip(theta).zip(&est.wheels) {
             *dof = Dof {
