@@ -492,15 +492,11 @@ mod tests {
 
     #[test]
     fn the_margin_and_the_range_bound_every_plan() {
-        // Fig. 10's start to the axis: every check point keeps the module's centre 10°
-        // inside the 45° half view and the rover within 4 m of the module.
-        let from = Polar {
-            r: 3.9,
-            alpha: 15f64.to_radians(),
-            h: 0.0,
-        }
-        .to_pose();
-        let goal = Pose2::new(2.5, 0.0, PI);
+        // 30 cm off the axis at 3.5 m, square to it, to the axis at 1.5 m: every check
+        // point keeps the module's centre 10° inside the 45° half view and the rover
+        // within 4 m of the module.
+        let from = Pose2::new(3.5, 0.3, PI);
+        let goal = Pose2::new(1.5, 0.0, PI);
         let params = PlanParams {
             view_margin_rad: 10f64.to_radians(),
             max_range_m: 4.0,

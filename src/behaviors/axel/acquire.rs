@@ -3,8 +3,9 @@
 //! a trusted pose arrives (event `acquired`). When the module was seen before this
 //! docking lost it, the rover first recovers from its last fix, dead-reckoned by
 //! odometry ([`Memory::reckoned`]): it turns back to face where the module should be,
-//! and, beyond the marks' detection range (`view.range_m`), drives straight toward it
-//! into range; at most `recover_steps` such steps per entry. Then it sweeps toward the
+//! then backs away when nearer than `near_m` (the marks leave the view's top), or,
+//! beyond the marks' detection range (`view.range_m`), drives straight toward it into
+//! range; at most `recover_steps` such steps per entry. Then it sweeps toward the
 //! side the module was last seen on, counter-clockwise when it was never seen. After
 //! `behavior.search_timeout_s` without a trusted pose the docking fails: `target_lost`
 //! if the module was seen this docking, `target_never_detected` otherwise.
@@ -29,8 +30,12 @@ pub struct AcquireParams {
     pub trust: Trust,
     /// Recovery steps (turn back, close in) from the last fix before sweeping.
     pub recover_steps: u32,
-    /// Longest straight step toward a module beyond the detection range, m.
+    /// Longest straight step toward a module beyond the detection range, or away from
+    /// one too near, m.
     pub step_m: f64,
+    /// Nearer than this (axle to mouth) the recovery backs away first, m: the marks
+    /// leave the view's top.
+    pub near_m: f64,
     /// The detection range the recovery closes into (`range_m`; the margin is unused).
     pub view: ViewLimits,
 }
@@ -41,21 +46,34 @@ impl Default for AcquireParams {
             turn_deg: 30.0,
             cycle: CycleParams::default(),
             trust: Trust::default(),
-            recover_steps: 2,
+            recover_steps: 3,
             step_m: 1.0,
+            near_m: 1.3,
             view: ViewLimits::default(),
         }
     }
 }
 
 /// One recovery step from the dead-reckoned module-frame pose `at`: turn to face the
-/// module when it lies more than 3° off the heading, else drive straight toward it (at
-/// most `step` m) when it is beyond `range` m (to 0.3 m inside), else nothing.
-pub fn recovery(at: &Pose2, range: f64, step: f64) -> Option<Decision> {
+/// module when it lies more than 3° off the heading; else back straight away (at most
+/// `step` m, to 0.3 m beyond `near` m) when it is nearer than `near` m, where the upper
+/// marks leave the cameras' vertical view; else drive straight toward it (at most `step`
+/// m) when it is beyond `range` m (to 0.3 m inside); else nothing.
+pub fn recovery(at: &Pose2, near: f64, range: f64, step: f64) -> Option<Decision> {
     let polar = Polar::from_pose(at);
     let bearing = polar.bearing();
     if bearing.abs() > 3f64.to_radians() {
         return Some(Decision::Turn(bearing));
+    }
+    if polar.r < near {
+        let length = (near - polar.r + 0.3).min(step);
+        return Some(Decision::Arc {
+            arc: Arc {
+                curvature: 0.0,
+                length: -length,
+            },
+            from: *at,
+        });
     }
     if polar.r > range {
         let length = (polar.r - range + 0.3).min(step);
@@ -128,7 +146,7 @@ impl Behavior for Acquire {
                     if b.abs() > 1e-3 {
                         m.search_sign = b.signum();
                     }
-                    recovery(&at, p.view.range_m, p.step_m)
+                    recovery(&at, p.near_m, p.view.range_m, p.step_m)
                 });
                 match back {
                     Some(d) => {
@@ -151,13 +169,13 @@ mod tests {
     fn recovery_turns_back_then_closes_into_range() {
         // 3 m out on the axis, turned 50° away: turn back by 50° toward the module.
         let turned = Pose2::new(3.0, 0.0, PI + 50f64.to_radians());
-        match recovery(&turned, 4.0, 1.0) {
+        match recovery(&turned, 1.3, 4.0, 1.0) {
             Some(Decision::Turn(a)) => assert!((a + 50f64.to_radians()).abs() < 1e-9, "{a}"),
             d => panic!("{d:?}"),
         }
         // Facing it from 5.2 m with a 4 m range: one straight step of at most 1 m in.
         let far = Pose2::new(5.2, 0.0, PI);
-        match recovery(&far, 4.0, 1.0) {
+        match recovery(&far, 1.3, 4.0, 1.0) {
             Some(Decision::Arc { arc, from }) => {
                 assert!(arc.curvature == 0.0 && (arc.length - 1.0).abs() < 1e-9, "{arc:?}");
                 assert_eq!(from, far);
@@ -165,11 +183,16 @@ mod tests {
             d => panic!("{d:?}"),
         }
         // 4.2 m: in to 0.3 m inside the range.
-        match recovery(&Pose2::new(4.2, 0.0, PI), 4.0, 1.0) {
+        match recovery(&Pose2::new(4.2, 0.0, PI), 1.3, 4.0, 1.0) {
             Some(Decision::Arc { arc, .. }) => assert!((arc.length - 0.5).abs() < 1e-9, "{arc:?}"),
             d => panic!("{d:?}"),
         }
+        // Facing it 0.85 m out: back away to 0.3 m beyond 1.3 m.
+        match recovery(&Pose2::new(0.85, 0.0, PI), 1.3, 4.0, 1.0) {
+            Some(Decision::Arc { arc, .. }) => assert!((arc.length + 0.75).abs() < 1e-9, "{arc:?}"),
+            d => panic!("{d:?}"),
+        }
         // Facing it within range: nothing to recover, the sweep takes over.
-        assert_eq!(recovery(&Pose2::new(3.0, 0.1, PI), 4.0, 1.0), None);
+        assert_eq!(recovery(&Pose2::new(3.0, 0.1, PI), 1.3, 4.0, 1.0), None);
     }
 }
