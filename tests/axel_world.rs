@@ -148,3 +148,45 @@ fn axel_stands_outdoors_with_seven_metre_starts_inside_the_world() {
     let start = (7.0 * 40f64.to_radians().cos(), 7.0 * 40f64.to_radians().sin());
     assert!(start.0.abs().max(start.1.abs()) < 10.0);
 }
+
+/// The circle marks' detection range on the profile's cameras, measured: facing the
+/// module on its axis and 20° off it, the marks each camera detects and labels at 3 to
+/// 7 m (printed with `--nocapture`). The 10 cm marks span 2·651.9·0.05/d px across, 16 px
+/// at 4 m and 9 px at 7 m; their rim is a fifth of the radius and the bar a quarter, so
+/// past about 4 m both are under 2 px and the bar (which a mark must show to count) blurs
+/// away. Asserted: every camera labels at least 5 marks (enough for a pose) to 4 m on the
+/// axis and 3.5 m at 20°, the range the behavior's `view.range_m` plans within.
+#[test]
+fn the_marks_are_detected_to_the_range_the_behavior_plans_within() {
+    use marsupial::perception::circles::{CircleDetector, CircleModel, CircleParams, CorrespondenceParams, correspond};
+    let p = axel();
+    let w = world::build(&p, &[], &[]).expect("axel world");
+    let model = CircleModel::from_profile(&p).expect("model");
+    let mut dets: Vec<CircleDetector> = p
+        .cameras
+        .iter()
+        .map(|c| CircleDetector::new(c.width_px, c.height_px, CircleParams::for_image(c.width_px)))
+        .collect();
+    for alpha in [0.0, 20.0] {
+        for d in [3.0, 3.5, 4.0, 4.5, 5.0, 6.0, 7.0] {
+            let robot = common::axel::facing(d, alpha, 0.0);
+            let mut labelled = [0usize; 2];
+            for (cam, det) in dets.iter_mut().enumerate() {
+                let im = common::axel::render(&p, &w, cam, &robot, 7 + cam as u64);
+                let marks = det.detect(&im.view()).expect("detect");
+                labelled[cam] = correspond(&model, marks, &CorrespondenceParams::default()).map_or(0, |f| f.inliers);
+            }
+            eprintln!(
+                "{d} m, α {alpha}°: marks labelled left {}, right {}",
+                labelled[0], labelled[1]
+            );
+            let within = if alpha == 0.0 { 4.0 } else { 3.5 };
+            if d <= within {
+                assert!(
+                    labelled.iter().all(|&n| n >= 5),
+                    "{d} m, α {alpha}°: {labelled:?} marks labelled"
+                );
+            }
+        }
+    }
+}

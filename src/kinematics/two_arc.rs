@@ -172,6 +172,13 @@ pub struct PlanParams {
     pub turn_weight_m_per_rad: f64,
     /// The cameras' half field of view, rad: the module must stay within it.
     pub fov_half_angle: f64,
+    /// Margin kept inside the half field of view, rad: the module's centre must stay
+    /// this far from the view's edge, where the fish-eye compresses the marks and the
+    /// off-centre camera of the stereo pair and the module's own width lose them first.
+    pub view_margin_rad: f64,
+    /// Farthest the rover may drive from the module along a plan, m (the marks'
+    /// detection range); a start already beyond it may not drive farther out.
+    pub max_range_m: f64,
     /// Junction headings tried, evenly over the full turn; as many first-arc curvatures
     /// are tried, evenly within the limit (see [`plan`]).
     pub headings: usize,
@@ -187,6 +194,8 @@ impl Default for PlanParams {
             min_radius_m: 0.5,
             turn_weight_m_per_rad: 0.5,
             fov_half_angle: 45f64.to_radians(),
+            view_margin_rad: 0.0,
+            max_range_m: f64::INFINITY,
             headings: 720,
             allow_reverse: true,
             check_step_m: 0.05,
@@ -211,17 +220,22 @@ fn module_bearing(pose: &Pose2) -> f64 {
 }
 
 /// True when the module stays within the view along `plan` from `from`: at every check
-/// point its bearing is within the half field of view, or, where the start already had
-/// it beyond (at the edge of the view), no farther out than at the start. A rover that
-/// sees the module keeps it; one at the edge does not lose it further.
-pub fn keeps_in_view(plan: &TwoArc, from: &Pose2, fov_half_angle: f64, step_m: f64) -> bool {
-    let limit = fov_half_angle.max(module_bearing(from).abs()) + 1e-9;
+/// point its bearing is within the half field of view less the margin
+/// ([`PlanParams::view_margin_rad`]), or, where the start already had it beyond (at the
+/// edge of the view), no farther out than at the start; and the rover stays within the
+/// detection range ([`PlanParams::max_range_m`]), or no farther than the start where it
+/// began beyond. A rover that sees the module keeps it; one at the edge does not lose it
+/// further.
+pub fn keeps_in_view(plan: &TwoArc, from: &Pose2, params: &PlanParams) -> bool {
+    let limit = (params.fov_half_angle - params.view_margin_rad.max(0.0)).max(module_bearing(from).abs()) + 1e-9;
+    let range = params.max_range_m.max(from.x.hypot(from.y)) + 1e-9;
+    let step_m = params.check_step_m.max(1e-3);
     let mut p = *from;
     for arc in &plan.arcs {
-        let n = (arc.length.abs() / step_m.max(1e-3)).ceil().max(1.0) as usize;
+        let n = (arc.length.abs() / step_m).ceil().max(1.0) as usize;
         for k in 1..=n {
             let q = arc.at(&p, arc.length * k as f64 / n as f64);
-            if module_bearing(&q).abs() > limit {
+            if module_bearing(&q).abs() > limit || q.x.hypot(q.y) > range {
                 return false;
             }
         }
@@ -287,6 +301,8 @@ pub fn plan(from: &Pose2, goal: &Pose2, params: &PlanParams) -> Result<TwoArc, P
         && params.min_radius_m.is_finite()
         && params.turn_weight_m_per_rad.is_finite()
         && params.fov_half_angle.is_finite()
+        && params.view_margin_rad.is_finite()
+        && !params.max_range_m.is_nan()
         && params.check_step_m.is_finite();
     if !finite || params.headings == 0 {
         return Err(PlanError::NonFinite);
@@ -310,7 +326,7 @@ pub fn plan(from: &Pose2, goal: &Pose2, params: &PlanParams) -> Result<TwoArc, P
         if best.is_some_and(|(c, _)| c <= cost) {
             return;
         }
-        if keeps_in_view(&cand, from, params.fov_half_angle, params.check_step_m) {
+        if keeps_in_view(&cand, from, params) {
             best = Some((cost, cand));
         }
     };
@@ -437,7 +453,11 @@ mod tests {
         // An S: the two arcs turn opposite ways, and nothing reverses.
         assert!(p.arcs[0].turn() * p.arcs[1].turn() < 0.0, "{p:?}");
         assert!(p.arcs.iter().all(|a| a.length >= 0.0));
-        assert!(keeps_in_view(&p, &from, 45f64.to_radians(), 0.01));
+        let check = PlanParams {
+            check_step_m: 0.01,
+            ..PlanParams::default()
+        };
+        assert!(keeps_in_view(&p, &from, &check));
         // No longer than the straight line plus a little.
         assert!(
             p.distance() < 1.1 * from.x.hypot(from.y) - 1.5 + 0.5,
@@ -468,6 +488,67 @@ mod tests {
             plan(&Pose2::new(f64::NAN, 0.0, 0.0), &goal, &params),
             Err(PlanError::NonFinite)
         );
+    }
+
+    #[test]
+    fn the_margin_and_the_range_bound_every_plan() {
+        // 30 cm off the axis at 3.5 m, square to it, to the axis at 1.5 m: every check
+        // point keeps the module's centre 10° inside the 45° half view and the rover
+        // within 4 m of the module.
+        let from = Pose2::new(3.5, 0.3, PI);
+        let goal = Pose2::new(1.5, 0.0, PI);
+        let params = PlanParams {
+            view_margin_rad: 10f64.to_radians(),
+            max_range_m: 4.0,
+            check_step_m: 0.01,
+            ..PlanParams::default()
+        };
+        let p = plan(&from, &goal, &params).expect("a plan");
+        assert!(close(&p.end(&from), &goal), "{p:?}");
+        let mut q = from;
+        for arc in &p.arcs {
+            for k in 1..=100 {
+                let at = arc.at(&q, arc.length * f64::from(k) / 100.0);
+                assert!(module_bearing(&at).abs() <= 35f64.to_radians() + 1e-6, "{at:?}");
+                assert!(at.x.hypot(at.y) <= 4.0 + 1e-6, "{at:?}");
+            }
+            q = arc.end(&q);
+        }
+        // A reverse out of range is refused however cheap: straight back from 3.9 m to
+        // 4.5 m on the axis.
+        let ahead = Pose2::new(3.9, 0.0, PI);
+        let behind = Pose2::new(4.5, 0.0, PI);
+        assert_eq!(plan(&ahead, &behind, &params), Err(PlanError::Infeasible));
+        // Starting beyond the range, driving in is allowed, farther out is not.
+        let far = Pose2::new(5.0, 0.0, PI);
+        assert!(plan(&far, &Pose2::new(3.0, 0.0, PI), &params).is_ok());
+        assert_eq!(
+            plan(&far, &Pose2::new(5.5, 0.0, PI), &params),
+            Err(PlanError::Infeasible)
+        );
+        // Without the margin a plan may graze the view's edge; with it, the same start
+        // 40° off (beyond 35°) may not turn the module any farther out.
+        let edge = Pose2::new(3.0, 0.0, PI + 40f64.to_radians());
+        let out = TwoArc {
+            arcs: [
+                Arc {
+                    curvature: 0.5,
+                    length: 0.2,
+                },
+                Arc::default(),
+            ],
+        };
+        assert!(!keeps_in_view(&out, &edge, &params));
+        let back = TwoArc {
+            arcs: [
+                Arc {
+                    curvature: -0.5,
+                    length: 0.2,
+                },
+                Arc::default(),
+            ],
+        };
+        assert!(keeps_in_view(&back, &edge, &params));
     }
 
     proptest! {

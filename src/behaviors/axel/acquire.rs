@@ -1,14 +1,20 @@
 //! `axel.acquire`: find the module. The module may start outside the cameras' view, so
 //! the rover turns in place in steps, stopping to look after each (sense-plan-act), until
-//! a trusted pose arrives (event `acquired`). It turns toward the side the module was last
-//! seen on, counter-clockwise when it was never seen. After `behavior.search_timeout_s`
-//! without a trusted pose the docking fails: `target_lost` if the module was seen this
-//! docking, `target_never_detected` otherwise.
+//! a trusted pose arrives (event `acquired`). When the module was seen before this
+//! docking lost it, the rover first recovers from its last fix, dead-reckoned by
+//! odometry ([`Memory::reckoned`]): it turns back to face where the module should be,
+//! then backs away when nearer than `near_m` (the marks leave the view's top), or,
+//! beyond the marks' detection range (`view.range_m`), drives straight toward it into
+//! range; at most `recover_steps` such steps per entry. Then it sweeps toward the
+//! side the module was last seen on, counter-clockwise when it was never seen. After
+//! `behavior.search_timeout_s` without a trusted pose the docking fails: `target_lost`
+//! if the module was seen this docking, `target_never_detected` otherwise.
 
 use super::cycle::{Cycle, CycleParams, Decision};
-use super::memory::{Memory, Trust};
+use super::memory::{Memory, Trust, ViewLimits};
 use crate::arbiter::Blackboard;
-use crate::kinematics::two_arc::Polar;
+use crate::geometry::Pose2;
+use crate::kinematics::two_arc::{Arc, Polar};
 use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, Step};
 use serde::Deserialize;
 
@@ -22,6 +28,16 @@ pub struct AcquireParams {
     pub cycle: CycleParams,
     /// What a pose must be to count as found.
     pub trust: Trust,
+    /// Recovery steps (turn back, close in) from the last fix before sweeping.
+    pub recover_steps: u32,
+    /// Longest straight step toward a module beyond the detection range, or away from
+    /// one too near, m.
+    pub step_m: f64,
+    /// Nearer than this (axle to mouth) the recovery backs away first, m: the marks
+    /// leave the view's top.
+    pub near_m: f64,
+    /// The detection range the recovery closes into (`range_m`; the margin is unused).
+    pub view: ViewLimits,
 }
 
 impl Default for AcquireParams {
@@ -30,8 +46,43 @@ impl Default for AcquireParams {
             turn_deg: 30.0,
             cycle: CycleParams::default(),
             trust: Trust::default(),
+            recover_steps: 3,
+            step_m: 1.0,
+            near_m: 1.3,
+            view: ViewLimits::default(),
         }
     }
+}
+
+/// One recovery step from the dead-reckoned module-frame pose `at`: turn to face the
+/// module when it lies more than 3° off the heading; else back straight away (at most
+/// `step` m, to 0.3 m beyond `near` m) when it is nearer than `near` m, where the upper
+/// marks leave the cameras' vertical view; else drive straight toward it (at most `step`
+/// m) when it is beyond `range` m (to 0.3 m inside); else nothing.
+pub fn recovery(at: &Pose2, near: f64, range: f64, step: f64) -> Option<Decision> {
+    let polar = Polar::from_pose(at);
+    let bearing = polar.bearing();
+    if bearing.abs() > 3f64.to_radians() {
+        return Some(Decision::Turn(bearing));
+    }
+    if polar.r < near {
+        let length = (near - polar.r + 0.3).min(step);
+        return Some(Decision::Arc {
+            arc: Arc {
+                curvature: 0.0,
+                length: -length,
+            },
+            from: *at,
+        });
+    }
+    if polar.r > range {
+        let length = (polar.r - range + 0.3).min(step);
+        return Some(Decision::Arc {
+            arc: Arc { curvature: 0.0, length },
+            from: *at,
+        });
+    }
+    None
 }
 
 /// See the module docs.
@@ -42,6 +93,7 @@ pub struct Acquire {
     timeout_s: f64,
     cycle: Cycle,
     since: f64,
+    recovered: u32,
 }
 
 impl Acquire {
@@ -54,6 +106,7 @@ impl Acquire {
             timeout_s,
             cycle: Cycle::new(params.cycle, params.trust),
             since: 0.0,
+            recovered: 0,
         }
     }
 }
@@ -65,6 +118,7 @@ impl Behavior for Acquire {
 
     fn enter(&mut self, inputs: &Inputs<'_>) {
         self.since = inputs.now;
+        self.recovered = 0;
         self.cycle.restart(inputs.now);
     }
 
@@ -78,14 +132,67 @@ impl Behavior for Acquire {
             };
             return Some(m.hold("acquire").finishing(Outcome::Failed(why)));
         }
-        let turn = self.params.turn_deg.to_radians();
+        let p = self.params;
+        let recovered = &mut self.recovered;
         Some(self.cycle.tick(&mut m, "acquire", |m, seen| match seen {
             Some(s) => {
-                m.seen = true;
                 m.search_sign = Polar::from_pose(&s.pose).bearing().signum();
                 Decision::Event("acquired")
             }
-            None => Decision::Turn(turn * m.search_sign),
+            None => {
+                let back = m.reckoned().filter(|_| *recovered < p.recover_steps).and_then(|at| {
+                    // Sweep on toward the side the module should lie on.
+                    let b = Polar::from_pose(&at).bearing();
+                    if b.abs() > 1e-3 {
+                        m.search_sign = b.signum();
+                    }
+                    recovery(&at, p.near_m, p.view.range_m, p.step_m)
+                });
+                match back {
+                    Some(d) => {
+                        *recovered += 1;
+                        d
+                    }
+                    None => Decision::Turn(p.turn_deg.to_radians() * m.search_sign),
+                }
+            }
         }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn recovery_turns_back_then_closes_into_range() {
+        // 3 m out on the axis, turned 50° away: turn back by 50° toward the module.
+        let turned = Pose2::new(3.0, 0.0, PI + 50f64.to_radians());
+        match recovery(&turned, 1.3, 4.0, 1.0) {
+            Some(Decision::Turn(a)) => assert!((a + 50f64.to_radians()).abs() < 1e-9, "{a}"),
+            d => panic!("{d:?}"),
+        }
+        // Facing it from 5.2 m with a 4 m range: one straight step of at most 1 m in.
+        let far = Pose2::new(5.2, 0.0, PI);
+        match recovery(&far, 1.3, 4.0, 1.0) {
+            Some(Decision::Arc { arc, from }) => {
+                assert!(arc.curvature == 0.0 && (arc.length - 1.0).abs() < 1e-9, "{arc:?}");
+                assert_eq!(from, far);
+            }
+            d => panic!("{d:?}"),
+        }
+        // 4.2 m: in to 0.3 m inside the range.
+        match recovery(&Pose2::new(4.2, 0.0, PI), 1.3, 4.0, 1.0) {
+            Some(Decision::Arc { arc, .. }) => assert!((arc.length - 0.5).abs() < 1e-9, "{arc:?}"),
+            d => panic!("{d:?}"),
+        }
+        // Facing it 0.85 m out: back away to 0.3 m beyond 1.3 m.
+        match recovery(&Pose2::new(0.85, 0.0, PI), 1.3, 4.0, 1.0) {
+            Some(Decision::Arc { arc, .. }) => assert!((arc.length + 0.75).abs() < 1e-9, "{arc:?}"),
+            d => panic!("{d:?}"),
+        }
+        // Facing it within range: nothing to recover, the sweep takes over.
+        assert_eq!(recovery(&Pose2::new(3.0, 0.1, PI), 1.3, 4.0, 1.0), None);
     }
 }

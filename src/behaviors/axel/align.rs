@@ -6,16 +6,17 @@
 //! checks the alignment: the heading within `behavior.two_arc.heading_tolerance_deg`
 //! (±5°, §V-B) and the gate of `[success]` (the tip's lateral offset and the arm's angle
 //! to the cone's axis); aligned, it commits to mating (event `aligned`, the pose kept in
-//! [`Memory::commit`]). Misaligned at the look pose, past it, or with no plan within the
-//! turn limit, it reverses `reverse_m` (paying the tether out) and retries; after
+//! [`Memory::commit`]). With no plan farther out than `spiral_beyond_m` beyond the look
+//! pose it spirals in toward the axis (the approach's spiral). Misaligned at the look
+//! pose, past it, or with no plan within the turn limit closer in, it reverses `reverse_m` (paying the tether out) and retries; after
 //! `behavior.max_retries` realignments (our choice: the paper had no limit and saw one
 //! oscillation) the docking fails with `retries_exhausted`. Beyond the alignment radius
 //! (after slipping or reversing) it hands back to the approach (event `far`); with no
 //! trusted pose for `lost_looks` looks, to the acquisition (event `lost`).
 
-use super::approach::one_step;
+use super::approach::{one_step, spiral};
 use super::cycle::{Cycle, CycleParams, Decision};
-use super::memory::{Memory, Sighting, Trust};
+use super::memory::{Memory, Sighting, Trust, ViewLimits};
 use crate::arbiter::Blackboard;
 use crate::geometry::{Pose2, wrap_angle};
 use crate::kinematics::two_arc::{Arc, Polar, plan};
@@ -43,6 +44,14 @@ pub struct AlignParams {
     pub cycle: CycleParams,
     /// What a pose must be to be planned on.
     pub trust: Trust,
+    /// Where every plan must keep the module: inside the view by a margin, within the
+    /// detection range.
+    pub view: ViewLimits,
+    /// With no plan farther than this beyond the look pose, spiral in toward the axis
+    /// (the approach's [`spiral`]) rather than reverse, m.
+    pub spiral_beyond_m: f64,
+    /// The module's bearing the spiral holds, degrees.
+    pub spiral_deg: f64,
 }
 
 impl Default for AlignParams {
@@ -56,6 +65,9 @@ impl Default for AlignParams {
             lost_looks: 3,
             cycle: CycleParams::default(),
             trust: Trust::default(),
+            view: ViewLimits::default(),
+            spiral_beyond_m: 0.5,
+            spiral_deg: 30.0,
         }
     }
 }
@@ -110,16 +122,22 @@ fn decide(m: &mut Memory, p: &AlignParams, s: Sighting) -> Decision {
         m.commit = Some(s.pose);
         return Decision::Event("aligned");
     }
+    let params = p.view.plan_params(&g.plan);
     let planned = if at_look || past {
         None
     } else {
-        plan(&s.pose, &look, &g.plan).ok()
+        plan(&s.pose, &look, &params).ok()
     };
     match planned {
         Some(pl) => Decision::Arc {
             arc: one_step(&pl.arcs, p.step_m),
             from: s.pose,
         },
+        // Far from the look pose and to the side: no S keeps the view, so spiral in
+        // toward the axis first; reversing would only bring the rover back here.
+        None if !at_look && !past && polar.r > look.x + p.spiral_beyond_m => {
+            spiral(&s.pose, p.spiral_deg.to_radians(), p.step_m, &params)
+        }
         None => {
             // Reverse and realign (seed 000 §II, §V-B), a bounded number of times.
             m.retries += 1;

@@ -5,14 +5,14 @@
 //! length along it. In the alignment region it hands over (event `near`); with no trusted
 //! pose for `lost_looks` looks in a row it goes back to acquiring (event `lost`). From
 //! far to the side, where no S within the turn limit reaches the entry, it aims at the
-//! mating radius on the axis instead; when no plan keeps the module in view it turns in
-//! place to centre the module and looks again.
+//! mating radius on the axis instead; when no plan keeps the module in view it spirals in
+//! toward the axis ([`spiral`]): the module held at a fixed bearing, straight steps.
 
 use super::cycle::{Cycle, CycleParams, Decision};
-use super::memory::{Memory, Trust};
+use super::memory::{Memory, Trust, ViewLimits};
 use crate::arbiter::Blackboard;
-use crate::geometry::Pose2;
-use crate::kinematics::two_arc::{Arc, Polar, Region, TwoArc, keeps_in_view, plan};
+use crate::geometry::{Pose2, wrap_angle};
+use crate::kinematics::two_arc::{Arc, PlanParams, Polar, Region, TwoArc, keeps_in_view, plan};
 use crate::schemas::{Behavior, Inputs, Step};
 use serde::Deserialize;
 use std::f64::consts::PI;
@@ -31,6 +31,11 @@ pub struct ApproachParams {
     pub cycle: CycleParams,
     /// What a pose must be to be planned on.
     pub trust: Trust,
+    /// Where every plan must keep the module: inside the view by a margin, within the
+    /// detection range.
+    pub view: ViewLimits,
+    /// The module's bearing the spiral in toward the axis holds, degrees (see [`spiral`]).
+    pub spiral_deg: f64,
 }
 
 impl Default for ApproachParams {
@@ -41,6 +46,8 @@ impl Default for ApproachParams {
             lost_looks: 3,
             cycle: CycleParams::default(),
             trust: Trust::default(),
+            view: ViewLimits::default(),
+            spiral_deg: 30.0,
         }
     }
 }
@@ -73,6 +80,38 @@ fn toward(pose: &Pose2, x: f64, step: f64) -> Option<Arc> {
         curvature,
         length: length.min(step),
     })
+}
+
+/// One step of the spiral in toward the axis, for where no two-arc plan keeps the
+/// module in view (far to the side, close in): hold the module at bearing `spiral` on
+/// the side that carries the rover toward the axis, and drive straight. Sense-plan-act,
+/// each look one motion: turn in place until the module sits within 5° of that bearing,
+/// else a straight step, at most `step` m and no longer than keeps the module in view
+/// (`params`); with no room even for 5 cm, face the module. Holding the bearing at B
+/// sweeps α by tan B · ln(r₀/r₁) (a log spiral), so the rover reaches the axis's
+/// neighbourhood at a radius from which an S to the axis keeps the view.
+pub(super) fn spiral(pose: &Pose2, spiral: f64, step: f64, params: &PlanParams) -> Decision {
+    let polar = Polar::from_pose(pose);
+    let want = -polar.alpha.signum() * spiral.min(params.fov_half_angle - params.view_margin_rad);
+    let off = wrap_angle(polar.bearing() - want);
+    if off.abs() > 5f64.to_radians() {
+        return Decision::Turn(off);
+    }
+    let mut length = step.min(polar.r - 0.5).max(0.0);
+    while length >= 0.05 {
+        let arc = Arc { curvature: 0.0, length };
+        if keeps_in_view(
+            &TwoArc {
+                arcs: [arc, Arc::default()],
+            },
+            pose,
+            params,
+        ) {
+            return Decision::Arc { arc, from: *pose };
+        }
+        length *= 0.5;
+    }
+    Decision::Turn(polar.bearing())
 }
 
 /// See the module docs.
@@ -109,6 +148,7 @@ impl Behavior for Approach {
         let p = self.params;
         Some(self.cycle.tick_seeing(&mut m, "approach", p.lost_looks, |m, s| {
             let g = m.geometry;
+            let params = p.view.plan_params(&g.plan);
             let polar = Polar::from_pose(&s.pose);
             if matches!(g.regions.classify(&polar), Region::Alignment | Region::Mating) {
                 return Decision::Event("near");
@@ -118,7 +158,7 @@ impl Behavior for Approach {
             let entry = (g.regions.alignment_radius - p.inside_m).max(g.regions.mating_radius);
             let planned = [entry, g.regions.mating_radius]
                 .into_iter()
-                .find_map(|x| plan(&s.pose, &Pose2::new(x, 0.0, PI), &g.plan).ok());
+                .find_map(|x| plan(&s.pose, &Pose2::new(x, 0.0, PI), &params).ok());
             match planned {
                 Some(pl) => Decision::Arc {
                     arc: one_step(&pl.arcs, p.step_m),
@@ -135,13 +175,12 @@ impl Behavior for Approach {
                                 arcs: [arc, Arc::default()],
                             },
                             &s.pose,
-                            g.plan.fov_half_angle,
-                            g.plan.check_step_m,
+                            &params,
                         ) =>
                     {
                         Decision::Arc { arc, from: s.pose }
                     }
-                    _ => Decision::Turn(polar.bearing()),
+                    _ => spiral(&s.pose, p.spiral_deg.to_radians(), p.step_m, &params),
                 },
             }
         }))

@@ -8,7 +8,7 @@
 
 use super::memory::{Memory, Sighting, Trust};
 use crate::geometry::{Pose2, Twist, wrap_angle};
-use crate::kinematics::two_arc::Arc;
+use crate::kinematics::two_arc::{Arc, Polar};
 use crate::schemas::{DriveCommand, Outcome, Step};
 use serde::Deserialize;
 
@@ -126,7 +126,24 @@ impl Cycle {
                     return m.hold(phase);
                 }
                 m.looking = false;
-                match decide(m, trusted) {
+                if let Some(s) = &trusted {
+                    m.fix(s);
+                }
+                let untrusted = m.sighting.filter(|s| s.t >= since);
+                let decision = decide(m, trusted);
+                tracing::debug!(
+                    target: "marsupial::behavior",
+                    phase,
+                    t = now,
+                    pose = ?untrusted.map(|s| (s.pose.x, s.pose.y, s.pose.theta.to_degrees())),
+                    source = ?untrusted.map(|s| s.source),
+                    marks = untrusted.map_or(0, |s| s.marks),
+                    reprojection_px = untrusted.map_or(f64::NAN, |s| s.reprojection_px),
+                    trusted = trusted.is_some(),
+                    ?decision,
+                    "axel looked"
+                );
+                match decision {
                     Decision::Arc { arc, from } => self.begin_arc(m, arc, &from, phase),
                     Decision::Turn(angle) => {
                         let omega = 0.5 * m.geometry.max_turn_rate * angle.signum();
@@ -180,8 +197,9 @@ impl Cycle {
     }
 
     /// [`Cycle::tick`] for a schema that plans only on a trusted pose: `decide` gets the
-    /// sighting; a look without one looks again, and `lost_looks` of them in a row end
-    /// the state with event `lost`.
+    /// sighting; a look without one turns to recentre the module (toward the look's
+    /// untrusted pose, else the dead-reckoned last fix) when it lies more than 5° off,
+    /// and looks again; `lost_looks` of them in a row end the state with event `lost`.
     pub fn tick_seeing(
         &mut self,
         m: &mut Memory,
@@ -200,7 +218,18 @@ impl Cycle {
                 if unseen >= lost_looks {
                     Decision::Event("lost")
                 } else {
-                    Decision::Turn(0.0)
+                    // Recentre before looking again: toward this look's untrusted pose
+                    // (the module at the fish-eye's edge, seen by one camera or by too
+                    // few marks), else toward where the last fix puts it.
+                    let seen = m.sighting.filter(|s| s.t >= m.now - 3.0).map(|s| s.pose);
+                    let bearing = seen
+                        .or_else(|| m.reckoned())
+                        .map_or(0.0, |p| Polar::from_pose(&p).bearing());
+                    if bearing.abs() > 5f64.to_radians() {
+                        Decision::Turn(bearing)
+                    } else {
+                        Decision::Turn(0.0)
+                    }
                 }
             }
         });

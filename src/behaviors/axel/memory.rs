@@ -82,6 +82,47 @@ impl Trust {
     }
 }
 
+/// Where the planner must keep the module (node params `view`, ours): the paper asked
+/// only that the module stay in the field of view "as much as possible" (§IV-A-1).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ViewLimits {
+    /// The module's centre stays this far inside the cameras' half field of view,
+    /// degrees: the off-centre camera of the 35 cm pair, the module's own width and the
+    /// fish-eye's compressed edge lose marks before the centre leaves the view.
+    pub margin_deg: f64,
+    /// No plan drives farther from the module than this, m: the marks' detection range
+    /// (a plan that reversed out of it lost the module, README).
+    pub range_m: f64,
+}
+
+impl Default for ViewLimits {
+    fn default() -> Self {
+        Self {
+            margin_deg: 5.0,
+            range_m: 4.0,
+        }
+    }
+}
+
+impl ViewLimits {
+    /// `base` with these limits.
+    pub fn plan_params(&self, base: &PlanParams) -> PlanParams {
+        PlanParams {
+            view_margin_rad: self.margin_deg.to_radians(),
+            max_range_m: self.range_m,
+            ..*base
+        }
+    }
+}
+
+/// The module-frame pose now, from the module-frame pose `at` measured when odometry read
+/// `odo_then`, and odometry's `odo_now`: the motion since, in the rover's frame then,
+/// applied to the fix.
+pub fn dead_reckon(at: &Pose2, odo_then: &Pose2, odo_now: &Pose2) -> Pose2 {
+    at.compose(&odo_then.relative(odo_now))
+}
+
 /// The circle pipeline for both cameras, every buffer owned and reused.
 struct Perception {
     detectors: [CircleDetector; 2],
@@ -249,6 +290,9 @@ pub struct Memory {
     pub seen: bool,
     /// The pose the alignment committed to mating from (the penultimate look).
     pub commit: Option<Pose2>,
+    /// The last trusted sighting's module-frame pose and the odometry pose at it: where
+    /// the module is believed to be once it is lost ([`Memory::reckoned`]).
+    pub last_fix: Option<(Pose2, Pose2)>,
 }
 
 impl Memory {
@@ -276,6 +320,7 @@ impl Memory {
             search_sign: 1.0,
             seen: false,
             commit: None,
+            last_fix: None,
         })
     }
 
@@ -306,6 +351,19 @@ impl Memory {
             ..Default::default()
         });
         Step::running(out, self.feedback(phase))
+    }
+
+    /// Records a trusted sighting as the last fix, with this tick's odometry.
+    pub fn fix(&mut self, s: &Sighting) {
+        self.seen = true;
+        self.last_fix = Some((s.pose, self.odo));
+    }
+
+    /// The rover's module-frame pose now, dead-reckoned from the last fix by odometry;
+    /// `None` before any fix this docking.
+    pub fn reckoned(&self) -> Option<Pose2> {
+        let (at, odo) = self.last_fix?;
+        Some(dead_reckon(&at, &odo, &self.odo))
     }
 
     /// Feedback for `phase` with this docking's retries.
@@ -351,10 +409,32 @@ impl SharedMemory for Memory {
         self.search_sign = 1.0;
         self.seen = false;
         self.commit = None;
+        self.last_fix = None;
         Ok(())
     }
 
     fn stats(&self) -> AgentStats {
         AgentStats { manoeuvres: self.arcs }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn dead_reckoning_carries_the_odometry_motion_into_the_module_frame() {
+        // Fixed at 3 m on the axis facing the module; odometry (its own frame, turned
+        // 90°) then drives 1 m ahead and turns 30° left: 2 m out, turned 30°.
+        let at = Pose2::new(3.0, 0.0, PI);
+        let then = Pose2::new(5.0, -2.0, PI / 2.0);
+        let now = Pose2::new(5.0, -1.0, PI / 2.0 + 30f64.to_radians());
+        let p = dead_reckon(&at, &then, &now);
+        assert!((p.x - 2.0).abs() < 1e-9 && p.y.abs() < 1e-9, "{p:?}");
+        assert!(
+            (crate::geometry::wrap_angle(p.theta - PI) - 30f64.to_radians()).abs() < 1e-9,
+            "{p:?}"
+        );
     }
 }
