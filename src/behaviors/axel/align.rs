@@ -48,7 +48,7 @@ pub struct AlignParams {
     /// detection range.
     pub view: ViewLimits,
     /// With no plan farther than this beyond the look pose, spiral in toward the axis
-    /// (the approach's [`spiral`]) rather than reverse, m.
+    /// (the approach's `approach::spiral`) rather than reverse, m.
     pub spiral_beyond_m: f64,
     /// The module's bearing the spiral holds, degrees.
     pub spiral_deg: f64,

@@ -6,7 +6,7 @@
 //! pose for `lost_looks` looks in a row it goes back to acquiring (event `lost`). From
 //! far to the side, where no S within the turn limit reaches the entry, it aims at the
 //! mating radius on the axis instead; when no plan keeps the module in view it spirals in
-//! toward the axis ([`spiral`]): the module held at a fixed bearing, straight steps.
+//! toward the axis (the private `spiral`): the module held at a fixed bearing, straight steps.
 
 use super::cycle::{Cycle, CycleParams, Decision};
 use super::memory::{Memory, Trust, ViewLimits};
@@ -34,7 +34,7 @@ pub struct ApproachParams {
     /// Where every plan must keep the module: inside the view by a margin, within the
     /// detection range.
     pub view: ViewLimits,
-    /// The module's bearing the spiral in toward the axis holds, degrees (see [`spiral`]).
+    /// The module's bearing the spiral in toward the axis holds, degrees (see the module docs).
     pub spiral_deg: f64,
 }
 
