@@ -7,6 +7,7 @@
 //! arbiters), so colour adaptation
 //! follows the light whichever phase runs; the phase schemas then read the views.
 
+pub use super::motor::{ApproachMotor, lowered, raised};
 use super::params::BujoldTuning;
 use crate::behaviors::BuildError;
 use crate::behaviors::common::median::MedianWindow;
@@ -18,53 +19,9 @@ use crate::perception::two_block_pose::{FiducialView, RatioJumpGate, TwoBlockGeo
 use crate::profile::{ApproachKind, Profile};
 use crate::schemas::TwoBlockSchema;
 use crate::schemas::{
-    Auxiliary, ColourRanges, DriveCommand, Feedback, Inputs, Mission, MissionError, MotionVector, MotorOutput,
-    Observation, ObservedPercept, Percept, PerceptualSchema, Posture, PotentialField, RatioSteering, Step,
+    ColourRanges, Feedback, Inputs, Mission, MissionError, Observation, ObservedPercept, Percept, PerceptualSchema,
+    PotentialField, RatioSteering,
 };
-
-/// The approach motor schema the profile selects (`behavior.approach`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ApproachMotor {
-    /// Ratio steering: also realises the field's heading error on a turn-or-drive base.
-    pub steering: RatioSteering,
-    /// The potential field, when selected.
-    pub field: Option<PotentialField>,
-}
-
-impl ApproachMotor {
-    /// The field's desired velocity for a view, body frame (`None` without a field):
-    /// Arkin's motion vector, for a vector-sum arbiter to combine with others.
-    pub fn vector(&self, view: &FiducialView) -> Option<MotionVector> {
-        self.vector_at(&view.dock_pose())
-    }
-
-    /// The field's desired velocity for a robot at `pose` in the dock frame, body frame.
-    pub fn vector_at(&self, pose: &Pose2) -> Option<MotionVector> {
-        let dd = self.steering.geometry.drive_dir;
-        // `body_vector` is in the frame of the leading end; back to the body frame.
-        self.field.as_ref().map(|pf| pf.body_vector(pose, dd).scale(dd))
-    }
-
-    /// The approach command for a view (raised).
-    pub fn act(&self, view: &FiducialView) -> MotorOutput {
-        let out = match &self.field {
-            None => self.steering.act(view),
-            // The field gives a heading error; the ratio-steering schema realises it with
-            // the same dead band, understeer and turn-or-drive alternation.
-            Some(pf) if self.steering.restricted => {
-                let error = pf
-                    .body_vector(&view.dock_pose(), self.steering.geometry.drive_dir)
-                    .angle();
-                self.steering
-                    .steer(error, self.steering.speed_for(view.total_px as f64))
-            }
-            Some(pf) => MotorOutput::drive(DriveCommand::Twist(
-                pf.twist(&view.dock_pose(), self.steering.geometry.drive_dir),
-            )),
-        };
-        out.with_aux(raised())
-    }
-}
 
 /// A repositioning plan one phase hands the reposition phase: the staging pose in the
 /// odometry frame, and whether to drive straight out first (no room to turn by the gate).
@@ -345,31 +302,6 @@ impl Memory {
         }
     }
 
-    /// Stand still, raised.
-    pub fn hold(&self, phase: &'static str) -> Step {
-        Step::running(MotorOutput::stop().with_aux(raised()), self.feedback(phase))
-    }
-
-    /// Turn in place toward a heading error `err` (rad), raised: twice the error per
-    /// second, capped at the turn rate (the odometry manoeuvres' turns).
-    pub fn turn_by(&self, err: f64, phase: &'static str) -> Step {
-        let rate = self.approach.steering.turn_rate;
-        let omega = (2.0 * err).clamp(-rate, rate);
-        Step::running(
-            MotorOutput::drive(DriveCommand::Turn { omega }).with_aux(raised()),
-            self.feedback(phase),
-        )
-    }
-
-    /// Drive straight away from the dock (front first), raised, at `speed`.
-    pub fn drive_away(&self, speed: f64, phase: &'static str) -> Step {
-        let v = -self.geometry.drive_dir * speed;
-        Step::running(
-            MotorOutput::drive(DriveCommand::Straight { v }).with_aux(raised()),
-            self.feedback(phase),
-        )
-    }
-
     /// Distance travelled from `mark` to this tick's odometry pose, m.
     pub fn travelled(&self, mark: &Pose2) -> f64 {
         self.odo.distance(mark)
@@ -415,22 +347,6 @@ impl SharedMemory for Memory {
             }
         }
         Ok(())
-    }
-}
-
-/// Lowered posture (backing in, leaving the pouch).
-pub fn lowered() -> Auxiliary {
-    Auxiliary {
-        posture: Some(Posture::Lowered),
-        ..Auxiliary::default()
-    }
-}
-
-/// Raised posture (everywhere else).
-pub fn raised() -> Auxiliary {
-    Auxiliary {
-        posture: Some(Posture::Raised),
-        ..Auxiliary::default()
     }
 }
 

@@ -21,6 +21,7 @@ pub mod decide;
 pub mod departure;
 pub mod docking;
 pub mod memory;
+pub mod motor;
 pub mod move_away;
 pub mod params;
 pub mod reposition;
