@@ -168,20 +168,7 @@ impl LightChange {
                 None => LightState::uniform(l.level as f32),
                 Some(illuminant) => {
                     let mut state = LightState::uniform(l.level as f32);
-                    let lighting = Lighting {
-                        intensity: l.level,
-                        illuminant,
-                        ambient: 1.0,
-                        sun: 0.0,
-                        sun_dir: Vector3::z(),
-                        glare: 0.0,
-                        change_per_hour: 0.0,
-                        session_s: 0.0,
-                        flashers: Vec::new(),
-                        shadows: Vec::new(),
-                        clouds: None,
-                        self_shadow: false,
-                    };
+                    let lighting = Lighting::ambient_only(l.level, illuminant);
                     LightingRun::new(lighting, &mut Rng::new(0), 0.0).fill(t, &mut state);
                     state
                 }

@@ -208,6 +208,27 @@ pub struct Lighting {
     pub self_shadow: bool,
 }
 
+impl Lighting {
+    /// Steady ambient light alone, of `illuminant`'s colour at `intensity`: no sun, glare,
+    /// drift, beacons, shadows or clouds (the sun's direction is then unused; straight up).
+    pub fn ambient_only(intensity: f64, illuminant: Illuminant) -> Self {
+        Self {
+            intensity,
+            illuminant,
+            ambient: 1.0,
+            sun: 0.0,
+            sun_dir: Vector3::z(),
+            glare: 0.0,
+            change_per_hour: 0.0,
+            session_s: 0.0,
+            flashers: Vec::new(),
+            shadows: Vec::new(),
+            clouds: None,
+            self_shadow: false,
+        }
+    }
+}
+
 impl LightingSpec {
     /// Resolves the preset and overrides.
     pub fn resolve(&self) -> Lighting {
