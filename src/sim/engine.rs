@@ -594,6 +594,9 @@ impl Sim {
             self.past.pop_front();
         }
         self.past.push_back((self.t, self.pose));
+        // Seated in this tick: the run ends docked at its end, and nothing later in the
+        // tick (the tether still pulling, the halted rover judged again) can undo that.
+        let mut seated = false;
         for _ in 0..substeps {
             let from = self.pose;
             let mut to = self.motion.step(self.t, dt, &from, &mut self.rng);
@@ -609,7 +612,7 @@ impl Sim {
                     if noise > 0.0 && dragged > 0.0 {
                         to.theta += noise * dragged.sqrt() * self.rng.normal();
                     }
-                    if t.fouled(&to, length, width) {
+                    if !seated && t.fouled(&to, length, width) {
                         self.motion.halt();
                         let psi = super::dock::Cone::arm_angle(&to);
                         let lateral = t.attach(&to).1;
@@ -670,8 +673,10 @@ impl Sim {
                             Some((to.to_world(-length / 2.0, 0.0).1, crate::geometry::wrap_angle(to.theta)));
                     }
                     self.docked = true;
+                    seated = true;
                     self.motion.halt();
                 }
+                Contact::Stuck { .. } if seated => {}
                 Contact::Stuck { lateral, heading } => {
                     self.entrance = Some((lateral, heading));
                     self.motion.halt();
