@@ -1,6 +1,7 @@
 //! The papers' published figures, for side-by-side tables printed by `marsupial trials`.
 //! A scenario opts in with `compare = "bujold-table1"` (or `"bujold-table2"`,
-//! `"raposa-table1"`, `"raposa-range"`, `"raposa-wide"`, `"axel-field"`).
+//! `"raposa-table1"`, `"raposa-range"`, `"raposa-wide"`, `"axel-field"`,
+//! `"axel-reel-only"`).
 
 use super::campaign::{RunRecord, summarise};
 use serde::{Deserialize, Serialize};
@@ -24,10 +25,26 @@ pub enum PaperTable {
     /// boundary. Starts labelled `b…` are boundary starts (7 m, or beyond 40°), reported
     /// apart; every other start is away from the boundary (`fig10` among them).
     AxelField,
+    /// Seed 000 §V-C: pure reeling docks only for |α| < 5° and tolerates |h| < 90°.
+    /// Starts are labelled `r<m>/a<α°>/h<h°>` (α of the arm's tip about the module's axis,
+    /// h the rover's heading from it); the table has one cell per (α, h), over every
+    /// distance and terrain, beside the paper's limit.
+    AxelReelOnly,
 }
 
 /// Seed 000 §V-B: (docked, runs) overall and away from the workspace boundary.
 pub const AXEL_FIELD: [(&str, usize, usize); 2] = [("all starts", 29, 40), ("away from the boundary", 20, 24)];
+
+/// Seed 000 §V-C's limits of pure reeling, degrees: it docks for |α| below the first and
+/// tolerates |h| below the second.
+pub const AXEL_REEL_ONLY_LIMITS_DEG: (f64, f64) = (5.0, 90.0);
+
+/// (α, h) in degrees from an `axel-reel-only` start label `r<m>/a<α>/h<h>`.
+fn reel_only_cell(label: &str) -> Option<(i64, i64)> {
+    let mut parts = label.split('/');
+    let (_r, a, h) = (parts.next()?, parts.next()?, parts.next()?);
+    Some((a.strip_prefix('a')?.parse().ok()?, h.strip_prefix('h')?.parse().ok()?))
+}
 
 /// Seed 004 Table Ia: start groups and the autonomous mean time to dock, s.
 pub const BUJOLD_TABLE_1A: [(&[&str], f64); 10] = [
@@ -275,6 +292,130 @@ pub fn comparison(table: PaperTable, records: &[RunRecord]) -> String {
                 );
             }
         }
+        PaperTable::AxelReelOnly => reel_only_table(&mut s, records),
     }
     s
+}
+
+/// The `axel-reel-only` grid: docked/runs per (α, h) cell, a `*` where the paper's limits
+/// say pure reeling docks, and how many cells agree with them.
+fn reel_only_table(s: &mut String, records: &[RunRecord]) {
+    let (a_max, h_max) = AXEL_REEL_ONLY_LIMITS_DEG;
+    let cells: Vec<((i64, i64), &RunRecord)> = records
+        .iter()
+        .filter_map(|r| reel_only_cell(&r.start).map(|c| (c, r)))
+        .collect();
+    let mut alphas: Vec<i64> = cells.iter().map(|(c, _)| c.0).collect();
+    let mut headings: Vec<i64> = cells.iter().map(|(c, _)| c.1).collect();
+    for v in [&mut alphas, &mut headings] {
+        v.sort_unstable();
+        v.dedup();
+    }
+    let _ = writeln!(
+        s,
+        "versus seed 000 §V-C (pure reeling: docks for |α| < {a_max}°, tolerates |h| < {h_max}°)"
+    );
+    let _ = writeln!(
+        s,
+        "docked/runs per start cell over every distance and terrain; * where the paper's limits say it docks"
+    );
+    let _ = write!(s, "{:>8}", "α \\ h");
+    for h in &headings {
+        let _ = write!(s, " {:>8}", format!("{h}°"));
+    }
+    let _ = writeln!(s);
+    let (mut agree, mut total) = (0, 0);
+    for a in &alphas {
+        let _ = write!(s, "{:>8}", format!("{a}°"));
+        for h in &headings {
+            let rs: Vec<&RunRecord> = cells.iter().filter(|(c, _)| c == &(*a, *h)).map(|(_, r)| *r).collect();
+            if rs.is_empty() {
+                let _ = write!(s, " {:>8}", "");
+                continue;
+            }
+            let ok = rs.iter().filter(|r| r.success).count();
+            let inside = (*a as f64).abs() < a_max && (*h as f64).abs() < h_max;
+            // A cell agrees when all its runs dock inside the limits and none outside.
+            total += 1;
+            agree += usize::from(if inside { ok == rs.len() } else { ok == 0 });
+            let mark = if inside { "*" } else { " " };
+            let _ = write!(s, " {:>8}", format!("{ok}/{}{mark}", rs.len()));
+        }
+        let _ = writeln!(s);
+    }
+    let _ = writeln!(
+        s,
+        "cells agreeing with the paper's limits (all docked inside, none outside): {agree}/{total}"
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(label: &str, success: bool) -> RunRecord {
+        RunRecord {
+            index: 0,
+            start: label.into(),
+            lighting: "lab".into(),
+            segmentation: "adaptive".into(),
+            terrain: "sand".into(),
+            fiducial_colors: None,
+            trial: 0,
+            seed: 0,
+            distance_m: 2.0,
+            angle_deg: 0.0,
+            success,
+            outcome: if success { "docked" } else { "stuck_contact" }.into(),
+            time_s: 40.0,
+            path_m: 2.0,
+            v_eff_cmps: 0.0,
+            commands_per_m: 0.0,
+            entrance_lateral_m: None,
+            entrance_heading_deg: None,
+            safe_stops: 0,
+            imprinted: None,
+            manoeuvres: 0,
+            fault: None,
+            fault_as_expected: None,
+            stale_motion_ticks: None,
+            safe_stop_s: None,
+            lighting_draw: None,
+            cycle: None,
+            outing_clock_s: None,
+            odometry_error_m: None,
+            odometry_error_deg: None,
+            excursion_reached: None,
+            carried_back: None,
+            track: vec![],
+        }
+    }
+
+    #[test]
+    fn reel_only_labels_give_alpha_and_h() {
+        assert_eq!(reel_only_cell("r4/a-7/h120"), Some((-7, 120)));
+        assert_eq!(reel_only_cell("r2/a0/h0"), Some((0, 0)));
+        for bad in ["fig10", "r4/a-7", "r4/x3/h0", "r4/a3/hx", ""] {
+            assert_eq!(reel_only_cell(bad), None, "{bad}");
+        }
+    }
+
+    #[test]
+    fn the_reel_only_table_counts_cells_against_the_paper_limits() {
+        let records = [
+            run("r2/a0/h0", true),     // inside, docked: agrees
+            run("r4/a0/h0", true),     // same cell
+            run("r2/a3/h120", false),  // outside (h), failed: agrees
+            run("r2/a7/h0", true),     // outside (α), docked: disagrees
+            run("r2/a-3/h-80", false), // inside, failed: disagrees
+            run("fig10", true),        // not a grid start: left out
+        ];
+        let t = comparison(PaperTable::AxelReelOnly, &records);
+        assert!(t.contains("2/2*"), "{t}");
+        assert!(t.contains("0/1*"), "{t}");
+        assert!(
+            t.contains("cells agreeing with the paper's limits (all docked inside, none outside): 2/4"),
+            "{t}"
+        );
+    }
 }

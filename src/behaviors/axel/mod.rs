@@ -25,6 +25,7 @@ pub mod approach;
 pub mod cycle;
 pub mod mate;
 pub mod memory;
+pub mod reel;
 pub mod stall;
 
 use super::agent::BuildError;
@@ -35,7 +36,8 @@ use crate::profile::Profile;
 pub use memory::Memory;
 
 /// Registers Axel's schemas (`axel.acquire`, `axel.approach`, `axel.align`, `axel.mate`,
-/// `axel.stall`) in `registry`; each takes its tuning from its node's `params`.
+/// `axel.stall`, and `axel.reel`, the paper's pure-reeling baseline) in `registry`; each
+/// takes its tuning from its node's `params`.
 pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
     registry
         .register("axel.acquire", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
@@ -57,6 +59,10 @@ pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
         })
         .register("axel.stall", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
             Ok(Box::new(stall::Stall::new(a.node, m.clone(), a.params()?)))
+        })
+        .register("axel.reel", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+            a.no_params()?;
+            Ok(Box::new(reel::Reel::new(a.node, m.clone())))
         });
 }
 

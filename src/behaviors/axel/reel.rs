@@ -1,0 +1,46 @@
+//! `axel.reel`: pure reeling, the paper's no-vision baseline (seed 000 §V-C) as a leaf.
+//! The wheels go to free rotation and the reel winds in at its top rate from the first
+//! tick; no camera is read and nothing is planned. Whether the arm finds the cone is the
+//! tether's and the cone's physics (`sim::tether`, `sim::dock::Cone`), so the paper's two
+//! limits (docks for |α| < 5°, tolerates |h| < 90°) must come out of the simulator, not
+//! out of this leaf. It never finishes by itself: the judge ends the run when the arm
+//! seats, and a reel pulling against a caught arm is the `axel.stall` leaf's to end
+//! (`stuck_contact`), as on the paper's robot, which had no other way to know.
+//!
+//! `scenarios/axel-reel-only.toml` runs it from a grid over α and h;
+//! `tests/axel_reel.rs` checks the same limits through the engine alone.
+
+use super::memory::Memory;
+use crate::arbiter::Blackboard;
+use crate::schemas::{Auxiliary, Behavior, Inputs, MotorOutput, Step, TetherCommand};
+
+/// See the module docs.
+pub struct Reel {
+    name: String,
+    mem: Blackboard<Memory>,
+}
+
+impl Reel {
+    /// A leaf named `name`.
+    pub fn new(name: &str, mem: Blackboard<Memory>) -> Self {
+        Self { name: name.into(), mem }
+    }
+}
+
+impl Behavior for Reel {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
+        let m = self.mem.lock();
+        let out = MotorOutput::stop().with_aux(Auxiliary {
+            tether: Some(TetherCommand {
+                reel_rate: m.geometry.max_reel_rate,
+                free_wheel: true,
+            }),
+            ..Default::default()
+        });
+        Some(Step::running(out, m.feedback("reel")))
+    }
+}
