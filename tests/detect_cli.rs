@@ -488,3 +488,85 @@ fn circles_bad_inputs_give_clear_errors() {
             .contains("has no [fiducial.two_block] or [fiducial.circles]")
     );
 }
+
+#[test]
+fn circles_stereo_pairs_give_a_stereo_pose_beside_each_mono_one() {
+    // Two pairs rendered from known poses; a third pair with camera 1's marks painted
+    // over: its stereo line says why there is no pose.
+    let poses = [facing(1.5, 10.0, 3.0), facing(2.5, -15.0, -4.0)];
+    let mut files = Vec::new();
+    for (k, robot) in poses.iter().enumerate() {
+        for cam in 0..2 {
+            let (im, _) = render_axel(cam, robot, 60 + 2 * k as u64 + cam as u64);
+            let f = tmp(&format!("axel-stereo-{k}-{cam}.png"));
+            save(&im, &f);
+            files.push(f);
+        }
+    }
+    let (mut hidden, truth) = render_axel(1, &poses[0], 61);
+    for c in &truth {
+        let (x0, y0) = (c[0] as usize - 40, c[1] as usize - 40);
+        common::rect(&mut hidden, x0, y0, x0 + 80, y0 + 80, [128, 128, 128]);
+    }
+    let hidden_file = tmp("axel-stereo-hidden.png");
+    save(&hidden, &hidden_file);
+    let args: Vec<&Path> = vec![&files[0], &files[1], &files[2], &files[3], &files[0], &hidden_file];
+    let v = json_lines(&detect_axel(&["--json", "--stereo", "--repeat", "2"], &args));
+    assert_eq!(v.len(), 9, "two records and a stereo line per pair");
+    for (k, robot) in poses.iter().enumerate() {
+        let (left, right, stereo) = (&v[3 * k], &v[3 * k + 1], &v[3 * k + 2]);
+        assert_eq!((left["camera"].clone(), right["camera"].clone()), (0.into(), 1.into()));
+        assert_eq!(left["pose"]["source"], "mono", "{left}");
+        assert_eq!(stereo["stereo"][0], files[2 * k].display().to_string());
+        assert_eq!(stereo["stereo"][1], files[2 * k + 1].display().to_string());
+        assert!(stereo["pose_error"].is_null(), "{stereo}");
+        let pose = &stereo["pose"];
+        assert_eq!(pose["source"], "stereo");
+        assert_eq!(pose["marks_used"], 8, "{stereo}");
+        let rim = pose["rover_in_module"].as_array().unwrap();
+        let (x, y, h) = (
+            rim[0].as_f64().unwrap(),
+            rim[1].as_f64().unwrap(),
+            rim[2].as_f64().unwrap(),
+        );
+        // The paper's stereo error: 2.56 cm / 2.5° at 1 m, 4.12 cm / 4.58° at 2 m.
+        let e = (x - robot.x).hypot(y - robot.y);
+        let eh = wrap_deg(h - robot.theta.to_degrees()).abs();
+        assert!(
+            e < 0.025 && eh < 1.0,
+            "pair {k}: rover {e:.4} m, {eh:.2}° off the truth: {stereo}"
+        );
+        assert!(stereo["us_per_pair"].as_f64().unwrap() > 0.0);
+    }
+    let failed = &v[8];
+    assert!(failed["pose"].is_null(), "{failed}");
+    let why = failed["pose_error"].as_str().unwrap();
+    assert!(why.starts_with("camera 1: "), "{why}");
+    // Text output: one stereo line per pair.
+    let out = detect_axel(&["--stereo"], &[&files[0], &files[1]]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains(" + ") && text.contains("stereo module at"), "{text}");
+}
+
+#[test]
+fn stereo_misuse_gives_clear_errors() {
+    let f = tmp("axel-stereo-misuse.png");
+    save(&render_axel(0, &facing(2.0, 0.0, 0.0), 5).0, &f);
+    let err = |args: &[&str], images: &[&Path], profile: &Path| {
+        let out = detect_with(profile, args, images);
+        assert!(!out.status.success());
+        String::from_utf8(out.stderr).unwrap()
+    };
+    let e = err(&["--stereo"], &[&f], &axel_profile());
+    assert!(
+        e.contains("--stereo takes the images in pairs") && e.contains("1 given"),
+        "{e}"
+    );
+    let e = err(&["--stereo", "--camera", "1"], &[&f, &f], &axel_profile());
+    assert!(e.contains("leave out --camera"), "{e}");
+    let e = err(&["--stereo"], &[&f, &f], &profile());
+    assert!(
+        e.contains("--stereo applies to [fiducial.circles] profiles only"),
+        "{e}"
+    );
+}

@@ -1,7 +1,8 @@
 //! `marsupial detect`: run a profile's fiducial detection over image files. A
 //! `[fiducial.two_block]` profile runs the two-block perceptual schema as a stream
 //! (adaptation carries from image to image); a `[fiducial.circles]` profile runs Axel's
-//! circle-mark detection, correspondence and monocular pose on each image independently
+//! circle-mark detection, correspondence and monocular pose on each image independently,
+//! and with `--stereo` the stereo pose of each pair of images from cameras 0 and 1
 //! ([`run`] dispatches on the profile).
 
 use crate::config::ConfigError;
@@ -9,6 +10,7 @@ use crate::image_io::{ImageFileError, load_rgb, save_png};
 use crate::perception::circles::{
     CircleDetector, CircleModel, CircleParams, CorrespondenceError, CorrespondenceParams, DetectedMark,
     MarkObservations, ModelFit, ModulePose, PoseBuffers, PoseError, PoseParams, RigCamera, correspond, mono_pose,
+    stereo_pose,
 };
 use crate::perception::overlay::{CirclesDrawing, paint_circles_overlay, paint_overlay};
 use crate::perception::{RgbImage, TwoBlockPercept, VisionError};
@@ -53,6 +55,12 @@ pub struct DetectOptions {
     /// two-block only).
     #[arg(long, value_name = "S")]
     pub interval: Option<f64>,
+    /// Circles with two cameras: take the images in pairs (camera 0's, then camera 1's,
+    /// taken together) and after each pair's two records print a third with the stereo
+    /// pose (the marks labelled in both images triangulated, then the model fitted to
+    /// them). Not with `--camera`.
+    #[arg(long)]
+    pub stereo: bool,
     /// Images, in stream order.
     #[arg(required = true, value_name = "IMAGE")]
     pub images: Vec<PathBuf>,
@@ -163,6 +171,12 @@ pub fn run(opts: &DetectOptions, out: &mut dyn Write) -> Result<(), DetectError>
     if profile.fiducial.two_block.is_none() {
         return Err(DetectError::NoFiducial(profile.name.clone()));
     }
+    if opts.stereo {
+        return Err(DetectError::Usage(format!(
+            "--stereo applies to [fiducial.circles] profiles only; `{}` has [fiducial.two_block]",
+            profile.name
+        )));
+    }
     let mut schema = TwoBlockSchema::from_profile(&profile, opts.camera)?;
     let interval = match opts.interval {
         Some(i) if i.is_finite() && i >= 0.0 => i,
@@ -265,13 +279,13 @@ pub struct UnlabelledMarkRecord {
 }
 
 /// The module's pose in a circles record: the monocular pose through the camera's lens
-/// model, in the rover frame (+x forward, +y left, +z up, origin on the ground under the
-/// rover's reference point).
+/// model, or the stereo pose of a pair, in the rover frame (+x forward, +y left, +z up,
+/// origin on the ground under the rover's reference point).
 #[derive(Debug, Clone, Serialize)]
 pub struct CirclePoseRecord {
-    /// `mono` (one image, one camera).
+    /// `mono` (one image, one camera) or `stereo` (a pair, cameras 0 and 1).
     pub source: &'static str,
-    /// The camera it was measured through.
+    /// The camera it was measured through (for `stereo`, 0: the pair's first).
     pub camera: usize,
     /// The module frame's origin (its face centre on the ground) in the rover frame, m.
     pub position_m: [f64; 3],
@@ -282,7 +296,7 @@ pub struct CirclePoseRecord {
     /// frame: what the polar planner uses.
     pub rover_in_module: [f64; 3],
     /// Quality figure: RMS distance between the detected centres and the posed model's
-    /// marks projected through the camera, px.
+    /// marks projected through the camera (for `stereo`, through both), px.
     pub reprojection_px: f64,
     /// Quality figure: RMS distance between the posed model's marks and the rays
     /// through their detections, m.
@@ -329,6 +343,21 @@ pub struct CirclesRecord<'a> {
     pub us_per_frame: f64,
 }
 
+/// One `--stereo` line of `--json` output: the stereo pose of a pair of images.
+#[derive(Debug, Clone, Serialize)]
+pub struct StereoRecord<'a> {
+    /// The pair's images as given: camera 0's, camera 1's.
+    pub stereo: [&'a str; 2],
+    /// The module's pose from both images (`source` = `stereo`), or null.
+    pub pose: Option<CirclePoseRecord>,
+    /// Why there is no stereo pose (null when there is one): a camera found no
+    /// labelling, or too few marks were labelled in both.
+    pub pose_error: Option<String>,
+    /// Median wall time of both images' detection and correspondence and the stereo
+    /// pose, µs.
+    pub us_per_pair: f64,
+}
+
 /// The circles pipeline for one camera, every buffer owned and reused.
 struct CirclesRun {
     detector: CircleDetector,
@@ -348,6 +377,20 @@ struct CirclesOutcome {
 }
 
 impl CirclesRun {
+    fn new(profile: &Profile, camera: usize) -> Result<Self, DetectError> {
+        let spec = &profile.cameras[camera];
+        Ok(Self {
+            detector: CircleDetector::new(spec.width_px, spec.height_px, CircleParams::for_image(spec.width_px)),
+            model: CircleModel::from_profile(profile)?,
+            cam: RigCamera::from_profile(profile, camera)?,
+            camera,
+            cam_size: (spec.width_px, spec.height_px),
+            corr: CorrespondenceParams::default(),
+            pose_params: PoseParams::default(),
+            buf: PoseBuffers::new(),
+        })
+    }
+
     fn process(&mut self, im: &RgbImage) -> Result<CirclesOutcome, VisionError> {
         if self.detector.size() != (im.width(), im.height()) {
             self.detector = CircleDetector::new(im.width(), im.height(), CircleParams::for_image(im.width()));
@@ -398,17 +441,10 @@ fn run_circles(opts: &DetectOptions, profile: &Profile, out: &mut dyn Write) -> 
             )));
         }
     }
-    let spec = &profile.cameras[opts.camera];
-    let mut run = CirclesRun {
-        detector: CircleDetector::new(spec.width_px, spec.height_px, CircleParams::for_image(spec.width_px)),
-        model: CircleModel::from_profile(profile)?,
-        cam: RigCamera::from_profile(profile, opts.camera)?,
-        camera: opts.camera,
-        cam_size: (spec.width_px, spec.height_px),
-        corr: CorrespondenceParams::default(),
-        pose_params: PoseParams::default(),
-        buf: PoseBuffers::new(),
-    };
+    if opts.stereo {
+        return run_circles_stereo(opts, profile, out);
+    }
+    let mut run = CirclesRun::new(profile, opts.camera)?;
     let images: Vec<RgbImage> = opts.images.iter().map(|p| load_rgb(p)).collect::<Result<_, _>>()?;
     let mut overlay = RgbImage::default();
     let mut times = Vec::with_capacity(opts.repeat);
@@ -421,24 +457,132 @@ fn run_circles(opts: &DetectOptions, profile: &Profile, out: &mut dyn Write) -> 
             times.push(start.elapsed().as_secs_f64() * 1e6);
             outcome = Some(o);
         }
-        times.sort_by(f64::total_cmp);
-        let us = times[times.len() / 2];
         let Some(o) = outcome else { continue };
         let name = path.display().to_string();
-        let rec = circles_record(&name, im, &run, &o, us);
+        let rec = circles_record(&name, im, &run, &o, median(&mut times));
         write_circles(out, &rec, opts.json)?;
         if let Some(base) = &opts.overlay {
-            let pose = o.pose.as_ref().and_then(|p| p.as_ref().ok()).map(|p| (p, &run.cam));
-            let drawing = CirclesDrawing {
-                marks: run.detector.marks(),
-                model: &run.model,
-                fit: o.fit.as_ref().ok(),
-                pose,
-            };
-            paint_circles_overlay(&im.view(), &drawing, &mut overlay);
-            save_png(&overlay_path(base, k, opts.images.len()), &overlay)?;
+            draw_circles(&run, &o, im, &mut overlay, &overlay_path(base, k, opts.images.len()))?;
         }
     }
+    Ok(())
+}
+
+/// `--stereo`: the images in pairs, camera 0's then camera 1's; each image's record as
+/// without `--stereo`, then the pair's stereo pose.
+fn run_circles_stereo(opts: &DetectOptions, profile: &Profile, out: &mut dyn Write) -> Result<(), DetectError> {
+    if profile.cameras.len() < 2 {
+        return Err(DetectError::Usage(format!(
+            "--stereo needs two cameras; profile `{}` has {}",
+            profile.name,
+            profile.cameras.len()
+        )));
+    }
+    if opts.camera != 0 {
+        return Err(DetectError::Usage(
+            "--stereo takes the images as pairs from cameras 0 and 1: leave out --camera".into(),
+        ));
+    }
+    if !opts.images.len().is_multiple_of(2) {
+        return Err(DetectError::Usage(format!(
+            "--stereo takes the images in pairs (camera 0's, then camera 1's); {} given",
+            opts.images.len()
+        )));
+    }
+    let mut runs = [CirclesRun::new(profile, 0)?, CirclesRun::new(profile, 1)?];
+    let images: Vec<RgbImage> = opts.images.iter().map(|p| load_rgb(p)).collect::<Result<_, _>>()?;
+    let mut overlay = RgbImage::default();
+    let (mut times, mut pair_times) = ([Vec::new(), Vec::new()], Vec::new());
+    for (pair, (paths, ims)) in opts.images.chunks(2).zip(images.chunks(2)).enumerate() {
+        let mut last = None;
+        times.iter_mut().for_each(Vec::clear);
+        pair_times.clear();
+        for _ in 0..opts.repeat {
+            let started = Instant::now();
+            let mut outcomes = Vec::with_capacity(2);
+            for (c, run) in runs.iter_mut().enumerate() {
+                let t = Instant::now();
+                outcomes.push(run.process(&ims[c])?);
+                times[c].push(t.elapsed().as_secs_f64() * 1e6);
+            }
+            let stereo = stereo_of(&mut runs, &outcomes, [&ims[0], &ims[1]]);
+            pair_times.push(started.elapsed().as_secs_f64() * 1e6);
+            last = Some((outcomes, stereo));
+        }
+        let Some((outcomes, stereo)) = last else { continue };
+        let names = [paths[0].display().to_string(), paths[1].display().to_string()];
+        for c in 0..2 {
+            let rec = circles_record(&names[c], &ims[c], &runs[c], &outcomes[c], median(&mut times[c]));
+            write_circles(out, &rec, opts.json)?;
+            if let Some(base) = &opts.overlay {
+                let path = overlay_path(base, 2 * pair + c, opts.images.len());
+                draw_circles(&runs[c], &outcomes[c], &ims[c], &mut overlay, &path)?;
+            }
+        }
+        let rec = StereoRecord {
+            stereo: [&names[0], &names[1]],
+            pose: stereo.as_ref().ok().map(|p| pose_record(p, "stereo", 0)),
+            pose_error: stereo.err(),
+            us_per_pair: round(median(&mut pair_times), 1),
+        };
+        write_stereo(out, &rec, opts.json)?;
+    }
+    Ok(())
+}
+
+/// The stereo pose from both cameras' labellings, or why there is none.
+fn stereo_of(
+    runs: &mut [CirclesRun; 2],
+    outcomes: &[CirclesOutcome],
+    ims: [&RgbImage; 2],
+) -> Result<ModulePose, String> {
+    let mut obs = [MarkObservations::new(runs[0].model.len()); 2];
+    for c in 0..2 {
+        let fit = outcomes[c].fit.as_ref().map_err(|e| format!("camera {c}: {e}"))?;
+        if (ims[c].width(), ims[c].height()) != runs[c].cam_size {
+            return Err(format!(
+                "camera {c}'s image is {}×{} px but the camera is {}×{}",
+                ims[c].width(),
+                ims[c].height(),
+                runs[c].cam_size.0,
+                runs[c].cam_size.1
+            ));
+        }
+        obs[c] = MarkObservations::from_fit(fit, runs[c].detector.marks());
+    }
+    let [r0, r1] = runs;
+    stereo_pose(
+        &r0.model,
+        [&r0.cam, &r1.cam],
+        [&obs[0], &obs[1]],
+        &r0.pose_params,
+        &mut r0.buf,
+    )
+    .map_err(|e: PoseError| e.to_string())
+}
+
+/// The median of `times` (sorted in place); 0 when empty.
+fn median(times: &mut [f64]) -> f64 {
+    times.sort_by(f64::total_cmp);
+    times.get(times.len() / 2).copied().unwrap_or(0.0)
+}
+
+fn draw_circles(
+    run: &CirclesRun,
+    o: &CirclesOutcome,
+    im: &RgbImage,
+    overlay: &mut RgbImage,
+    path: &Path,
+) -> Result<(), DetectError> {
+    let pose = o.pose.as_ref().and_then(|p| p.as_ref().ok()).map(|p| (p, &run.cam));
+    let drawing = CirclesDrawing {
+        marks: run.detector.marks(),
+        model: &run.model,
+        fit: o.fit.as_ref().ok(),
+        pose,
+    };
+    paint_circles_overlay(&im.view(), &drawing, overlay);
+    save_png(path, overlay)?;
     Ok(())
 }
 
@@ -493,24 +637,26 @@ fn circles_record<'a>(
     rec.reprojection_px = Some(round(fit.rms_px, 3));
     rec.inliers = Some(fit.inliers);
     match &o.pose {
-        Some(Ok(p)) => {
-            let t = p.translation;
-            let r = p.rover_in_module();
-            rec.pose = Some(CirclePoseRecord {
-                source: "mono",
-                camera: run.camera,
-                position_m: [round(t.x, 4), round(t.y, 4), round(t.z, 4)],
-                heading_deg: round(p.heading().to_degrees(), 2),
-                rover_in_module: [round(r[0], 4), round(r[1], 4), round(r[2].to_degrees(), 2)],
-                reprojection_px: round(p.reprojection_px, 3),
-                rms_residual_m: round(p.rms_residual_m, 5),
-                marks_used: p.marks_used,
-            });
-        }
+        Some(Ok(p)) => rec.pose = Some(pose_record(p, "mono", run.camera)),
         Some(Err(e)) => rec.pose_error = Some(e.clone()),
         None => {}
     }
     rec
+}
+
+fn pose_record(p: &ModulePose, source: &'static str, camera: usize) -> CirclePoseRecord {
+    let t = p.translation;
+    let r = p.rover_in_module();
+    CirclePoseRecord {
+        source,
+        camera,
+        position_m: [round(t.x, 4), round(t.y, 4), round(t.z, 4)],
+        heading_deg: round(p.heading().to_degrees(), 2),
+        rover_in_module: [round(r[0], 4), round(r[1], 4), round(r[2].to_degrees(), 2)],
+        reprojection_px: round(p.reprojection_px, 3),
+        rms_residual_m: round(p.rms_residual_m, 5),
+        marks_used: p.marks_used,
+    }
 }
 
 fn write_circles(out: &mut dyn Write, rec: &CirclesRecord<'_>, json: bool) -> Result<(), DetectError> {
@@ -549,5 +695,34 @@ fn write_circles(out: &mut dyn Write, rec: &CirclesRecord<'_>, json: bool) -> Re
         return Ok(());
     };
     writeln!(out, "{image}: not found: {reason}  {:.1} µs", rec.us_per_frame)?;
+    Ok(())
+}
+
+fn write_stereo(out: &mut dyn Write, rec: &StereoRecord<'_>, json: bool) -> Result<(), DetectError> {
+    if json {
+        writeln!(out, "{}", serde_json::to_string(rec).map_err(std::io::Error::other)?)?;
+        return Ok(());
+    }
+    let [left, right] = rec.stereo;
+    match (&rec.pose, &rec.pose_error) {
+        (Some(p), _) => writeln!(
+            out,
+            "{left} + {right}: stereo module at ({:.3}, {:.3}, {:.3}) m heading {:.1}° [{:.2} px, {:.4} m, {} marks]  {:.1} µs",
+            p.position_m[0],
+            p.position_m[1],
+            p.position_m[2],
+            p.heading_deg,
+            p.reprojection_px,
+            p.rms_residual_m,
+            p.marks_used,
+            rec.us_per_pair
+        )?,
+        (None, e) => writeln!(
+            out,
+            "{left} + {right}: no stereo pose: {}  {:.1} µs",
+            e.as_deref().unwrap_or("unknown"),
+            rec.us_per_pair
+        )?,
+    }
     Ok(())
 }
