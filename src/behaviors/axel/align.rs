@@ -8,7 +8,8 @@
 //! to the cone's axis); aligned, it commits to mating (event `aligned`, the pose kept in
 //! [`Memory::commit`]). With no plan farther out than `spiral_beyond_m` beyond the look
 //! pose it spirals in toward the axis (the approach's spiral). Misaligned at the look
-//! pose, past it, or with no plan within the turn limit closer in, it reverses `reverse_m` (paying the tether out) and retries; after
+//! pose, past it (also when only an untrusted pose says so: nearer than the look pose one
+//! camera loses the marks), or with no plan within the turn limit closer in, it reverses `reverse_m` (paying the tether out) and retries; after
 //! `behavior.max_retries` realignments (our choice: the paper had no limit and saw one
 //! oscillation) the docking fails with `retries_exhausted`. Beyond the alignment radius
 //! (after slipping or reversing) it hands back to the approach (event `far`); with no
@@ -155,6 +156,31 @@ fn decide(m: &mut Memory, p: &AlignParams, s: Sighting) -> Decision {
     }
 }
 
+/// A centred look whose pose is untrusted (one camera lost the marks, or too few were
+/// matched in both) while that pose puts the rover past the look pose: nearer than
+/// the look pose, the module leaves one camera's view, so looking again from here
+/// never gives the stereo pose the commitment needs. Reverse and realign, as `decide`
+/// does past the look pose (a bounded retry). Replayed: axel-field run 22 (i11, loose
+/// sand) stood 12 cm past the look pose, square to the axis, seen by camera 1 only, and
+/// went align → acquire → approach → align for 600 s.
+fn past_unseen(m: &mut Memory, p: &AlignParams, s: Sighting) -> Option<Decision> {
+    let look_x = m.geometry.tether.arm + p.look_m;
+    if s.pose.x >= look_x - p.arrive_m {
+        return None;
+    }
+    m.retries += 1;
+    if m.retries > m.geometry.max_retries {
+        return Some(Decision::Done(Outcome::Failed(FailureReason::RetriesExhausted)));
+    }
+    Some(Decision::Arc {
+        arc: Arc {
+            curvature: 0.0,
+            length: -p.reverse_m,
+        },
+        from: s.pose,
+    })
+}
+
 impl Behavior for Align {
     fn name(&self) -> &str {
         &self.name
@@ -167,10 +193,13 @@ impl Behavior for Align {
     fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
         let mut m = self.mem.lock();
         let p = self.params;
-        Some(
-            self.cycle
-                .tick_seeing(&mut m, "align", p.lost_looks, |m, s| decide(m, &p, s)),
-        )
+        Some(self.cycle.tick_seeing(
+            &mut m,
+            "align",
+            p.lost_looks,
+            |m, s| decide(m, &p, s),
+            |m, s| past_unseen(m, &p, s),
+        ))
     }
 }
 
@@ -193,5 +222,37 @@ mod tests {
         // 3° off, axle 4 cm aside, tip pointing back at the axis: within.
         let converging = Pose2::new(1.05, 0.04, PI + 3f64.to_radians());
         assert!(aligned(&converging, arm, d5, 0.05, d5));
+    }
+
+    #[test]
+    fn an_untrusted_pose_past_the_look_pose_reverses_and_counts_a_retry() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/profiles/axel.toml");
+        let profile = crate::profile::Profile::load(std::path::Path::new(path)).expect("axel profile");
+        let mut m = Memory::from_profile(&profile).expect("memory");
+        let p = AlignParams::default();
+        let look_x = m.geometry.tether.arm + p.look_m;
+        let sighting = |x: f64| Sighting {
+            t: 0.0,
+            pose: Pose2::new(x, -0.02, PI),
+            source: crate::perception::circles::PoseSource::Mono { camera: 1 },
+            marks: 6,
+            reprojection_px: 0.03,
+            residual_m: 0.001,
+        };
+        // At or before the look pose: look again (None), no retry spent.
+        assert!(past_unseen(&mut m, &p, sighting(look_x)).is_none());
+        assert_eq!(m.retries, 0);
+        // 12 cm past it (axel-field run 22): reverse `reverse_m`, one retry.
+        match past_unseen(&mut m, &p, sighting(look_x - 0.12)) {
+            Some(Decision::Arc { arc, .. }) => assert_eq!((arc.curvature, arc.length), (0.0, -p.reverse_m)),
+            _ => panic!("expected a reverse"),
+        }
+        assert_eq!(m.retries, 1);
+        // Retries are bounded as for any realignment.
+        m.retries = m.geometry.max_retries;
+        assert!(matches!(
+            past_unseen(&mut m, &p, sighting(look_x - 0.12)),
+            Some(Decision::Done(Outcome::Failed(FailureReason::RetriesExhausted)))
+        ));
     }
 }

@@ -146,43 +146,49 @@ impl Behavior for Approach {
     fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
         let mut m = self.mem.lock();
         let p = self.params;
-        Some(self.cycle.tick_seeing(&mut m, "approach", p.lost_looks, |m, s| {
-            let g = m.geometry;
-            let params = p.view.plan_params(&g.plan);
-            let polar = Polar::from_pose(&s.pose);
-            if matches!(g.regions.classify(&polar), Region::Alignment | Region::Mating) {
-                return Decision::Event("near");
-            }
-            // The alignment region's entry on the axis; from far to the side, where no
-            // S within the turn limit reaches it, a goal farther in along the axis.
-            let entry = (g.regions.alignment_radius - p.inside_m).max(g.regions.mating_radius);
-            let planned = [entry, g.regions.mating_radius]
-                .into_iter()
-                .find_map(|x| plan(&s.pose, &Pose2::new(x, 0.0, PI), &params).ok());
-            match planned {
-                Some(pl) => Decision::Arc {
-                    arc: one_step(&pl.arcs, p.step_m),
-                    from: s.pose,
-                },
-                // No two-arc plan keeps the module in view (square to the axis far to
-                // the side, the S would turn it out): one arc toward the entry point,
-                // whatever the heading it ends in, if that keeps it; otherwise face the
-                // module and look again.
-                None => match toward(&s.pose, entry, p.step_m) {
-                    Some(arc)
-                        if keeps_in_view(
-                            &TwoArc {
-                                arcs: [arc, Arc::default()],
-                            },
-                            &s.pose,
-                            &params,
-                        ) =>
-                    {
-                        Decision::Arc { arc, from: s.pose }
-                    }
-                    _ => spiral(&s.pose, p.spiral_deg.to_radians(), p.step_m, &params),
-                },
-            }
-        }))
+        Some(self.cycle.tick_seeing(
+            &mut m,
+            "approach",
+            p.lost_looks,
+            |m, s| {
+                let g = m.geometry;
+                let params = p.view.plan_params(&g.plan);
+                let polar = Polar::from_pose(&s.pose);
+                if matches!(g.regions.classify(&polar), Region::Alignment | Region::Mating) {
+                    return Decision::Event("near");
+                }
+                // The alignment region's entry on the axis; from far to the side, where no
+                // S within the turn limit reaches it, a goal farther in along the axis.
+                let entry = (g.regions.alignment_radius - p.inside_m).max(g.regions.mating_radius);
+                let planned = [entry, g.regions.mating_radius]
+                    .into_iter()
+                    .find_map(|x| plan(&s.pose, &Pose2::new(x, 0.0, PI), &params).ok());
+                match planned {
+                    Some(pl) => Decision::Arc {
+                        arc: one_step(&pl.arcs, p.step_m),
+                        from: s.pose,
+                    },
+                    // No two-arc plan keeps the module in view (square to the axis far to
+                    // the side, the S would turn it out): one arc toward the entry point,
+                    // whatever the heading it ends in, if that keeps it; otherwise face the
+                    // module and look again.
+                    None => match toward(&s.pose, entry, p.step_m) {
+                        Some(arc)
+                            if keeps_in_view(
+                                &TwoArc {
+                                    arcs: [arc, Arc::default()],
+                                },
+                                &s.pose,
+                                &params,
+                            ) =>
+                        {
+                            Decision::Arc { arc, from: s.pose }
+                        }
+                        _ => spiral(&s.pose, p.spiral_deg.to_radians(), p.step_m, &params),
+                    },
+                }
+            },
+            |_, _| None,
+        ))
     }
 }

@@ -200,12 +200,16 @@ impl Cycle {
     /// sighting; a look without one turns to recentre the module (toward the look's
     /// untrusted pose, else the dead-reckoned last fix) when it lies more than 5° off,
     /// and looks again; `lost_looks` of them in a row end the state with event `lost`.
+    /// When the module is centred but the look's pose is untrusted, `untrusted` may
+    /// decide from that pose instead (`None`: look again): recentring cannot help a
+    /// view that one camera lost because the module is too near.
     pub fn tick_seeing(
         &mut self,
         m: &mut Memory,
         phase: &'static str,
         lost_looks: u32,
         decide: impl FnOnce(&mut Memory, Sighting) -> Decision,
+        untrusted: impl FnOnce(&mut Memory, Sighting) -> Option<Decision>,
     ) -> Step {
         let mut unseen = self.unseen;
         let step = self.tick(m, phase, |m, seen| match seen {
@@ -215,21 +219,29 @@ impl Cycle {
             }
             None => {
                 unseen += 1;
+                // Recentre before looking again: toward this look's untrusted pose
+                // (the module at the fish-eye's edge, seen by one camera or by too
+                // few marks), else toward where the last fix puts it.
+                let seen = m.sighting.filter(|s| s.t >= m.now - 3.0);
+                let bearing = seen
+                    .map(|s| s.pose)
+                    .or_else(|| m.reckoned())
+                    .map_or(0.0, |p| Polar::from_pose(&p).bearing());
+                if bearing.abs() > 5f64.to_radians() {
+                    return if unseen >= lost_looks {
+                        Decision::Event("lost")
+                    } else {
+                        Decision::Turn(bearing)
+                    };
+                }
+                if let Some(d) = seen.and_then(|s| untrusted(m, s)) {
+                    unseen = 0;
+                    return d;
+                }
                 if unseen >= lost_looks {
                     Decision::Event("lost")
                 } else {
-                    // Recentre before looking again: toward this look's untrusted pose
-                    // (the module at the fish-eye's edge, seen by one camera or by too
-                    // few marks), else toward where the last fix puts it.
-                    let seen = m.sighting.filter(|s| s.t >= m.now - 3.0).map(|s| s.pose);
-                    let bearing = seen
-                        .or_else(|| m.reckoned())
-                        .map_or(0.0, |p| Polar::from_pose(&p).bearing());
-                    if bearing.abs() > 5f64.to_radians() {
-                        Decision::Turn(bearing)
-                    } else {
-                        Decision::Turn(0.0)
-                    }
+                    Decision::Turn(0.0)
                 }
             }
         });
