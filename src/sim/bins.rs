@@ -151,42 +151,13 @@ mod tests {
         params.insert("beacon_power".to_string(), power);
         params.insert("beacons".to_string(), beacons);
         RunRecord {
-            index: 0,
-            start: "1".into(),
             lighting: "mixed".into(),
             segmentation: seg.into(),
-            terrain: "lab_floor".into(),
-            fiducial_colors: None,
-            trial: 0,
-            seed: 0,
-            distance_m: 1.0,
-            angle_deg: 0.0,
-            success,
-            outcome: if success { "docked" } else { "timeout" }.into(),
-            time_s: 10.0,
-            path_m: 1.0,
-            v_eff_cmps: 0.0,
-            commands_per_m: 0.0,
-            entrance_lateral_m: None,
-            entrance_heading_deg: None,
-            safe_stops: 0,
-            imprinted: None,
-            manoeuvres: 0,
-            fault: None,
-            fault_as_expected: None,
-            stale_motion_ticks: None,
-            safe_stop_s: None,
             lighting_draw: Some(LightingDraw {
                 spec: Default::default(),
                 params,
             }),
-            cycle: None,
-            outing_clock_s: None,
-            odometry_error_m: None,
-            odometry_error_deg: None,
-            excursion_reached: None,
-            carried_back: None,
-            track: vec![],
+            ..RunRecord::for_test("1", success)
         }
     }
 

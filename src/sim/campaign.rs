@@ -133,6 +133,50 @@ pub struct RunRecord {
     pub track: Vec<[i32; 2]>,
 }
 
+#[cfg(test)]
+impl RunRecord {
+    /// A lab-light, adaptive record of start `start` with every measured figure at a
+    /// neutral value (1 m, 10 s, no faults, no draw): what the tests of the tables built
+    /// from records (`bins`, `paper`) start from, overriding what they group by.
+    pub(crate) fn for_test(start: &str, success: bool) -> Self {
+        Self {
+            index: 0,
+            start: start.into(),
+            lighting: "lab".into(),
+            segmentation: "adaptive".into(),
+            terrain: "lab_floor".into(),
+            fiducial_colors: None,
+            trial: 0,
+            seed: 0,
+            distance_m: 1.0,
+            angle_deg: 0.0,
+            success,
+            outcome: if success { "docked" } else { "timeout" }.into(),
+            time_s: 10.0,
+            path_m: 1.0,
+            v_eff_cmps: 0.0,
+            commands_per_m: 0.0,
+            entrance_lateral_m: None,
+            entrance_heading_deg: None,
+            safe_stops: 0,
+            imprinted: None,
+            manoeuvres: 0,
+            fault: None,
+            fault_as_expected: None,
+            stale_motion_ticks: None,
+            safe_stop_s: None,
+            lighting_draw: None,
+            cycle: None,
+            outing_clock_s: None,
+            odometry_error_m: None,
+            odometry_error_deg: None,
+            excursion_reached: None,
+            carried_back: None,
+            track: vec![],
+        }
+    }
+}
+
 /// Options for [`run_campaign`].
 #[derive(Debug, Clone, Default)]
 pub struct CampaignOptions {

@@ -353,44 +353,6 @@ fn reel_only_table(s: &mut String, records: &[RunRecord]) {
 mod tests {
     use super::*;
 
-    fn run(label: &str, success: bool) -> RunRecord {
-        RunRecord {
-            index: 0,
-            start: label.into(),
-            lighting: "lab".into(),
-            segmentation: "adaptive".into(),
-            terrain: "sand".into(),
-            fiducial_colors: None,
-            trial: 0,
-            seed: 0,
-            distance_m: 2.0,
-            angle_deg: 0.0,
-            success,
-            outcome: if success { "docked" } else { "stuck_contact" }.into(),
-            time_s: 40.0,
-            path_m: 2.0,
-            v_eff_cmps: 0.0,
-            commands_per_m: 0.0,
-            entrance_lateral_m: None,
-            entrance_heading_deg: None,
-            safe_stops: 0,
-            imprinted: None,
-            manoeuvres: 0,
-            fault: None,
-            fault_as_expected: None,
-            stale_motion_ticks: None,
-            safe_stop_s: None,
-            lighting_draw: None,
-            cycle: None,
-            outing_clock_s: None,
-            odometry_error_m: None,
-            odometry_error_deg: None,
-            excursion_reached: None,
-            carried_back: None,
-            track: vec![],
-        }
-    }
-
     #[test]
     fn reel_only_labels_give_alpha_and_h() {
         assert_eq!(reel_only_cell("r4/a-7/h120"), Some((-7, 120)));
@@ -403,12 +365,12 @@ mod tests {
     #[test]
     fn the_reel_only_table_counts_cells_against_the_paper_limits() {
         let records = [
-            run("r2/a0/h0", true),     // inside, docked: agrees
-            run("r4/a0/h0", true),     // same cell
-            run("r2/a3/h120", false),  // outside (h), failed: agrees
-            run("r2/a7/h0", true),     // outside (α), docked: disagrees
-            run("r2/a-3/h-80", false), // inside, failed: disagrees
-            run("fig10", true),        // not a grid start: left out
+            RunRecord::for_test("r2/a0/h0", true),     // inside, docked: agrees
+            RunRecord::for_test("r4/a0/h0", true),     // same cell
+            RunRecord::for_test("r2/a3/h120", false),  // outside (h), failed: agrees
+            RunRecord::for_test("r2/a7/h0", true),     // outside (α), docked: disagrees
+            RunRecord::for_test("r2/a-3/h-80", false), // inside, failed: disagrees
+            RunRecord::for_test("fig10", true),        // not a grid start: left out
         ];
         let t = comparison(PaperTable::AxelReelOnly, &records);
         assert!(t.contains("2/2*"), "{t}");
