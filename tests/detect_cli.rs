@@ -241,6 +241,15 @@ fn wrap_deg(a: f64) -> f64 {
     (a + 180.0).rem_euclid(360.0) - 180.0
 }
 
+/// Position (m) and heading (°) errors of a pose record's `rover_in_module` against
+/// the rover's true pose in the module frame.
+fn rover_error(pose: &serde_json::Value, robot: &Pose2) -> (f64, f64) {
+    let rim = pose["rover_in_module"].as_array().unwrap();
+    let [x, y, h] = [0, 1, 2].map(|i| rim[i].as_f64().unwrap());
+    let e = (x - robot.x).hypot(y - robot.y);
+    (e, wrap_deg(h - robot.theta.to_degrees()).abs())
+}
+
 #[test]
 fn circles_marks_ids_and_pose_on_rendered_frames() {
     let p = common::shipped_profile("axel");
@@ -289,14 +298,7 @@ fn circles_marks_ids_and_pose_on_rendered_frames() {
         assert_eq!(pose["camera"], cam);
         assert_eq!(pose["marks_used"], 8);
         assert!(pose["reprojection_px"].as_f64().unwrap() < 1.0, "{label}");
-        let rim = pose["rover_in_module"].as_array().unwrap();
-        let (x, y, h) = (
-            rim[0].as_f64().unwrap(),
-            rim[1].as_f64().unwrap(),
-            rim[2].as_f64().unwrap(),
-        );
-        let e = (x - robot.x).hypot(y - robot.y);
-        let eh = wrap_deg(h - robot.theta.to_degrees()).abs();
+        let (e, eh) = rover_error(pose, &robot);
         assert!(e < 0.03 && eh < 1.0, "{label}: rover {e:.4} m, {eh:.2}° off the truth");
         // The module in the rover frame: its face looks back at the rover.
         let hd = pose["heading_deg"].as_f64().unwrap();
@@ -523,15 +525,8 @@ fn circles_stereo_pairs_give_a_stereo_pose_beside_each_mono_one() {
         let pose = &stereo["pose"];
         assert_eq!(pose["source"], "stereo");
         assert_eq!(pose["marks_used"], 8, "{stereo}");
-        let rim = pose["rover_in_module"].as_array().unwrap();
-        let (x, y, h) = (
-            rim[0].as_f64().unwrap(),
-            rim[1].as_f64().unwrap(),
-            rim[2].as_f64().unwrap(),
-        );
         // The paper's stereo error: 2.56 cm / 2.5° at 1 m, 4.12 cm / 4.58° at 2 m.
-        let e = (x - robot.x).hypot(y - robot.y);
-        let eh = wrap_deg(h - robot.theta.to_degrees()).abs();
+        let (e, eh) = rover_error(pose, robot);
         assert!(
             e < 0.025 && eh < 1.0,
             "pair {k}: rover {e:.4} m, {eh:.2}° off the truth: {stereo}"
