@@ -400,22 +400,20 @@ pub fn build_with(profile: &Profile, state: &KrawlerState, extras: &GearExtras) 
         let c = &profile.cameras[0].mount;
         let (z0, z1) = (g.camera_z - PLATE_BELOW, g.camera_z - PLATE_TOP_GAP);
         let t = PLATE_THICK / 2.0;
-        for (dx, dy) in [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)] {
+        // A plate's extent along one axis: out from the camera on the side it points
+        // to, its thickness about the centre across.
+        let span = |d: f64| {
             let (a, b) = (PLATE_INNER, PLATE_OUTER);
-            let (x0, x1) = if dx > 0.0 {
+            if d > 0.0 {
                 (a, b)
-            } else if dx < 0.0 {
+            } else if d < 0.0 {
                 (-b, -a)
             } else {
                 (-t, t)
-            };
-            let (y0, y1) = if dy > 0.0 {
-                (a, b)
-            } else if dy < 0.0 {
-                (-b, -a)
-            } else {
-                (-t, t)
-            };
+            }
+        };
+        for (dx, dy) in [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)] {
+            let ((x0, x1), (y0, y1)) = (span(dx), span(dy));
             prims.extend(boxed(
                 Point3::new(c.x_m + x0, c.y_m + y0, z0),
                 Point3::new(c.x_m + x1, c.y_m + y1, z1),

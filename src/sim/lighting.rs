@@ -235,18 +235,9 @@ impl LightingSpec {
         let preset = self.preset.unwrap_or(LightingPreset::Lab);
         let mut l = match preset {
             LightingPreset::Lab | LightingPreset::Flashers => Lighting {
-                intensity: 1.0,
-                illuminant: Illuminant::Fluorescent,
-                ambient: 1.0,
-                sun: 0.0,
                 sun_dir: sun_vector(70.0, 0.0),
                 glare: 1.0,
-                change_per_hour: 0.0,
-                session_s: 0.0,
-                flashers: Vec::new(),
-                shadows: Vec::new(),
-                clouds: None,
-                self_shadow: false,
+                ..Lighting::ambient_only(1.0, Illuminant::Fluorescent)
             },
             LightingPreset::Noon => Lighting {
                 intensity: 3.0,
