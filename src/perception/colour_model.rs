@@ -21,7 +21,8 @@
 //! to nothing and a noisy one cannot swallow the colour space (ALGORITHMS §2 pitfalls).
 //! The two colours' ranges never overlap each other or reach halfway to grey
 //! ([`separate_ranges`]): adaptation cannot grow one colour's range over the other's block
-//! or over the grey body around it.
+//! or over the grey body around it. In the table fallback, "grey" is grey as the imprint
+//! saw it ([`seen_grey`]): the table's colours were measured under another light.
 
 use super::image::RgbView;
 use super::sct::Sct;
@@ -457,12 +458,20 @@ impl<S: Blend> ColorModel<S> {
 
 impl ColorModel<[AngleStats; 2]> {
     /// SCT segmentation ranges for the next frame, never overlapping: see
-    /// [`separate_ranges`].
+    /// [`separate_ranges`]. On the table, each range is cut halfway to the grey the
+    /// imprint saw ([`seen_grey`], when a change of light explains the imprint): the
+    /// table's colours were measured under a light of their own, and the imprint's say
+    /// where grey lies under this one. The imprinted and adapted ranges were measured
+    /// under this light and centred on it, and keep the cut at r = g = b.
     pub fn ranges(&self) -> [SctRange; 2] {
         let p = &self.params;
         let stats = self.current();
         let mut r = stats.map(|s| s.range(p));
-        separate_ranges(&mut r, stats);
+        let grey = match (self.mode, &self.imprinted) {
+            (ColorMode::Table, Some(imp)) => seen_grey(&self.table, imp).unwrap_or(GREY_AB),
+            _ => GREY_AB,
+        };
+        separate_ranges_about(&mut r, stats, grey);
         r
     }
 }
@@ -511,8 +520,16 @@ impl ColorModel<[AngleStats; 2]> {
 /// assert!((r[1].b[0] - (1.2 + grey_b) / 2.0).abs() < 1e-12 && (r[1].b[1] - 2.3).abs() < 1e-12);
 /// ```
 pub fn separate_ranges(r: &mut [SctRange; 2], stats: &[AngleStats; 2]) {
+    separate_ranges_about(r, stats, GREY_AB);
+}
+
+/// As [`separate_ranges`], with grey seen at SCT angles `grey` (A, B) instead of at
+/// r = g = b: under a coloured light a grey surface takes the light's colour, and the
+/// cut between a colour and grey belongs halfway to the grey the camera sees (see
+/// [`seen_grey`]).
+pub fn separate_ranges_about(r: &mut [SctRange; 2], stats: &[AngleStats; 2], grey: (f64, f64)) {
     for (range, s) in r.iter_mut().zip(stats) {
-        off_grey(range, s);
+        off_grey(range, s, grey);
     }
     let overlap = |x: [f64; 2], y: [f64; 2]| x[0] < y[1] && y[0] < x[1];
     if !(overlap(r[0].a, r[1].a) && overlap(r[0].b, r[1].b)) {
@@ -539,12 +556,12 @@ const GREY_AB: (f64, f64) = (0.955_316_618_124_509_3, std::f64::consts::FRAC_PI_
 /// it, and the range widens further. We replayed it (bujold-table1 run 45 at 1.9 m,
 /// 60° off the axis): cyan's range came to hold half the body's rear face, and the pose
 /// read 0.5 m where the robot stood 1.9 m away.
-fn off_grey(r: &mut SctRange, s: &AngleStats) {
-    let (da, db) = (s.mean_a - GREY_AB.0, s.mean_b - GREY_AB.1);
+fn off_grey(r: &mut SctRange, s: &AngleStats, grey_ab: (f64, f64)) {
+    let (da, db) = (s.mean_a - grey_ab.0, s.mean_b - grey_ab.1);
     let (x, mean, grey) = if da.abs() >= db.abs() {
-        (&mut r.a, s.mean_a, GREY_AB.0)
+        (&mut r.a, s.mean_a, grey_ab.0)
     } else {
-        (&mut r.b, s.mean_b, GREY_AB.1)
+        (&mut r.b, s.mean_b, grey_ab.1)
     };
     let mid = (mean + grey) / 2.0;
     if mean >= grey {
@@ -552,6 +569,106 @@ fn off_grey(r: &mut SctRange, s: &AngleStats) {
     } else {
         x[1] = x[1].min(mid);
     }
+}
+
+/// The unit RGB direction of SCT angles (A, B): the inverse of [`Sct::from_rgb`] up to
+/// brightness.
+fn rgb_of(a: f64, b: f64) -> [f64; 3] {
+    let (sa, ca) = a.sin_cos();
+    let (sb, cb) = b.sin_cos();
+    [sa * cb, sa * sb, ca]
+}
+
+/// SCT angles (A, B) of an RGB direction.
+fn angles_of(rgb: [f64; 3]) -> (f64, f64) {
+    (rgb[0].hypot(rgb[1]).atan2(rgb[2]), rgb[1].atan2(rgb[0]))
+}
+
+/// Largest RMS angle error, rad, with which a change of light may explain the imprint:
+/// beyond it the imprint is not the table's colours under another light (it took in
+/// something else, or the table is a nominal sRGB that no camera sees), and grey stays
+/// at r = g = b.
+const SEEN_GREY_MAX_RMS: f64 = 0.05;
+
+/// Grey as the camera saw it when it imprinted: the SCT angles of r = g = b under the
+/// light that takes the table's colours to the imprinted ones, or `None` when no change
+/// of light explains the imprint.
+///
+/// The table holds the paints as the camera sees them under the light they were
+/// measured in; the imprint holds them under the light of the departure. A change of
+/// light multiplies each channel by its own gain (von Kries), so the two gain ratios
+/// r/g and b/g are fitted by Gauss–Newton to the two colours' four angles, and grey is
+/// moved by the same gains. A warm low sun, for one, makes a grey surface warm: the
+/// midpoint between a colour and grey, where [`off_grey`] cuts, then lies toward that
+/// warm grey, and a blue block whose sheen takes some of the warm light is still blue.
+///
+/// # Example
+///
+/// ```
+/// use marsupial::perception::colour_model::seen_grey;
+/// use marsupial::perception::{AngleStats, Sct};
+///
+/// let st = |rgb: [u8; 3]| {
+///     let s = Sct::from_rgb(rgb);
+///     AngleStats { mean_a: s.a, sd_a: 0.02, mean_b: s.b, sd_b: 0.02, n: 100 }
+/// };
+/// // Cyan and magenta paints, then the same paints under a light with gains (1.2, 1, 0.8).
+/// let table = [st([40, 160, 170]), st([170, 40, 150])];
+/// let warm = [st([48, 160, 136]), st([204, 40, 120])];
+/// let (a, b) = seen_grey(&table, &warm).unwrap();
+/// let truth = Sct::from_rgb([120, 100, 80]);
+/// assert!((a - truth.a).abs() < 1e-3 && (b - truth.b).abs() < 1e-3);
+/// // The same light: grey is grey.
+/// let (a, b) = seen_grey(&table, &table).unwrap();
+/// assert!((a - Sct::from_rgb([9, 9, 9]).a).abs() < 1e-9 && (b - std::f64::consts::FRAC_PI_4).abs() < 1e-9);
+/// // An imprint of something else entirely is no change of light.
+/// assert!(seen_grey(&table, &[st([40, 160, 170]), st([40, 160, 170])]).is_none());
+/// ```
+pub fn seen_grey(table: &[AngleStats; 2], imprint: &[AngleStats; 2]) -> Option<(f64, f64)> {
+    let lit = |p: [f64; 2], s: &AngleStats| {
+        let [r, g, b] = rgb_of(s.mean_a, s.mean_b);
+        angles_of([r * p[0].exp(), g, b * p[1].exp()])
+    };
+    let residuals = |p: [f64; 2]| {
+        let mut e = [0.0; 4];
+        for (k, (t, i)) in table.iter().zip(imprint).enumerate() {
+            let (a, b) = lit(p, t);
+            e[2 * k] = a - i.mean_a;
+            e[2 * k + 1] = b - i.mean_b;
+        }
+        e
+    };
+    let mut p = [0.0f64; 2];
+    for _ in 0..20 {
+        let e = residuals(p);
+        // Numerical Jacobian, 4 × 2; normal equations JᵀJ δ = −Jᵀe.
+        let h = 1e-6;
+        let cols = [0, 1].map(|j| {
+            let mut q = p;
+            q[j] += h;
+            let f = residuals(q);
+            [0, 1, 2, 3].map(|k| (f[k] - e[k]) / h)
+        });
+        let dot = |x: &[f64; 4], y: &[f64; 4]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+        let (m00, m01, m11) = (
+            dot(&cols[0], &cols[0]),
+            dot(&cols[0], &cols[1]),
+            dot(&cols[1], &cols[1]),
+        );
+        let (g0, g1) = (dot(&cols[0], &e), dot(&cols[1], &e));
+        let det = m00 * m11 - m01 * m01;
+        if !det.is_finite() || det.abs() < 1e-12 {
+            return None;
+        }
+        let step = [-(m11 * g0 - m01 * g1) / det, -(m00 * g1 - m01 * g0) / det];
+        p = [p[0] + step[0].clamp(-1.0, 1.0), p[1] + step[1].clamp(-1.0, 1.0)];
+        if step[0].abs().max(step[1].abs()) < 1e-10 {
+            break;
+        }
+    }
+    let e = residuals(p);
+    let rms = (e.iter().map(|x| x * x).sum::<f64>() / 4.0).sqrt();
+    (rms.is_finite() && rms <= SEEN_GREY_MAX_RMS).then(|| angles_of([p[0].exp(), 1.0, p[1].exp()]))
 }
 
 /// Cuts intervals `x` (about mean `mx`) and `y` (about `my`) at the midpoint of the means.
@@ -910,5 +1027,45 @@ mod tests {
         // Yellow (A 80.5°) from the other side.
         assert!((r[1].a[0] - (d(80.5) + grey_a) / 2.0).abs() < 1e-12);
         assert!(!r[0].contains([128, 128, 128]) && !r[1].contains([128, 128, 128]));
+    }
+
+    #[test]
+    fn the_table_fallback_cuts_halfway_to_the_grey_the_imprint_saw() {
+        // Blue and red paints under a light with gains (1.25, 1, 0.73), a warm low sun:
+        // the imprint sees them moved toward warm, and so is grey.
+        let st = |rgb: [f64; 3]| {
+            let (a, b) = angles_of(rgb);
+            AngleStats {
+                mean_a: a,
+                sd_a: 0.1,
+                mean_b: b,
+                sd_b: 0.1,
+                n: 100,
+            }
+        };
+        let gains = [1.25, 1.0, 0.73];
+        let warm = |c: [f64; 3]| [c[0] * gains[0], c[1] * gains[1], c[2] * gains[2]];
+        let (blue, red) = ([0.25, 0.35, 0.9], [0.9, 0.2, 0.15]);
+        let table = [st(blue), st(red)];
+        let mut m = ColorModel::new(table, params(true));
+        m.imprint([st(warm(blue)), st(warm(red))], 0.0);
+        let grey = seen_grey(&table, m.imprinted().unwrap()).unwrap();
+        let truth = angles_of(gains);
+        assert!((grey.0 - truth.0).abs() < 1e-6 && (grey.1 - truth.1).abs() < 1e-6);
+        // Imprinted and adapted ranges keep the cut at r = g = b ...
+        let imprinted = m.ranges()[0];
+        m.update(6.0, None);
+        assert_eq!(m.mode(), ColorMode::Table);
+        // ... the table's blue, farther from grey on A, is cut halfway to the warm grey.
+        let r = m.ranges();
+        assert!((r[0].a[1] - (table[0].mean_a + truth.0) / 2.0).abs() < 1e-9);
+        assert!(
+            r[0].a[1] > (table[0].mean_a + GREY_AB.0) / 2.0,
+            "warm grey lies past r = g = b"
+        );
+        assert!(imprinted.a[1] <= (m.imprinted().unwrap()[0].mean_a + GREY_AB.0) / 2.0 + 1e-12);
+        // A warm grey surface is still outside both ranges.
+        let warm_grey = [(128.0 * gains[0]) as u8, 128, (128.0 * gains[2]) as u8];
+        assert!(!r[0].contains(warm_grey) && !r[1].contains(warm_grey));
     }
 }
