@@ -187,6 +187,53 @@ mod tests {
         }
     }
 
+    proptest::proptest! {
+        /// The integral image, the branch-free interior and the clipped borders against
+        /// a plain 64-bit window sum, over small and large images, windows from 3 to
+        /// 238 px, and every offset.
+        #[test]
+        fn the_masks_agree_with_a_plain_window_sum(
+            (w, h, window) in proptest::prop_oneof![
+                (1usize..48, 1usize..40, 3usize..15),
+                (240usize..300, 240usize..260, 183usize..239),
+            ],
+            offset in proptest::prelude::any::<u8>(),
+            seed in 0u64..1000,
+        ) {
+            let grey: Vec<u8> = (0..w * h).map(|i| (mix(seed, i as u64) % 256) as u8).collect();
+            let p = AdaptiveThreshold { window_px: window, offset };
+            let (mut b, mut wh) = (Mask::new(1, 1), Mask::new(1, 1));
+            Thresholder::new(w, h).apply(&grey, w, h, &p, &mut b, &mut wh);
+            // Reference: 64-bit cumulative sums, clipped windows.
+            let mut cum = vec![0u64; (w + 1) * (h + 1)];
+            for y in 0..h {
+                for x in 0..w {
+                    cum[(y + 1) * (w + 1) + x + 1] = grey[y * w + x] as u64 + cum[y * (w + 1) + x + 1]
+                        + cum[(y + 1) * (w + 1) + x]
+                        - cum[y * (w + 1) + x];
+                }
+            }
+            let r = (window.max(3) | 1) / 2;
+            for y in 0..h {
+                for x in 0..w {
+                    let (y0, y1, x0, x1) = (y.saturating_sub(r), (y + r + 1).min(h), x.saturating_sub(r), (x + r + 1).min(w));
+                    let s = cum[y1 * (w + 1) + x1] + cum[y0 * (w + 1) + x0] - cum[y0 * (w + 1) + x1] - cum[y1 * (w + 1) + x0];
+                    let n = ((y1 - y0) * (x1 - x0)) as u64;
+                    let (g, off) = (grey[y * w + x] as u64, offset as u64);
+                    proptest::prop_assert_eq!(b.get(x, y), (g + off) * n < s, "black ({}, {})", x, y);
+                    proptest::prop_assert_eq!(wh.get(x, y), g * n > s + off * n, "white ({}, {})", x, y);
+                }
+            }
+        }
+    }
+
+    /// A cheap hash for test images: varied levels without an RNG dependency.
+    fn mix(seed: u64, i: u64) -> u64 {
+        let mut z = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ i.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z ^= z >> 31;
+        z.wrapping_mul(0x94D0_49BB_1331_11EB) >> 17
+    }
+
     #[test]
     fn degenerate_sizes_give_empty_masks() {
         let (mut b, mut wh) = (Mask::new(1, 1), Mask::new(1, 1));
