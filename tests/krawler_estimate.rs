@@ -188,3 +188,31 @@ fn mud_invalidates_its_axle_only_while_it_lasts() {
     }
     assert!(s.errors.iter().any(|e| e.contains("mud on marker 4")), "{:?}", s.errors);
 }
+
+#[test]
+fn scenario_is_another_name_for_sequence() {
+    // The same 1-s sequence through either spelling of the option gives the same summary
+    // (`--json`: the printed table also carries the wall time).
+    let dir = tmp("alias");
+    let seq = dir.join("one.toml");
+    std::fs::write(&seq, short(1.0, "")).unwrap();
+    let summary = |option: &str| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_marsupial"))
+            .args(["estimate", "--json", option])
+            .arg(&seq)
+            .arg("--profile")
+            .arg(profile_path())
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{option}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let by_sequence = summary("--sequence");
+    assert_eq!(by_sequence["frames"], 30, "{by_sequence}");
+    assert_eq!(summary("--scenario"), by_sequence);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -44,8 +44,9 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone, clap::Args)]
 pub struct EstimateOptions {
     /// A built-in sequence (dataset1, dataset2, dataset3: the paper's 82, 170 and 257 s)
-    /// or a sequence file (TOML, see sequences/).
-    #[arg(long, value_name = "NAME|FILE")]
+    /// or a sequence file (TOML, see sequences/). `--scenario` is the same option: a
+    /// sequence is the AutoKrawler's scenario.
+    #[arg(long, visible_alias = "scenario", value_name = "NAME|FILE")]
     pub sequence: String,
     /// Write frames.csv, odometry.csv, the plots and summary.json here.
     #[arg(long, value_name = "DIR")]
