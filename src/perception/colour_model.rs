@@ -599,7 +599,7 @@ const SEEN_GREY_MAX_RMS: f64 = 0.05;
 /// light multiplies each channel by its own gain (von Kries), so the two gain ratios
 /// r/g and b/g are fitted by Gauss–Newton to the two colours' four angles, and grey is
 /// moved by the same gains. A warm low sun, for one, makes a grey surface warm: the
-/// midpoint between a colour and grey, where [`off_grey`] cuts, then lies toward that
+/// midpoint between a colour and grey, where [`separate_ranges_about`] cuts, then lies toward that
 /// warm grey, and a blue block whose sheen takes some of the warm light is still blue.
 ///
 /// # Example
