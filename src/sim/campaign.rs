@@ -44,8 +44,11 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// Builds a fresh agent for a (per-run) profile.
 pub type AgentFactory = dyn Fn(&Profile) -> Result<Box<dyn Agent>, BuildError> + Sync;
 
-/// The record of one run (one line of `runs.jsonl`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// The record of one run (one line of `runs.jsonl`). `Default` is an empty record (no
+/// start, not docked, every optional figure absent), for struct-update syntax: a run's
+/// record fills the figures every run has and leaves the fault's and the outing's to the
+/// stages that add them.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct RunRecord {
     /// Run index in the campaign.
     pub index: usize,
@@ -140,39 +143,16 @@ impl RunRecord {
     /// from records (`bins`, `paper`) start from, overriding what they group by.
     pub(crate) fn for_test(start: &str, success: bool) -> Self {
         Self {
-            index: 0,
             start: start.into(),
             lighting: "lab".into(),
             segmentation: "adaptive".into(),
             terrain: "lab_floor".into(),
-            fiducial_colors: None,
-            trial: 0,
-            seed: 0,
             distance_m: 1.0,
-            angle_deg: 0.0,
             success,
             outcome: if success { "docked" } else { "timeout" }.into(),
             time_s: 10.0,
             path_m: 1.0,
-            v_eff_cmps: 0.0,
-            commands_per_m: 0.0,
-            entrance_lateral_m: None,
-            entrance_heading_deg: None,
-            safe_stops: 0,
-            imprinted: None,
-            manoeuvres: 0,
-            fault: None,
-            fault_as_expected: None,
-            stale_motion_ticks: None,
-            safe_stop_s: None,
-            lighting_draw: None,
-            cycle: None,
-            outing_clock_s: None,
-            odometry_error_m: None,
-            odometry_error_deg: None,
-            excursion_reached: None,
-            carried_back: None,
-            track: vec![],
+            ..Self::default()
         }
     }
 }

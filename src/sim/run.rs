@@ -484,21 +484,12 @@ pub(super) fn record(spec: &RunSpec, sim: &Sim, end: PhaseEnd, imprinted: Option
         safe_stops: sim.safe_stops,
         imprinted,
         manoeuvres,
-        lighting_draw: None,
-        fault: None,
-        fault_as_expected: None,
-        stale_motion_ticks: None,
-        safe_stop_s: None,
-        cycle: None,
-        outing_clock_s: None,
-        odometry_error_m: None,
-        odometry_error_deg: None,
-        excursion_reached: None,
-        carried_back: None,
         track: sim
             .track
             .iter()
             .map(|t| [(t[1] * 1000.0).round() as i32, (t[2] * 1000.0).round() as i32])
             .collect(),
+        // The fault's, the draw's and the outing's figures are added by those stages.
+        ..RunRecord::default()
     }
 }
