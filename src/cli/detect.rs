@@ -5,6 +5,7 @@
 //! and with `--stereo` the stereo pose of each pair of images from cameras 0 and 1
 //! ([`run`] dispatches on the profile).
 
+use super::json_line;
 use crate::config::ConfigError;
 use crate::image_io::{ImageFileError, load_rgb, save_png};
 use crate::perception::circles::{
@@ -210,8 +211,7 @@ pub fn run(opts: &DetectOptions, out: &mut dyn Write) -> Result<(), DetectError>
             times.push(start.elapsed().as_secs_f64() * 1e6);
             std::hint::black_box(p);
         }
-        times.sort_by(f64::total_cmp);
-        let us = times[times.len() / 2];
+        let us = median(&mut times);
         let p = schema.process(&im.view(), t)?;
         write_record(out, &path.display().to_string(), &p, us, opts.json)?;
         if let Some(base) = &opts.overlay {
@@ -240,7 +240,7 @@ fn write_record(out: &mut dyn Write, image: &str, p: &TwoBlockPercept, us: f64, 
         us_per_frame: (us * 10.0).round() / 10.0,
     };
     if json {
-        writeln!(out, "{}", serde_json::to_string(&rec).map_err(std::io::Error::other)?)?;
+        json_line(out, &rec)?;
     } else if p.found {
         writeln!(
             out,
@@ -661,7 +661,7 @@ fn pose_record(p: &ModulePose, source: &'static str, camera: usize) -> CirclePos
 
 fn write_circles(out: &mut dyn Write, rec: &CirclesRecord<'_>, json: bool) -> Result<(), DetectError> {
     if json {
-        writeln!(out, "{}", serde_json::to_string(rec).map_err(std::io::Error::other)?)?;
+        json_line(out, rec)?;
         return Ok(());
     }
     let image = rec.image;
@@ -700,7 +700,7 @@ fn write_circles(out: &mut dyn Write, rec: &CirclesRecord<'_>, json: bool) -> Re
 
 fn write_stereo(out: &mut dyn Write, rec: &StereoRecord<'_>, json: bool) -> Result<(), DetectError> {
     if json {
-        writeln!(out, "{}", serde_json::to_string(rec).map_err(std::io::Error::other)?)?;
+        json_line(out, rec)?;
         return Ok(());
     }
     let [left, right] = rec.stereo;

@@ -10,3 +10,9 @@ pub mod merge;
 pub mod replay;
 pub mod sim_cmds;
 pub mod timeline;
+
+/// Writes `v` as one line of JSON (the `--json` output of the subcommands that print a
+/// record per item).
+pub(crate) fn json_line<T: serde::Serialize>(out: &mut dyn std::io::Write, v: &T) -> std::io::Result<()> {
+    writeln!(out, "{}", serde_json::to_string(v).map_err(std::io::Error::other)?)
+}

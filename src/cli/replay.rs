@@ -1,6 +1,7 @@
 //! `marsupial replay`: run a profile's perception, or its whole behavior open-loop, on the
 //! frames of a real log (see [`crate::replay`]), printing one line per frame.
 
+use super::json_line;
 use crate::config::ConfigError;
 use crate::perception::RgbImage;
 use crate::profile::{CameraSpec, Profile};
@@ -131,10 +132,6 @@ fn found(p: &ObservedPercept) -> bool {
         ObservedPercept::TwoBlock(p) => p.found,
         ObservedPercept::Pyramid(p) => p.view.is_some(),
     }
-}
-
-fn json_line<T: Serialize>(out: &mut dyn Write, v: &T) -> std::io::Result<()> {
-    writeln!(out, "{}", serde_json::to_string(v).map_err(std::io::Error::other)?)
 }
 
 /// Skip counts, by (topic, reason).
