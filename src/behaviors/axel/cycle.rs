@@ -227,21 +227,15 @@ impl Cycle {
                     .map(|s| s.pose)
                     .or_else(|| m.reckoned())
                     .map_or(0.0, |p| Polar::from_pose(&p).bearing());
-                if bearing.abs() > 5f64.to_radians() {
-                    return if unseen >= lost_looks {
-                        Decision::Event("lost")
-                    } else {
-                        Decision::Turn(bearing)
-                    };
-                }
-                if let Some(d) = seen.and_then(|s| untrusted(m, s)) {
+                let off_centre = bearing.abs() > 5f64.to_radians();
+                if !off_centre && let Some(d) = seen.and_then(|s| untrusted(m, s)) {
                     unseen = 0;
                     return d;
                 }
                 if unseen >= lost_looks {
                     Decision::Event("lost")
                 } else {
-                    Decision::Turn(0.0)
+                    Decision::Turn(if off_centre { bearing } else { 0.0 })
                 }
             }
         });
