@@ -468,7 +468,15 @@ impl ColorModel<[AngleStats; 2]> {
         let stats = self.current();
         let mut r = stats.map(|s| s.range(p));
         let grey = match (self.mode, &self.imprinted) {
-            (ColorMode::Table, Some(imp)) => seen_grey(&self.table, imp).unwrap_or(GREY_AB),
+            (ColorMode::Table, Some(imp)) => {
+                let seen = seen_grey(&self.table, imp);
+                tracing::trace!(
+                    target: "marsupial::perception",
+                    seen_grey_deg = ?seen.map(|g| (g.0.to_degrees(), g.1.to_degrees())),
+                    "table ranges cut toward grey (None: at r = g = b)"
+                );
+                seen.unwrap_or(GREY_AB)
+            }
             _ => GREY_AB,
         };
         separate_ranges_about(&mut r, stats, grey);
