@@ -145,6 +145,32 @@ impl<'a> CdrReader<'a> {
         Ok(self.take(1, 1, field)?[0])
     }
 
+    /// A `uint16`.
+    ///
+    /// # Errors
+    /// [`CdrError::Truncated`].
+    pub fn u16(&mut self, field: &'static str) -> Result<u16, CdrError> {
+        Ok(u16::from_le_bytes(self.array::<2>(field)?))
+    }
+
+    /// A `float32`.
+    ///
+    /// # Errors
+    /// [`CdrError::Truncated`].
+    pub fn f32(&mut self, field: &'static str) -> Result<f32, CdrError> {
+        Ok(f32::from_le_bytes(self.array::<4>(field)?))
+    }
+
+    /// `N` bytes of a fixed `uint8[N]` array (no count), as a UUID is.
+    ///
+    /// # Errors
+    /// [`CdrError::Truncated`].
+    pub fn fixed_bytes<const N: usize>(&mut self, field: &'static str) -> Result<[u8; N], CdrError> {
+        let mut a = [0u8; N];
+        a.copy_from_slice(self.take(N, 1, field)?);
+        Ok(a)
+    }
+
     /// A `uint32`.
     ///
     /// # Errors
@@ -221,6 +247,87 @@ impl<'a> CdrReader<'a> {
     }
 }
 
+/// Writes little-endian plain CDR: [`CdrWriter::new`] puts the encapsulation header
+/// (`00 01 00 00`), and each primitive is aligned to its size counted from the first byte
+/// after that header, as [`CdrReader`] reads it.
+#[derive(Debug)]
+pub struct CdrWriter<'a>(&'a mut Vec<u8>);
+
+impl<'a> CdrWriter<'a> {
+    /// Clears `buf` and writes the encapsulation header into it.
+    pub fn new(buf: &'a mut Vec<u8>) -> Self {
+        buf.clear();
+        buf.extend_from_slice(&[0, 1, 0, 0]);
+        Self(buf)
+    }
+
+    fn align(&mut self, n: usize) {
+        while !(self.0.len() - 4).is_multiple_of(n) {
+            self.0.push(0);
+        }
+    }
+
+    /// A `uint8` (or a `bool`, as 0 or 1).
+    pub fn u8(&mut self, v: u8) {
+        self.0.push(v);
+    }
+
+    /// A `uint16`.
+    pub fn u16(&mut self, v: u16) {
+        self.align(2);
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+
+    /// A `uint32`.
+    pub fn u32(&mut self, v: u32) {
+        self.align(4);
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+
+    /// An `int32`.
+    pub fn i32(&mut self, v: i32) {
+        self.align(4);
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+
+    /// A `float32`.
+    pub fn f32(&mut self, v: f32) {
+        self.align(4);
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+
+    /// A `float64`.
+    pub fn f64(&mut self, v: f64) {
+        self.align(8);
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+
+    /// A `string`: a length that counts the NUL, the bytes and the NUL.
+    pub fn string(&mut self, s: &str) {
+        self.u32(s.len() as u32 + 1);
+        self.0.extend_from_slice(s.as_bytes());
+        self.0.push(0);
+    }
+
+    /// A `uint8[]` sequence: its count, then the bytes.
+    pub fn bytes(&mut self, b: &[u8]) {
+        self.u32(b.len() as u32);
+        self.0.extend_from_slice(b);
+    }
+
+    /// A fixed `uint8[N]` array (no count).
+    pub fn fixed_bytes(&mut self, b: &[u8]) {
+        self.0.extend_from_slice(b);
+    }
+
+    /// A `std_msgs/Header`.
+    pub fn header(&mut self, stamp: Time, frame_id: &str) {
+        self.i32(stamp.sec);
+        self.u32(stamp.nanosec);
+        self.string(frame_id);
+    }
+}
+
 /// Decodes a `sensor_msgs/msg/Image`: header, `uint32 height`, `uint32 width`, `string
 /// encoding`, `uint8 is_bigendian`, `uint32 step`, `uint8[] data`. The pixels are
 /// borrowed from `buf`; their encoding is not checked here (see [`Image::to_rgb`]).
@@ -284,6 +391,34 @@ pub fn decode_odometry(buf: &[u8]) -> Result<Odometry<'_>, CdrError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_writer_writes_what_the_reader_reads() {
+        let mut buf = Vec::new();
+        let mut w = CdrWriter::new(&mut buf);
+        w.u8(7);
+        w.u16(0x0102);
+        w.string("ab");
+        w.f64(1.5);
+        w.f32(-2.0);
+        w.fixed_bytes(&[9; 3]);
+        w.bytes(&[4, 5]);
+        w.header(Time { sec: -3, nanosec: 4 }, "cam");
+        let mut r = CdrReader::new(&buf).unwrap();
+        assert_eq!(r.u8("a").unwrap(), 7);
+        assert_eq!(r.u16("b").unwrap(), 0x0102);
+        assert_eq!(r.string("c").unwrap(), "ab");
+        assert_eq!(r.f64("d").unwrap(), 1.5);
+        assert_eq!(r.f32("e").unwrap(), -2.0);
+        assert_eq!(r.fixed_bytes::<3>("f").unwrap(), [9; 3]);
+        assert_eq!(r.bytes("g").unwrap(), &[4, 5]);
+        let h = r.header().unwrap();
+        assert_eq!((h.stamp, h.frame_id), (Time { sec: -3, nanosec: 4 }, "cam"));
+        assert_eq!(r.offset(), buf.len());
+        // The float64 sits on a multiple of 8 from the body's start: 1 + pad 1 + 2 + 4 + 3
+        // ("ab" and its NUL) = 11, padded to 16.
+        assert_eq!(&buf[4 + 16..4 + 24], &1.5f64.to_le_bytes());
+    }
 
     #[test]
     fn big_endian_and_alignment() {

@@ -37,6 +37,7 @@ use super::run::TraceLine;
 use crate::geometry::Pose2;
 use crate::perception::RgbImage;
 use crate::profile::CameraSpec;
+use crate::replay::cdr::CdrWriter;
 use crate::schemas::{MotorOutput, Observation};
 use messages::{CameraCalibration, FrameTransform, Log, PoseInFrame, Quaternion, Time, Vector3};
 use serde::Serialize;
@@ -514,19 +515,16 @@ impl McapRecorder {
         let (w, h) = (frame.width(), frame.height());
         let cam = &self.ch.cameras[i];
         let id = cam.image;
-        self.buf.clear();
-        let mut cdr = CdrWriter(&mut self.buf);
-        cdr.0.extend_from_slice(&[0, 1, 0, 0]); // CDR, little-endian
+        let mut cdr = CdrWriter::new(&mut self.buf);
         cdr.u32(t.sec);
         cdr.u32(t.nsec);
         cdr.string(&cam.frame_id);
         cdr.u32(h as u32);
         cdr.u32(w as u32);
         cdr.string("rgb8");
-        cdr.0.push(0); // is_bigendian
+        cdr.u8(0); // is_bigendian
         cdr.u32(3 * w as u32);
-        cdr.u32(frame.as_bytes().len() as u32);
-        cdr.0.extend_from_slice(frame.as_bytes());
+        cdr.bytes(frame.as_bytes());
         self.put(id, ns);
     }
 
@@ -609,24 +607,4 @@ impl McapRecorder {
 /// The inverse of a planar pose.
 fn inverse(p: &Pose2) -> Pose2 {
     p.relative(&Pose2::default())
-}
-
-/// Little-endian CDR (the encapsulation header written by the caller), aligned from the
-/// first byte after that header as ROS 2 aligns it.
-struct CdrWriter<'a>(&'a mut Vec<u8>);
-
-impl CdrWriter<'_> {
-    fn u32(&mut self, v: u32) {
-        while !(self.0.len() - 4).is_multiple_of(4) {
-            self.0.push(0);
-        }
-        self.0.extend_from_slice(&v.to_le_bytes());
-    }
-
-    /// A length (counting the NUL), the bytes and a NUL.
-    fn string(&mut self, s: &str) {
-        self.u32(s.len() as u32 + 1);
-        self.0.extend_from_slice(s.as_bytes());
-        self.0.push(0);
-    }
 }
