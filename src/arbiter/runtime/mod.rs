@@ -312,7 +312,7 @@ pub fn run<B: Behavior + ?Sized>(
     config: &RuntimeConfig,
     stop: &StopHandle,
 ) -> RuntimeReport {
-    run_with(robot, lp, config, stop, &mut |_, _| false)
+    run_with(robot, lp, config, stop, &mut |_, _| {}, &mut |_, _| false)
 }
 
 /// Runs `missions` one after the other on the robot `lp` drives: each is started with
@@ -326,6 +326,21 @@ pub fn run_missions<B: Agent + ?Sized>(
     missions: &[Mission],
     config: &RuntimeConfig,
     stop: &StopHandle,
+) -> RuntimeReport {
+    run_missions_observed(robot, lp, missions, config, stop, &mut |_, _| {})
+}
+
+/// [`run_missions`], telling `observe` each tick's run time and loop status as the
+/// actuators get its command: a front end that reports progress (the ROS 2 bridge's
+/// action feedback) reads the running behavior's phase and retries there. `observe` runs
+/// on the loop's thread, between ticks, so it must return quickly.
+pub fn run_missions_observed<B: Agent + ?Sized>(
+    robot: &mut Robot,
+    lp: &mut ReactiveLoop<B>,
+    missions: &[Mission],
+    config: &RuntimeConfig,
+    stop: &StopHandle,
+    observe: &mut dyn FnMut(f64, &LoopStatus),
 ) -> RuntimeReport {
     let Some((first, rest)) = missions.split_first() else {
         return RuntimeReport::default();
@@ -345,7 +360,7 @@ pub fn run_missions<B: Agent + ?Sized>(
         mission: first.name(),
     }];
     let mut next = rest.iter();
-    let mut report = run_with(robot, lp, config, stop, &mut |lp, t| {
+    let mut report = run_with(robot, lp, config, stop, observe, &mut |lp, t| {
         let Some(m) = next.next() else { return false };
         match lp.begin(m) {
             Ok(()) => {
@@ -394,13 +409,15 @@ impl StopEvents {
     }
 }
 
-/// The loop, with `next_mission` asked after each successful finish whether to go on
-/// (it starts the next mission on the loop and returns true).
+/// The loop, with `observe` told each tick's status and `next_mission` asked after each
+/// successful finish whether to go on (it starts the next mission on the loop and
+/// returns true).
 fn run_with<B: Behavior + ?Sized>(
     robot: &mut Robot,
     lp: &mut ReactiveLoop<B>,
     config: &RuntimeConfig,
     stop: &StopHandle,
+    observe: &mut dyn FnMut(f64, &LoopStatus),
     next_mission: &mut dyn FnMut(&mut ReactiveLoop<B>, f64) -> bool,
 ) -> RuntimeReport {
     let clock = Clock(Instant::now());
@@ -615,6 +632,7 @@ fn run_with<B: Behavior + ?Sized>(
         }
         send_latest(&cmd_tx, &cmd_rx, (command, from_behaviors));
         report.last_command = Some(command);
+        observe(now, &status);
         if let LoopStatus::Finished { outcome } = status {
             report.events.push(RuntimeEvent::Finished { t: now, outcome });
             report.outcome = Some(outcome);
