@@ -56,6 +56,8 @@ pub mod profile;
 #[cfg(feature = "sim")]
 pub mod replay;
 pub mod robot;
+#[cfg(feature = "ros2")]
+pub mod ros2;
 pub mod schemas;
 #[cfg(feature = "sim")]
 pub mod sim;

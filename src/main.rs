@@ -108,6 +108,15 @@ enum Command {
     /// would have sent), one per message that could not be used (bad CDR, Bayer or 16-bit
     /// encodings…), and a summary with the skipped counts by topic and reason.
     Replay(marsupial::cli::replay::ReplayOptions),
+    /// Run a profile's behaviors as a ROS 2 node over Zenoh (built with `--features ros2`).
+    ///
+    /// Speaks `rmw_zenoh`'s key expressions and CDR: subscribes to the camera image(s),
+    /// odometry and the dock switch, publishes cmd_vel (and posture, dock_guides, lights),
+    /// and serves the actions dock_robot and undock_robot (marsupial_msgs/action/Dock and
+    /// Undock, after Nav2's DockRobot and UndockRobot). Multicast scouting is off: it
+    /// talks to the endpoints given and nothing else.
+    #[cfg(feature = "ros2")]
+    Ros2(marsupial::cli::ros2::Ros2Options),
     /// Print the phase timeline of a run from its decision trace (`dock --trace`).
     ///
     /// One line per sequencer transition: mission, time, sequencer, from → to and the
@@ -165,6 +174,8 @@ fn main() -> ExitCode {
         Command::Detect(opts) => exit_code(marsupial::cli::detect::run(&opts, &mut std::io::stdout())),
         Command::Estimate(opts) => exit_code(marsupial::cli::estimate::run(&opts, &mut std::io::stdout())),
         Command::Replay(opts) => exit_code(marsupial::cli::replay::run(&opts, &mut std::io::stdout())),
+        #[cfg(feature = "ros2")]
+        Command::Ros2(opts) => exit_code(marsupial::cli::ros2::run(&opts, &mut std::io::stdout())),
         Command::Timeline { trace } => exit_code(marsupial::cli::timeline::run(&trace, &mut std::io::stdout())),
     }
 }

@@ -8,6 +8,8 @@ pub mod detect;
 pub mod estimate;
 pub mod merge;
 pub mod replay;
+#[cfg(feature = "ros2")]
+pub mod ros2;
 pub mod sim_cmds;
 pub mod timeline;
 

@@ -1,0 +1,171 @@
+//! Calling the node's actions from Rust, as `ros2 action send_goal` would: send a goal,
+//! follow its feedback, wait for its result, or cancel it. The tests use it; so can a
+//! mission planner written in Rust that shares the node's Zenoh network.
+
+use super::interfaces::{self, ActionInterfaces};
+use super::keys::{Attachment, NodeName, gid, now_ns};
+use super::messages::{
+    Goal, GoalFeedback, GoalId, GoalResult, decode_cancel_response, decode_feedback, decode_result,
+    decode_send_goal_response, encode_cancel_request, encode_goal_id, encode_send_goal,
+};
+use std::sync::atomic::{AtomicI64, Ordering};
+use std::time::Duration;
+use thiserror::Error;
+use zenoh::Wait;
+use zenoh::query::QueryTarget;
+
+/// Why a call did not get its answer.
+#[derive(Debug, Error)]
+pub enum ClientError {
+    /// Zenoh failed the request.
+    #[error("zenoh: {0}")]
+    Zenoh(String),
+    /// No server answered within the timeout.
+    #[error("no answer from `{0}` (is the node running, and connected to this session?)")]
+    NoAnswer(String),
+    /// The answer did not decode.
+    #[error("`{service}` answered with a payload that does not decode: {why}")]
+    Malformed {
+        /// The service.
+        service: String,
+        /// Why.
+        why: String,
+    },
+    /// The server rejected the goal.
+    #[error("the goal was rejected (another goal is running, or the goal did not decode)")]
+    Rejected,
+}
+
+/// A client of the node's `dock_robot` and `undock_robot` actions.
+pub struct ActionClient {
+    session: zenoh::Session,
+    node: NodeName,
+    gid: [u8; 16],
+    sequence: AtomicI64,
+}
+
+impl ActionClient {
+    /// A client on `session` for the node whose names `node` gives (its domain and
+    /// namespace; the node's own name is not part of action keys).
+    pub fn new(session: &zenoh::Session, node: NodeName) -> Self {
+        let gid = gid(&format!("client/{}/{}", session.zid(), now_ns()));
+        Self {
+            session: session.clone(),
+            node,
+            gid,
+            sequence: AtomicI64::new(0),
+        }
+    }
+
+    fn names(goal_is_dock: bool) -> (&'static str, ActionInterfaces) {
+        if goal_is_dock {
+            ("dock_robot", interfaces::action("marsupial_msgs/action/Dock"))
+        } else {
+            ("undock_robot", interfaces::action("marsupial_msgs/action/Undock"))
+        }
+    }
+
+    /// One request-reply on the service `name` of type `ty`.
+    fn call(
+        &self,
+        name: &str,
+        ty: &interfaces::Interface,
+        payload: Vec<u8>,
+        timeout: Duration,
+    ) -> Result<Vec<u8>, ClientError> {
+        let att = Attachment {
+            sequence_number: self.sequence.fetch_add(1, Ordering::SeqCst) + 1,
+            source_timestamp: now_ns(),
+            gid: self.gid,
+        };
+        let replies = self
+            .session
+            .get(self.node.key(name, ty))
+            .payload(payload)
+            .attachment(att.encode())
+            .target(QueryTarget::AllComplete)
+            .timeout(timeout)
+            .wait()
+            .map_err(|e| ClientError::Zenoh(e.to_string()))?;
+        while let Ok(reply) = replies.recv() {
+            if let Ok(sample) = reply.result() {
+                return Ok(sample.payload().to_bytes().into_owned());
+            }
+        }
+        Err(ClientError::NoAnswer(self.node.qualify(name)))
+    }
+
+    /// Sends `goal` and returns its id once the node accepted it.
+    ///
+    /// # Errors
+    /// [`ClientError`]; [`ClientError::Rejected`] when the node refused the goal.
+    pub fn send(&self, goal: &Goal, timeout: Duration) -> Result<GoalId, ClientError> {
+        let dock = matches!(goal, Goal::Dock(_));
+        let (action, ty) = Self::names(dock);
+        let id = gid(&format!("goal/{}/{}", now_ns(), self.sequence.load(Ordering::SeqCst)));
+        let mut buf = Vec::new();
+        encode_send_goal(&mut buf, &id, goal);
+        let name = format!("{action}/_action/send_goal");
+        let answer = self.call(&name, &ty.send_goal, buf, timeout)?;
+        let accepted = decode_send_goal_response(&answer).map_err(|e| ClientError::Malformed {
+            service: name,
+            why: e.to_string(),
+        })?;
+        if accepted { Ok(id) } else { Err(ClientError::Rejected) }
+    }
+
+    /// Waits up to `timeout` for goal `id`'s result (`dock`: of the docking action).
+    ///
+    /// # Errors
+    /// [`ClientError`].
+    pub fn result(&self, id: &GoalId, dock: bool, timeout: Duration) -> Result<GoalResult, ClientError> {
+        let (action, ty) = Self::names(dock);
+        let mut buf = Vec::new();
+        encode_goal_id(&mut buf, id);
+        let name = format!("{action}/_action/get_result");
+        let answer = self.call(&name, &ty.get_result, buf, timeout)?;
+        decode_result(&answer, dock).map_err(|e| ClientError::Malformed {
+            service: name,
+            why: e.to_string(),
+        })
+    }
+
+    /// Asks the node to cancel goal `id`; returns `action_msgs/srv/CancelGoal`'s return
+    /// code (0 accepted, 2 unknown goal, 3 already terminated).
+    ///
+    /// # Errors
+    /// [`ClientError`].
+    pub fn cancel(&self, id: &GoalId, dock: bool, timeout: Duration) -> Result<i8, ClientError> {
+        let (action, _) = Self::names(dock);
+        let mut buf = Vec::new();
+        encode_cancel_request(&mut buf, id);
+        let name = format!("{action}/_action/cancel_goal");
+        let answer = self.call(&name, &interfaces::cancel_goal(), buf, timeout)?;
+        decode_cancel_response(&answer).map_err(|e| ClientError::Malformed {
+            service: name,
+            why: e.to_string(),
+        })
+    }
+
+    /// Calls `f` with each feedback message of the action (`dock`: docking) until the
+    /// returned subscriber is dropped.
+    ///
+    /// # Errors
+    /// [`ClientError::Zenoh`].
+    pub fn on_feedback(
+        &self,
+        dock: bool,
+        f: impl Fn(GoalId, GoalFeedback) + Send + Sync + 'static,
+    ) -> Result<zenoh::pubsub::Subscriber<()>, ClientError> {
+        let (action, ty) = Self::names(dock);
+        self.session
+            .declare_subscriber(self.node.key(&format!("{action}/_action/feedback"), &ty.feedback))
+            .callback(move |s| {
+                if let Ok((id, fb)) = decode_feedback(&s.payload().to_bytes()) {
+                    f(id, fb);
+                }
+            })
+            .wait()
+            .map_err(|e| ClientError::Zenoh(e.to_string()))
+    }
+}

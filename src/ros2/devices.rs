@@ -1,0 +1,275 @@
+//! The robot's hardware as ROS 2 topics: a [`Camera`] fed by a `sensor_msgs` image topic,
+//! an [`Odometer`] fed by `nav_msgs/msg/Odometry`, and a [`Drive`] that publishes
+//! `geometry_msgs/msg/Twist` on `cmd_vel`. They implement the same traits a hand-written
+//! driver does, so the node runs the threaded runtime unchanged: its staleness limits,
+//! safe stops, watchdog and typed outcomes are the ones every robot gets.
+//!
+//! Each subscription's callback (on Zenoh's threads) only stores the latest payload; the
+//! device decodes it when the runtime asks, so a slow decode never backs Zenoh up.
+
+use super::keys::{Attachment, now_ns};
+use crate::kinematics::DriveCommand;
+use crate::perception::RgbImage;
+use crate::replay::cdr::{decode_compressed_image, decode_image, decode_odometry};
+use crate::robot::{Camera, Drive, Exposure, HardwareError, Odometer};
+use crate::schemas::OdometryReading;
+use std::sync::{Arc, Condvar, Mutex};
+use std::time::Duration;
+use zenoh::Wait;
+use zenoh::pubsub::{Publisher, Subscriber};
+
+/// The latest payload of a topic, and a condition to wait on for a new one.
+#[derive(Default)]
+pub(super) struct LatestPayload {
+    slot: Mutex<Option<Vec<u8>>>,
+    arrived: Condvar,
+}
+
+impl LatestPayload {
+    /// Keeps `payload`, replacing an unread one.
+    pub(super) fn put(&self, payload: Vec<u8>) {
+        if let Ok(mut s) = self.slot.lock() {
+            *s = Some(payload);
+            self.arrived.notify_all();
+        }
+    }
+
+    /// The unread payload, waiting up to `wait` for one.
+    pub(super) fn take(&self, wait: Duration) -> Option<Vec<u8>> {
+        let s = self.slot.lock().ok()?;
+        let (mut s, _) = self.arrived.wait_timeout_while(s, wait, |s| s.is_none()).ok()?;
+        s.take()
+    }
+}
+
+/// Subscribes `key` into a [`LatestPayload`].
+///
+/// # Errors
+/// Zenoh's, as text.
+pub(super) fn subscribe(session: &zenoh::Session, key: &str) -> Result<(Arc<LatestPayload>, Subscriber<()>), String> {
+    let latest = Arc::new(LatestPayload::default());
+    let sink = latest.clone();
+    let sub = session
+        .declare_subscriber(key.to_owned())
+        .callback(move |sample| sink.put(sample.payload().to_bytes().into_owned()))
+        .wait()
+        .map_err(|e| e.to_string())?;
+    Ok((latest, sub))
+}
+
+/// Which image message a camera topic carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageKind {
+    /// `sensor_msgs/msg/Image` (`rgb8`, `bgr8`, `mono8` …).
+    Raw,
+    /// `sensor_msgs/msg/CompressedImage` (JPEG or PNG).
+    Compressed,
+}
+
+/// A camera whose frames come from a ROS 2 image topic.
+pub struct TopicCamera {
+    topic: String,
+    kind: ImageKind,
+    size: (usize, usize),
+    frames: Arc<LatestPayload>,
+    wait: Duration,
+    trust_stamps: bool,
+    _sub: Subscriber<()>,
+}
+
+impl TopicCamera {
+    /// A camera of `size` (the profile's) on `topic`, subscribed with `frames`.
+    /// `capture` waits up to `wait` for a frame. With `trust_stamps`, a frame's age is
+    /// its header stamp's distance from this machine's clock (ROS stamps in wall time, with
+    /// clocks kept in sync); without, frames are stamped on arrival.
+    pub(super) fn new(
+        topic: String,
+        kind: ImageKind,
+        size: (usize, usize),
+        (frames, sub): (Arc<LatestPayload>, Subscriber<()>),
+        wait: Duration,
+        trust_stamps: bool,
+    ) -> Self {
+        Self {
+            topic,
+            kind,
+            size,
+            frames,
+            wait,
+            trust_stamps,
+            _sub: sub,
+        }
+    }
+
+    fn fault(&self, detail: String) -> HardwareError {
+        HardwareError::Fault {
+            device: format!("camera on {}", self.topic),
+            detail,
+        }
+    }
+}
+
+impl Camera for TopicCamera {
+    fn resolution(&self) -> (usize, usize) {
+        self.size
+    }
+
+    fn capture(&mut self, frame: &mut RgbImage) -> Result<Exposure, HardwareError> {
+        let Some(payload) = self.frames.take(self.wait) else {
+            return Err(HardwareError::NotReady);
+        };
+        let (rgb, stamp) = match self.kind {
+            ImageKind::Raw => {
+                let im = decode_image(&payload).map_err(|e| self.fault(e.to_string()))?;
+                (im.to_rgb().map_err(|e| self.fault(e.to_string()))?, im.header.stamp)
+            }
+            ImageKind::Compressed => {
+                let im = decode_compressed_image(&payload).map_err(|e| self.fault(e.to_string()))?;
+                (im.to_rgb().map_err(|e| self.fault(e.to_string()))?, im.header.stamp)
+            }
+        };
+        if (rgb.width(), rgb.height()) != self.size {
+            return Err(self.fault(format!(
+                "frame is {}x{}, the profile's camera is {}x{}",
+                rgb.width(),
+                rgb.height(),
+                self.size.0,
+                self.size.1
+            )));
+        }
+        frame.as_bytes_mut().copy_from_slice(rgb.as_bytes());
+        let age = match stamp.ns() {
+            Some(ns) if self.trust_stamps => {
+                let age = now_ns() - ns as i64;
+                Duration::from_nanos(age.max(0) as u64)
+            }
+            _ => Duration::ZERO,
+        };
+        Ok(Exposure::ago(age))
+    }
+}
+
+/// An odometer fed by a `nav_msgs/msg/Odometry` topic. A read with no new message since
+/// the last is [`HardwareError::NotReady`], so a silent publisher goes stale.
+pub struct TopicOdometer {
+    topic: String,
+    odometry: Arc<LatestPayload>,
+    _sub: Subscriber<()>,
+}
+
+impl TopicOdometer {
+    pub(super) fn new(topic: String, (odometry, sub): (Arc<LatestPayload>, Subscriber<()>)) -> Self {
+        Self {
+            topic,
+            odometry,
+            _sub: sub,
+        }
+    }
+}
+
+impl Odometer for TopicOdometer {
+    fn read(&mut self) -> Result<OdometryReading, HardwareError> {
+        let Some(payload) = self.odometry.take(Duration::ZERO) else {
+            return Err(HardwareError::NotReady);
+        };
+        let o = decode_odometry(&payload).map_err(|e| HardwareError::Fault {
+            device: format!("odometry on {}", self.topic),
+            detail: e.to_string(),
+        })?;
+        Ok(OdometryReading {
+            pose: o.pose2(),
+            twist: o.twist(),
+        })
+    }
+}
+
+/// A base driven by `geometry_msgs/msg/Twist` on `cmd_vel`.
+pub struct TwistDrive {
+    publisher: Publisher<'static>,
+    gid: [u8; 16],
+    sequence: i64,
+    buf: Vec<u8>,
+}
+
+impl TwistDrive {
+    pub(super) fn new(publisher: Publisher<'static>, gid: [u8; 16]) -> Self {
+        Self {
+            publisher,
+            gid,
+            sequence: 0,
+            buf: Vec::with_capacity(64),
+        }
+    }
+}
+
+impl Drive for TwistDrive {
+    fn apply(&mut self, command: &DriveCommand) -> Result<(), HardwareError> {
+        let t = command.to_twist();
+        super::messages::Twist {
+            linear_x: t.v,
+            angular_z: t.omega,
+        }
+        .encode(&mut self.buf);
+        self.sequence += 1;
+        let att = Attachment {
+            sequence_number: self.sequence,
+            source_timestamp: now_ns(),
+            gid: self.gid,
+        };
+        self.publisher
+            .put(self.buf.as_slice())
+            .attachment(att.encode())
+            .wait()
+            .map_err(|e| HardwareError::Fault {
+                device: "cmd_vel".to_owned(),
+                detail: e.to_string(),
+            })
+    }
+}
+
+/// The drive command a base that receives `twist` on `cmd_vel` executes: a twist with no
+/// turn is a straight drive, one with no speed a turn in place, and zero a stop, so a
+/// turn-or-drive base (Bujold's) gets exactly the commands the behaviors realised.
+pub fn command_of(twist: super::messages::Twist) -> DriveCommand {
+    match (twist.linear_x == 0.0, twist.angular_z == 0.0) {
+        (true, true) => DriveCommand::Stop,
+        (true, false) => DriveCommand::Turn { omega: twist.angular_z },
+        (false, true) => DriveCommand::Straight { v: twist.linear_x },
+        (false, false) => DriveCommand::Twist(crate::geometry::Twist::new(twist.linear_x, twist.angular_z)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ros2::messages::Twist;
+
+    #[test]
+    fn twists_become_the_commands_they_came_from() {
+        for cmd in [
+            DriveCommand::Stop,
+            DriveCommand::Turn { omega: -0.3 },
+            DriveCommand::Straight { v: 0.2 },
+            DriveCommand::Twist(crate::geometry::Twist::new(0.1, 0.4)),
+        ] {
+            let t = cmd.to_twist();
+            assert_eq!(
+                command_of(Twist {
+                    linear_x: t.v,
+                    angular_z: t.omega
+                }),
+                cmd
+            );
+        }
+    }
+
+    #[test]
+    fn the_latest_payload_wins_and_is_taken_once() {
+        let l = LatestPayload::default();
+        assert_eq!(l.take(Duration::ZERO), None);
+        l.put(vec![1]);
+        l.put(vec![2]);
+        assert_eq!(l.take(Duration::ZERO), Some(vec![2]));
+        assert_eq!(l.take(Duration::from_millis(1)), None);
+    }
+}

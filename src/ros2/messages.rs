@@ -1,0 +1,413 @@
+//! CDR payloads of the messages the bridge writes and reads, beyond the camera and
+//! odometry messages [`crate::replay::cdr`] already decodes: `geometry_msgs/msg/Twist`,
+//! the encoders of `sensor_msgs/msg/Image` and `nav_msgs/msg/Odometry` (for a simulator
+//! or a test publishing to the node), and the action protocol's requests, replies and
+//! messages for `marsupial_msgs/action/Dock` and `…/Undock`.
+//!
+//! Every decoder is total: a short or malformed payload is a [`CdrError`], never a panic.
+
+use crate::geometry::Pose2;
+use crate::replay::cdr::{CdrError, CdrReader, CdrWriter};
+use crate::replay::ros::Time;
+
+/// A goal's id, `unique_identifier_msgs/msg/UUID`.
+pub type GoalId = [u8; 16];
+
+/// `geometry_msgs/msg/Twist`, as a planar base uses it.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Twist {
+    /// `linear.x`, m/s forward.
+    pub linear_x: f64,
+    /// `angular.z`, rad/s counter-clockwise.
+    pub angular_z: f64,
+}
+
+impl Twist {
+    /// The CDR payload (the other four components are zero).
+    pub fn encode(&self, buf: &mut Vec<u8>) {
+        let mut w = CdrWriter::new(buf);
+        for v in [self.linear_x, 0.0, 0.0, 0.0, 0.0, self.angular_z] {
+            w.f64(v);
+        }
+    }
+
+    /// Reads a payload, keeping `linear.x` and `angular.z`.
+    ///
+    /// # Errors
+    /// [`CdrError`] naming the field.
+    pub fn decode(buf: &[u8]) -> Result<Self, CdrError> {
+        let mut r = CdrReader::new(buf)?;
+        let linear = r.f64s::<3>("linear")?;
+        let angular = r.f64s::<3>("angular")?;
+        Ok(Self {
+            linear_x: linear[0],
+            angular_z: angular[2],
+        })
+    }
+}
+
+/// A stamp from ns since the epoch.
+pub fn stamp(ns: i64) -> Time {
+    Time {
+        sec: ns.div_euclid(1_000_000_000) as i32,
+        nanosec: ns.rem_euclid(1_000_000_000) as u32,
+    }
+}
+
+/// Writes a `sensor_msgs/msg/Image` of packed `rgb8` pixels.
+pub fn encode_image(buf: &mut Vec<u8>, t: Time, frame_id: &str, width: u32, height: u32, rgb: &[u8]) {
+    let mut w = CdrWriter::new(buf);
+    w.header(t, frame_id);
+    w.u32(height);
+    w.u32(width);
+    w.string("rgb8");
+    w.u8(0);
+    w.u32(3 * width);
+    w.bytes(rgb);
+}
+
+/// Writes a `nav_msgs/msg/Odometry` of a planar pose and body twist (covariances zero).
+pub fn encode_odometry(buf: &mut Vec<u8>, t: Time, pose: Pose2, v: f64, omega: f64) {
+    let mut w = CdrWriter::new(buf);
+    w.header(t, "odom");
+    w.string("base_link");
+    let (s, c) = (pose.theta / 2.0).sin_cos();
+    for x in [pose.x, pose.y, 0.0, 0.0, 0.0, s, c] {
+        w.f64(x);
+    }
+    for _ in 0..36 {
+        w.f64(0.0);
+    }
+    for x in [v, 0.0, 0.0, 0.0, 0.0, omega] {
+        w.f64(x);
+    }
+    for _ in 0..36 {
+        w.f64(0.0);
+    }
+}
+
+/// What a docking goal asks (`marsupial_msgs/action/Dock_Goal`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct DockGoal {
+    /// Where the dock is believed to be, in the odometry frame (`dock_hint` when
+    /// `use_dock_hint`).
+    pub dock_hint: Option<Pose2>,
+    /// Give up after this long, s; 0 for the profile's own limits only.
+    pub max_time: f32,
+}
+
+/// What an undocking goal asks (`marsupial_msgs/action/Undock_Goal`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct UndockGoal {
+    /// Give up after this long, s; 0 for the profile's own limits only.
+    pub max_time: f32,
+}
+
+/// Either goal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Goal {
+    /// Dock.
+    Dock(DockGoal),
+    /// Undock (the departure).
+    Undock(UndockGoal),
+}
+
+/// Reads a `SendGoal` request: the goal id, then the goal of the action `dock` says.
+///
+/// # Errors
+/// [`CdrError`] naming the field.
+pub fn decode_send_goal(buf: &[u8], dock: bool) -> Result<(GoalId, Goal), CdrError> {
+    let mut r = CdrReader::new(buf)?;
+    let id = r.fixed_bytes::<16>("goal_id")?;
+    let goal = if dock {
+        let use_hint = r.u8("goal.use_dock_hint")? != 0;
+        let [x, y, theta] = r.f64s::<3>("goal.dock_hint")?;
+        let max_time = r.f32("goal.max_time")?;
+        Goal::Dock(DockGoal {
+            dock_hint: use_hint.then_some(Pose2 { x, y, theta }),
+            max_time,
+        })
+    } else {
+        Goal::Undock(UndockGoal {
+            max_time: r.f32("goal.max_time")?,
+        })
+    };
+    Ok((id, goal))
+}
+
+/// Writes a `SendGoal` request (what a client sends).
+pub fn encode_send_goal(buf: &mut Vec<u8>, id: &GoalId, goal: &Goal) {
+    let mut w = CdrWriter::new(buf);
+    w.fixed_bytes(id);
+    match goal {
+        Goal::Dock(g) => {
+            w.u8(u8::from(g.dock_hint.is_some()));
+            let p = g.dock_hint.unwrap_or_default();
+            for v in [p.x, p.y, p.theta] {
+                w.f64(v);
+            }
+            w.f32(g.max_time);
+        }
+        Goal::Undock(g) => w.f32(g.max_time),
+    }
+}
+
+/// Writes a `SendGoal` response.
+pub fn encode_send_goal_response(buf: &mut Vec<u8>, accepted: bool, t: Time) {
+    let mut w = CdrWriter::new(buf);
+    w.u8(u8::from(accepted));
+    w.i32(t.sec);
+    w.u32(t.nanosec);
+}
+
+/// Reads a `SendGoal` response: accepted or not.
+///
+/// # Errors
+/// [`CdrError`].
+pub fn decode_send_goal_response(buf: &[u8]) -> Result<bool, CdrError> {
+    Ok(CdrReader::new(buf)?.u8("accepted")? != 0)
+}
+
+/// Reads a request that is a goal id alone (`GetResult`), or a cancel request's goal id
+/// (`CancelGoal`'s `GoalInfo`, whose stamp follows and is not needed).
+///
+/// # Errors
+/// [`CdrError`].
+pub fn decode_goal_id(buf: &[u8]) -> Result<GoalId, CdrError> {
+    CdrReader::new(buf)?.fixed_bytes::<16>("goal_id")
+}
+
+/// Writes a request that is a goal id alone (`GetResult`).
+pub fn encode_goal_id(buf: &mut Vec<u8>, id: &GoalId) {
+    CdrWriter::new(buf).fixed_bytes(id);
+}
+
+/// How a goal ended, as its result says it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GoalResult {
+    /// `action_msgs/msg/GoalStatus` code: 4 succeeded, 5 canceled, 6 aborted.
+    pub status: i8,
+    /// Docked, or undocked.
+    pub success: bool,
+    /// Nav2's `DockRobot` error code (0 on success).
+    pub error_code: u16,
+    /// The typed outcome: `docked`, `completed`, a failure reason (`target_lost` …), or
+    /// the runtime's (`aborted: camera 0 driver panicked …`, `canceled`, `timeout`).
+    pub outcome: String,
+    /// Retries used (docking only).
+    pub num_retries: u16,
+}
+
+/// Writes a `GetResult` response for the action `dock` says.
+pub fn encode_result(buf: &mut Vec<u8>, r: &GoalResult, dock: bool) {
+    let mut w = CdrWriter::new(buf);
+    w.u8(r.status as u8);
+    w.u8(u8::from(r.success));
+    w.u16(r.error_code);
+    w.string(&r.outcome);
+    if dock {
+        w.u16(r.num_retries);
+    }
+}
+
+/// Reads a `GetResult` response.
+///
+/// # Errors
+/// [`CdrError`] naming the field.
+pub fn decode_result(buf: &[u8], dock: bool) -> Result<GoalResult, CdrError> {
+    let mut r = CdrReader::new(buf)?;
+    let status = r.u8("status")? as i8;
+    let success = r.u8("result.success")? != 0;
+    let error_code = r.u16("result.error_code")?;
+    let outcome = r.string("result.outcome")?.to_owned();
+    let num_retries = if dock { r.u16("result.num_retries")? } else { 0 };
+    Ok(GoalResult {
+        status,
+        success,
+        error_code,
+        outcome,
+        num_retries,
+    })
+}
+
+/// A goal's progress (`<action>_Feedback`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GoalFeedback {
+    /// The active phase (`search`, `approach`, `back_in` …).
+    pub phase: String,
+    /// Since the goal started, ns.
+    pub elapsed_ns: i64,
+    /// Retries used so far.
+    pub num_retries: u16,
+}
+
+/// Writes a `FeedbackMessage`: the goal id and the feedback.
+pub fn encode_feedback(buf: &mut Vec<u8>, id: &GoalId, f: &GoalFeedback) {
+    let mut w = CdrWriter::new(buf);
+    w.fixed_bytes(id);
+    w.string(&f.phase);
+    let d = stamp(f.elapsed_ns);
+    w.i32(d.sec);
+    w.u32(d.nanosec);
+    w.u16(f.num_retries);
+}
+
+/// Reads a `FeedbackMessage`.
+///
+/// # Errors
+/// [`CdrError`] naming the field.
+pub fn decode_feedback(buf: &[u8]) -> Result<(GoalId, GoalFeedback), CdrError> {
+    let mut r = CdrReader::new(buf)?;
+    let id = r.fixed_bytes::<16>("goal_id")?;
+    let phase = r.string("feedback.phase")?.to_owned();
+    let sec = r.i32("feedback.elapsed.sec")?;
+    let nanosec = r.u32("feedback.elapsed.nanosec")?;
+    let num_retries = r.u16("feedback.num_retries")?;
+    Ok((
+        id,
+        GoalFeedback {
+            phase,
+            elapsed_ns: i64::from(sec) * 1_000_000_000 + i64::from(nanosec),
+            num_retries,
+        },
+    ))
+}
+
+/// Writes an `action_msgs/msg/GoalStatusArray` of `(id, accepted at, status)`.
+pub fn encode_status(buf: &mut Vec<u8>, goals: &[(GoalId, Time, i8)]) {
+    let mut w = CdrWriter::new(buf);
+    w.u32(goals.len() as u32);
+    for (id, t, status) in goals {
+        w.fixed_bytes(id);
+        w.i32(t.sec);
+        w.u32(t.nanosec);
+        w.u8(*status as u8);
+    }
+}
+
+/// Writes an `action_msgs/srv/CancelGoal` response: return code (0 accepted, 2 unknown
+/// goal, 3 terminated) and the goals now canceling.
+pub fn encode_cancel_response(buf: &mut Vec<u8>, code: i8, canceling: &[(GoalId, Time)]) {
+    let mut w = CdrWriter::new(buf);
+    w.u8(code as u8);
+    w.u32(canceling.len() as u32);
+    for (id, t) in canceling {
+        w.fixed_bytes(id);
+        w.i32(t.sec);
+        w.u32(t.nanosec);
+    }
+}
+
+/// Writes a `CancelGoal` request for one goal (stamp zero).
+pub fn encode_cancel_request(buf: &mut Vec<u8>, id: &GoalId) {
+    let mut w = CdrWriter::new(buf);
+    w.fixed_bytes(id);
+    w.i32(0);
+    w.u32(0);
+}
+
+/// Reads a `CancelGoal` response's return code.
+///
+/// # Errors
+/// [`CdrError`].
+pub fn decode_cancel_response(buf: &[u8]) -> Result<i8, CdrError> {
+    Ok(CdrReader::new(buf)?.u8("return_code")? as i8)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::replay::cdr::{decode_image, decode_odometry};
+
+    #[test]
+    fn twist_layout_is_six_float64_after_the_header() {
+        let mut b = Vec::new();
+        Twist {
+            linear_x: 0.25,
+            angular_z: -0.5,
+        }
+        .encode(&mut b);
+        assert_eq!(b.len(), 4 + 48);
+        assert_eq!(&b[4..12], &0.25f64.to_le_bytes());
+        assert_eq!(&b[44..52], &(-0.5f64).to_le_bytes());
+        assert_eq!(
+            Twist::decode(&b).unwrap(),
+            Twist {
+                linear_x: 0.25,
+                angular_z: -0.5
+            }
+        );
+        assert!(Twist::decode(&b[..40]).is_err());
+    }
+
+    #[test]
+    fn image_and_odometry_encoders_match_the_replay_decoders() {
+        let mut b = Vec::new();
+        encode_image(&mut b, stamp(1_500_000_000), "cam0", 2, 1, &[1, 2, 3, 4, 5, 6]);
+        let im = decode_image(&b).unwrap();
+        assert_eq!((im.width, im.height, im.encoding, im.step), (2, 1, "rgb8", 6));
+        assert_eq!(im.data, &[1, 2, 3, 4, 5, 6]);
+        assert_eq!((im.header.stamp.sec, im.header.stamp.nanosec), (1, 500_000_000));
+        let p = Pose2 {
+            x: 1.0,
+            y: -2.0,
+            theta: 0.5,
+        };
+        encode_odometry(&mut b, stamp(3), p, 0.1, -0.2);
+        let o = decode_odometry(&b).unwrap();
+        let back = o.pose2();
+        assert!((back.x - 1.0).abs() < 1e-12 && (back.y + 2.0).abs() < 1e-12 && (back.theta - 0.5).abs() < 1e-12);
+        assert_eq!((o.linear[0], o.angular[2]), (0.1, -0.2));
+    }
+
+    #[test]
+    fn goals_results_and_feedback_round_trip() {
+        let id = [9u8; 16];
+        let mut b = Vec::new();
+        let dock = Goal::Dock(DockGoal {
+            dock_hint: Some(Pose2 {
+                x: 1.0,
+                y: 2.0,
+                theta: 3.0,
+            }),
+            max_time: 60.0,
+        });
+        encode_send_goal(&mut b, &id, &dock);
+        assert_eq!(decode_send_goal(&b, true).unwrap(), (id, dock));
+        let undock = Goal::Undock(UndockGoal { max_time: 5.0 });
+        encode_send_goal(&mut b, &id, &undock);
+        assert_eq!(decode_send_goal(&b, false).unwrap(), (id, undock));
+        assert!(decode_send_goal(&b[..10], false).is_err());
+
+        let r = GoalResult {
+            status: 6,
+            success: false,
+            error_code: 904,
+            outcome: "target_lost".into(),
+            num_retries: 2,
+        };
+        encode_result(&mut b, &r, true);
+        assert_eq!(decode_result(&b, true).unwrap(), r);
+
+        let f = GoalFeedback {
+            phase: "approach".into(),
+            elapsed_ns: 12_300_000_000,
+            num_retries: 1,
+        };
+        encode_feedback(&mut b, &id, &f);
+        assert_eq!(decode_feedback(&b).unwrap(), (id, f));
+
+        encode_send_goal_response(&mut b, true, stamp(5));
+        assert!(decode_send_goal_response(&b).unwrap());
+        encode_cancel_request(&mut b, &id);
+        assert_eq!(decode_goal_id(&b).unwrap(), id);
+        encode_cancel_response(&mut b, 0, &[(id, stamp(0))]);
+        assert_eq!(decode_cancel_response(&b).unwrap(), 0);
+    }
+
+    #[test]
+    fn negative_durations_keep_their_value() {
+        let t = stamp(-1);
+        assert_eq!((t.sec, t.nanosec), (-1, 999_999_999));
+    }
+}
