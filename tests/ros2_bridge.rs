@@ -412,7 +412,11 @@ fn the_node_answers_in_its_own_domain_only() {
     let (node, name, locator) = node(&prepared, 61);
     let sess = session(&locator);
     // The test's own session listens nowhere: it only connects to the node's locator.
-    assert_eq!(sess.info().locators().wait(), Vec::new(), "the client session listens on nothing");
+    assert_eq!(
+        sess.info().locators().wait(),
+        Vec::new(),
+        "the client session listens on nothing"
+    );
     let other = NodeName {
         domain: 62,
         ..name.clone()
