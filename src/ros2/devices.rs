@@ -7,7 +7,7 @@
 //! Each subscription's callback (on Zenoh's threads) only stores the latest payload; the
 //! device decodes it when the runtime asks, so a slow decode never backs Zenoh up.
 
-use super::keys::{Attachment, now_ns};
+use super::keys::{RmwPublisher, now_ns};
 use crate::kinematics::DriveCommand;
 use crate::perception::RgbImage;
 use crate::replay::cdr::{decode_compressed_image, decode_image, decode_odometry};
@@ -16,7 +16,7 @@ use crate::schemas::OdometryReading;
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::Duration;
 use zenoh::Wait;
-use zenoh::pubsub::{Publisher, Subscriber};
+use zenoh::pubsub::Subscriber;
 
 /// The latest payload of a topic, and a condition to wait on for a new one.
 #[derive(Default)]
@@ -185,18 +185,14 @@ impl Odometer for TopicOdometer {
 
 /// A base driven by `geometry_msgs/msg/Twist` on `cmd_vel`.
 pub struct TwistDrive {
-    publisher: Publisher<'static>,
-    gid: [u8; 16],
-    sequence: i64,
+    out: RmwPublisher,
     buf: Vec<u8>,
 }
 
 impl TwistDrive {
-    pub(super) fn new(publisher: Publisher<'static>, gid: [u8; 16]) -> Self {
+    pub(super) fn new(out: RmwPublisher) -> Self {
         Self {
-            publisher,
-            gid,
-            sequence: 0,
+            out,
             buf: Vec::with_capacity(64),
         }
     }
@@ -210,20 +206,10 @@ impl Drive for TwistDrive {
             angular_z: t.omega,
         }
         .encode(&mut self.buf);
-        self.sequence += 1;
-        let att = Attachment {
-            sequence_number: self.sequence,
-            source_timestamp: now_ns(),
-            gid: self.gid,
-        };
-        self.publisher
-            .put(self.buf.as_slice())
-            .attachment(att.encode())
-            .wait()
-            .map_err(|e| HardwareError::Fault {
-                device: "cmd_vel".to_owned(),
-                detail: e.to_string(),
-            })
+        self.out.put(&self.buf).map_err(|detail| HardwareError::Fault {
+            device: "cmd_vel".to_owned(),
+            detail,
+        })
     }
 }
 

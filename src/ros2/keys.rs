@@ -15,6 +15,9 @@
 //!   and client GID.
 
 use super::interfaces::Interface;
+use std::sync::atomic::{AtomicI64, Ordering};
+use zenoh::Wait;
+use zenoh::pubsub::Publisher;
 
 /// Where the node's names live: the ROS domain and namespace, and the node's name.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -123,6 +126,47 @@ impl Attachment {
             source_timestamp: i64_at(8),
             gid,
         })
+    }
+}
+
+/// A publisher that sends each message with `rmw_zenoh`'s attachment: its own GID (its
+/// liveliness token's) and a sequence number counting its messages from 1.
+pub struct RmwPublisher {
+    publisher: Publisher<'static>,
+    gid: [u8; 16],
+    sequence: AtomicI64,
+}
+
+impl RmwPublisher {
+    /// Wraps `publisher`, whose entity's GID is `gid`.
+    pub fn new(publisher: Publisher<'static>, gid: [u8; 16]) -> Self {
+        Self {
+            publisher,
+            gid,
+            sequence: AtomicI64::new(0),
+        }
+    }
+
+    /// Publishes `payload` (a CDR message).
+    ///
+    /// # Errors
+    /// Zenoh's, as text.
+    pub fn put(&self, payload: &[u8]) -> Result<(), String> {
+        let att = Attachment {
+            sequence_number: self.sequence.fetch_add(1, Ordering::Relaxed) + 1,
+            source_timestamp: now_ns(),
+            gid: self.gid,
+        };
+        self.publisher
+            .put(payload)
+            .attachment(att.encode())
+            .wait()
+            .map_err(|e| e.to_string())
+    }
+
+    /// The key expression it publishes on.
+    pub fn key(&self) -> String {
+        self.publisher.key_expr().to_string()
     }
 }
 

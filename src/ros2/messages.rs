@@ -241,15 +241,16 @@ pub struct GoalFeedback {
     pub num_retries: u16,
 }
 
-/// Writes a `FeedbackMessage`: the goal id and the feedback.
-pub fn encode_feedback(buf: &mut Vec<u8>, id: &GoalId, f: &GoalFeedback) {
+/// Writes a `FeedbackMessage`: the goal id and the feedback's phase, elapsed time (ns)
+/// and retries, borrowed, so the loop's feedback allocates nothing.
+pub fn encode_feedback(buf: &mut Vec<u8>, id: &GoalId, phase: &str, elapsed_ns: i64, num_retries: u16) {
     let mut w = CdrWriter::new(buf);
     w.fixed_bytes(id);
-    w.string(&f.phase);
-    let d = stamp(f.elapsed_ns);
+    w.string(phase);
+    let d = stamp(elapsed_ns);
     w.i32(d.sec);
     w.u32(d.nanosec);
-    w.u16(f.num_retries);
+    w.u16(num_retries);
 }
 
 /// Reads a `FeedbackMessage`.
@@ -394,7 +395,7 @@ mod tests {
             elapsed_ns: 12_300_000_000,
             num_retries: 1,
         };
-        encode_feedback(&mut b, &id, &f);
+        encode_feedback(&mut b, &id, &f.phase, f.elapsed_ns, f.num_retries);
         assert_eq!(decode_feedback(&b).unwrap(), (id, f));
 
         encode_send_goal_response(&mut b, true, stamp(5));

@@ -21,10 +21,10 @@
 
 use super::devices::{ImageKind, TopicCamera, TopicOdometer, TwistDrive, subscribe};
 use super::interfaces::{self, Interface};
-use super::keys::{Attachment, NodeName, gid, now_ns};
+use super::keys::{Attachment, NodeName, RmwPublisher, gid, now_ns};
 use super::messages::{
-    Goal, GoalFeedback, GoalId, GoalResult, decode_goal_id, decode_send_goal, encode_cancel_response, encode_feedback,
-    encode_result, encode_send_goal_response, encode_status, stamp,
+    Goal, GoalId, GoalResult, decode_goal_id, decode_send_goal, encode_cancel_response, encode_feedback, encode_result,
+    encode_send_goal_response, encode_status, stamp,
 };
 use crate::arbiter::ReactiveLoop;
 use crate::arbiter::reactive_loop::LoopStatus;
@@ -42,7 +42,6 @@ use std::thread::JoinHandle;
 use std::time::Duration;
 use thiserror::Error;
 use zenoh::Wait;
-use zenoh::pubsub::Publisher;
 use zenoh::query::Query;
 
 /// Why the node could not start.
@@ -208,9 +207,8 @@ struct Shared {
     /// Raised when the node closes: the worker ends after the goal it runs.
     closing: AtomicBool,
     jobs: Sender<Job>,
-    status: [Publisher<'static>; 2],
-    feedback: [Publisher<'static>; 2],
-    gids: [[u8; 16]; 2],
+    status: [RmwPublisher; 2],
+    feedback: [RmwPublisher; 2],
 }
 
 impl Shared {
@@ -218,7 +216,7 @@ impl Shared {
         let list: Vec<_> = g.recent[which as usize].iter().copied().collect();
         let mut buf = Vec::new();
         encode_status(&mut buf, &list);
-        put(&self.status[which as usize], buf, self.gids[which as usize]);
+        let _ = self.status[which as usize].put(&buf);
     }
 
     fn set_status(&self, which: Which, id: &GoalId, code: i8) {
@@ -253,15 +251,6 @@ impl Shared {
             g.results.pop_front();
         }
     }
-}
-
-fn put(p: &Publisher<'static>, payload: Vec<u8>, gid: [u8; 16]) {
-    let att = Attachment {
-        sequence_number: 0,
-        source_timestamp: now_ns(),
-        gid,
-    };
-    let _ = p.put(payload).attachment(att.encode()).wait();
 }
 
 /// Replies to a service request, echoing its sequence number and client GID as
@@ -372,7 +361,7 @@ impl Ros2Node {
             .declare_publisher(node.key(&config.cmd_vel, &twist))
             .wait()
             .map_err(zerr)?;
-        let mut robot = Robot::new(cameras, Box::new(TwistDrive::new(cmd, drive_gid)));
+        let mut robot = Robot::new(cameras, Box::new(TwistDrive::new(RmwPublisher::new(cmd, drive_gid))));
         if let Some(topic) = &config.odometry {
             let ty = interfaces::odometry();
             token(&mut declared, "MS", topic, &ty)?;
@@ -393,7 +382,7 @@ impl Ros2Node {
         let mut aux = |name: &str, ty: &Interface| -> Result<AuxTopic, BridgeError> {
             let g = token(&mut declared, "MP", name, ty)?;
             let p = session.declare_publisher(node.key(name, ty)).wait().map_err(zerr)?;
-            Ok(AuxTopic { publisher: p, gid: g })
+            Ok(AuxTopic(RmwPublisher::new(p, g)))
         };
         robot.posture = Some(Box::new(aux("posture", &string)?));
         robot.guides = Some(Box::new(aux("dock_guides", &string)?));
@@ -404,26 +393,17 @@ impl Ros2Node {
         let status_ty = interfaces::goal_status_array();
         let mut status = Vec::new();
         let mut feedback = Vec::new();
-        let mut gids = Vec::new();
         for which in [Which::Dock, Which::Undock] {
             let a = interfaces::action(which.interface());
             let base = format!("{}/_action", which.action());
             let fb_name = format!("{base}/feedback");
             let st_name = format!("{base}/status");
-            gids.push(token(&mut declared, "MP", &fb_name, &a.feedback)?);
-            token(&mut declared, "MP", &st_name, &status_ty)?;
-            feedback.push(
-                session
-                    .declare_publisher(node.key(&fb_name, &a.feedback))
-                    .wait()
-                    .map_err(zerr)?,
-            );
-            status.push(
-                session
-                    .declare_publisher(node.key(&st_name, &status_ty))
-                    .wait()
-                    .map_err(zerr)?,
-            );
+            let fb_gid = token(&mut declared, "MP", &fb_name, &a.feedback)?;
+            let st_gid = token(&mut declared, "MP", &st_name, &status_ty)?;
+            let publisher =
+                |name: &str, ty: &Interface| session.declare_publisher(node.key(name, ty)).wait().map_err(zerr);
+            feedback.push(RmwPublisher::new(publisher(&fb_name, &a.feedback)?, fb_gid));
+            status.push(RmwPublisher::new(publisher(&st_name, &status_ty)?, st_gid));
         }
         let (jobs_tx, jobs_rx) = unbounded();
         let shared = Arc::new(Shared {
@@ -432,7 +412,6 @@ impl Ros2Node {
             jobs: jobs_tx,
             status: to_pair(status),
             feedback: to_pair(feedback),
-            gids: [gids[0], gids[1]],
         });
         for which in [Which::Dock, Which::Undock] {
             let a = interfaces::action(which.interface());
@@ -669,20 +648,8 @@ impl Progress {
             return;
         }
         self.last = Some((phase, t));
-        encode_feedback(
-            &mut self.buf,
-            &self.id,
-            &GoalFeedback {
-                phase: phase.to_owned(),
-                elapsed_ns: (t * 1e9) as i64,
-                num_retries: self.retries,
-            },
-        );
-        put(
-            &sh.feedback[self.which as usize],
-            self.buf.clone(),
-            sh.gids[self.which as usize],
-        );
+        encode_feedback(&mut self.buf, &self.id, phase, (t * 1e9) as i64, self.retries);
+        let _ = sh.feedback[self.which as usize].put(&self.buf);
     }
 }
 
@@ -722,26 +689,14 @@ fn error_code(r: FailureReason, dock: bool) -> u16 {
 }
 
 /// An auxiliary actuator published as a topic.
-struct AuxTopic {
-    publisher: Publisher<'static>,
-    gid: [u8; 16],
-}
+struct AuxTopic(RmwPublisher);
 
 impl AuxTopic {
     fn send(&self, payload: Vec<u8>) -> Result<(), HardwareError> {
-        let att = Attachment {
-            sequence_number: 0,
-            source_timestamp: now_ns(),
-            gid: self.gid,
-        };
-        self.publisher
-            .put(payload)
-            .attachment(att.encode())
-            .wait()
-            .map_err(|e| HardwareError::Fault {
-                device: self.publisher.key_expr().to_string(),
-                detail: e.to_string(),
-            })
+        self.0.put(&payload).map_err(|detail| HardwareError::Fault {
+            device: self.0.key(),
+            detail,
+        })
     }
 }
 
