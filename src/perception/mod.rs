@@ -16,6 +16,7 @@
 //! * [`sct`] and [`hsv`]: colour spaces, exact per pixel and fast over whole frames.
 //! * [`cast`]: removing fast colour casts (a flashing coloured light) before segmentation.
 //! * [`segment`]: per-colour ranges into reusable [`Mask`]s (the SCT test is trig-free).
+//! * [`spurs`]: the pixels that stick out of a block's edge (noise touching it), kept out of its count.
 //! * [`components`]: 8-connected labelling with per-component moments.
 //! * [`colour_model`]: imprinting, adaptation and the fallback chain of seed 004 Fig. 5.
 //! * [`hsv_stats`]: the HSV statistics that chain uses for RAPOSA's bands.
@@ -45,6 +46,7 @@ pub mod pyramid_pose;
 pub mod pyramid_tracker;
 pub mod sct;
 pub mod segment;
+pub mod spurs;
 pub mod two_block;
 pub mod two_block_pose;
 

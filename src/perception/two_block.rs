@@ -32,6 +32,7 @@ use super::components::Labeler;
 use super::image::RgbView;
 use super::sct::Sct;
 use super::segment::{ColorRange, Mask, SctRange, Segmenter};
+use super::spurs::spur_count;
 use super::{VisionError, check_same_size};
 use serde::Serialize;
 
@@ -268,7 +269,21 @@ impl TwoBlockDetector {
                 }
             }
         }
-        Ok(best.map(|(_, _, p)| p))
+        Ok(best.map(|(_, _, p)| self.without_spurs(p)))
+    }
+
+    /// `pair` with each block's spurs taken out of its count and the ratio recomputed:
+    /// noise pixels touching a block are not paint (`spurs`). The blocks' boxes and
+    /// centroids, and the pairing that chose them, are left as detected.
+    fn without_spurs(&self, mut pair: Pair) -> Pair {
+        for (c, block) in [&mut pair.left, &mut pair.right].into_iter().enumerate() {
+            let runs = self.labelers[c].runs().iter().filter(|r| r.label == block.component);
+            let spurs = spur_count(&self.masks[c], runs);
+            block.count = block.count.saturating_sub(spurs).max(1);
+        }
+        let (l, r) = (pair.left.count, pair.right.count);
+        pair.ratio = l.min(r) as f64 / l.max(r) as f64;
+        pair
     }
 
     /// SCT statistics of the pixels of each accepted block (fast SCT path), for
@@ -281,7 +296,12 @@ impl TwoBlockDetector {
         let bytes = view.as_bytes();
         let w = view.width();
         for (c, block) in [pair.left, pair.right].iter().enumerate() {
-            let stride = block.count.div_ceil(MAX_ADAPT_SAMPLES).max(1) as usize;
+            // The component's whole count, spurs included: those are the pixels sampled.
+            let pixels = self.labelers[c]
+                .components()
+                .get(block.component as usize)
+                .map_or(block.count, |k| k.count);
+            let stride = pixels.div_ceil(MAX_ADAPT_SAMPLES).max(1) as usize;
             let mut k = 0usize;
             for run in self.labelers[c].runs().iter().filter(|r| r.label == block.component) {
                 let row = run.y as usize * w;

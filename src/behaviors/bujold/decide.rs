@@ -61,6 +61,13 @@ pub fn at_dock_decision(
     }
 }
 
+/// The heading margin for a decision after `retries` of `max_retries`: the margin is
+/// insurance for a robot that can still retry, so the last decision (a "no" would end
+/// the mission in a certain failure) backs in within the tolerance fraction alone.
+fn heading_margin(margin: f64, retries: u32, max_retries: u32) -> f64 {
+    if retries >= max_retries { 0.0 } else { margin }
+}
+
 /// See the module docs.
 pub struct Decide {
     name: String,
@@ -126,7 +133,7 @@ impl Behavior for Decide {
             self.tol_lateral,
             self.tol_heading,
             self.params.tolerance_fraction,
-            self.params.heading_margin_deg.to_radians(),
+            heading_margin(self.params.heading_margin_deg.to_radians(), m.retries, self.max_retries),
         );
         tracing::debug!(target: "marsupial::behavior", now = m.now, back_in = d.back_in, alpha_deg = d.alpha.to_degrees(), heading_deg = d.heading.to_degrees(), distance = d.distance, lateral_m = d.lateral_at_entrance, "at-dock decision");
         if d.back_in {
@@ -216,6 +223,19 @@ mod tests {
         let small = 0.5f64.to_radians();
         assert!(!at_dock_decision(&[view(4.2, 4.2); 5], 0.15, 0.02, tol, 0.8, small).back_in);
         assert!(at_dock_decision(&[view(3.9, 3.9); 5], 0.15, 0.02, tol, 0.8, small).back_in);
+    }
+
+    #[test]
+    fn the_last_decision_drops_the_margin() {
+        let margin = 2f64.to_radians();
+        assert_eq!(heading_margin(margin, 0, 2), margin);
+        assert_eq!(heading_margin(margin, 1, 2), margin);
+        assert_eq!(heading_margin(margin, 2, 2), 0.0);
+        // A heading of 3.4° is refused with the margin and taken without it.
+        let s = [view(3.4, 3.4)];
+        let tol = 5f64.to_radians();
+        assert!(!at_dock_decision(&s, 0.2, 0.02, tol, 0.8, heading_margin(margin, 1, 2)).back_in);
+        assert!(at_dock_decision(&s, 0.2, 0.02, tol, 0.8, heading_margin(margin, 2, 2)).back_in);
     }
 
     #[test]

@@ -147,7 +147,9 @@ pub struct DecideParams {
     pub tolerance_fraction: f64,
     /// And only with the heading at least this far inside its tolerance, degrees: the
     /// error of the heading estimate at the gate, which the blind back-in cannot correct.
-    /// Default 0 (the fraction alone).
+    /// Default 0 (the fraction alone). The margin is insurance for a robot that can still
+    /// retry: the last decision, with the retries used up, backs in within the fraction
+    /// alone, since declining it ends the mission in a certain failure.
     pub heading_margin_deg: f64,
 }
 
