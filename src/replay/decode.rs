@@ -34,7 +34,7 @@ impl DecodeError {
             DecodeError::Cdr(_) => "cdr",
             DecodeError::Foxglove(_) => "json",
             DecodeError::Pixels(P::Unsupported { .. }) => "unsupported_encoding",
-            DecodeError::Pixels(P::Size { .. } | P::Buffer { .. }) => "bad_size",
+            DecodeError::Pixels(P::Size { .. } | P::Buffer { .. } | P::Frame { .. }) => "bad_size",
             DecodeError::Pixels(P::Decode { .. }) => "undecodable_image",
             DecodeError::Kind(_) => "kind",
         }

@@ -49,6 +49,18 @@ pub enum PixelError {
         /// Bytes given.
         got: usize,
     },
+    /// The image's size is not that of the frame it is to fill.
+    #[error("image is {width}×{height}, the frame to fill is {frame_width}×{frame_height}")]
+    Frame {
+        /// The image's columns.
+        width: u32,
+        /// The image's rows.
+        height: u32,
+        /// The frame's columns.
+        frame_width: usize,
+        /// The frame's rows.
+        frame_height: usize,
+    },
     /// Compressed bytes that do not decode.
     #[error("`{format}` data does not decode: {why}")]
     Decode {
@@ -95,8 +107,63 @@ fn refusal(encoding: &str) -> &'static str {
 /// assert!(rgb_from_raw(2, 1, "bayer_rggb8", 2, &[0, 0]).is_err());
 /// ```
 pub fn rgb_from_raw(width: u32, height: u32, encoding: &str, step: u32, data: &[u8]) -> Result<RgbImage, PixelError> {
-    // (bytes per pixel, index of R, G, B within the pixel)
-    let (bpp, [r, g, b]) = match encoding {
+    let layout = raw_layout(width, height, encoding, step, data)?;
+    // Validated first, so a bad message never sizes an allocation.
+    let mut out = RgbImage::new(width as usize, height as usize);
+    convert_raw(&layout, step, data, &mut out);
+    Ok(out)
+}
+
+/// [`rgb_from_raw`] into a caller's frame of the same size, so that a camera loop
+/// converts each message without allocating (`ros2::devices::TopicCamera`).
+///
+/// # Errors
+/// As [`rgb_from_raw`], and [`PixelError::Frame`] when `out` is not `width × height`
+/// (`out` is then left as it was).
+///
+/// # Example
+///
+/// ```
+/// use marsupial::perception::RgbImage;
+/// use marsupial::replay::pixels::rgb_into_raw;
+///
+/// let mut frame = RgbImage::new(1, 1);
+/// rgb_into_raw(1, 1, "mono8", 1, &[7], &mut frame).unwrap();
+/// assert_eq!(frame.as_bytes(), &[7, 7, 7]);
+/// assert!(rgb_into_raw(2, 1, "mono8", 2, &[7, 7], &mut frame).is_err());
+/// ```
+pub fn rgb_into_raw(
+    width: u32,
+    height: u32,
+    encoding: &str,
+    step: u32,
+    data: &[u8],
+    out: &mut RgbImage,
+) -> Result<(), PixelError> {
+    let layout = raw_layout(width, height, encoding, step, data)?;
+    if (out.width(), out.height()) != (width as usize, height as usize) {
+        return Err(PixelError::Frame {
+            width,
+            height,
+            frame_width: out.width(),
+            frame_height: out.height(),
+        });
+    }
+    convert_raw(&layout, step, data, out);
+    Ok(())
+}
+
+/// A raw buffer's validated layout: bytes per pixel, the index of R, G and B within a
+/// pixel, and the bytes in one row of pixels.
+struct RawLayout {
+    bpp: usize,
+    rgb: [usize; 3],
+    row: usize,
+}
+
+/// Checks the encoding, the sides and the buffer, in that order.
+fn raw_layout(width: u32, height: u32, encoding: &str, step: u32, data: &[u8]) -> Result<RawLayout, PixelError> {
+    let (bpp, rgb) = match encoding {
         "rgb8" | "RGB8" => (3, [0, 1, 2]),
         "bgr8" | "BGR8" => (3, [2, 1, 0]),
         "rgba8" | "RGBA8" => (4, [0, 1, 2]),
@@ -126,17 +193,19 @@ pub fn rgb_from_raw(width: u32, height: u32, encoding: &str, step: u32, data: &[
             got: data.len(),
         });
     }
-    let mut out = Vec::with_capacity(w * h * 3);
-    for y in 0..h {
-        let src = &data[y * step as usize..y * step as usize + row];
-        for px in src.chunks_exact(bpp) {
-            out.extend_from_slice(&[px[r], px[g], px[b]]);
+    Ok(RawLayout { bpp, rgb, row })
+}
+
+/// Copies a validated buffer into `out`, which is its size.
+fn convert_raw(layout: &RawLayout, step: u32, data: &[u8], out: &mut RgbImage) {
+    let [r, g, b] = layout.rgb;
+    let dst_row = out.width() * 3;
+    for (y, dst) in out.as_bytes_mut().chunks_exact_mut(dst_row).enumerate() {
+        let src = &data[y * step as usize..y * step as usize + layout.row];
+        for (d, px) in dst.chunks_exact_mut(3).zip(src.chunks_exact(layout.bpp)) {
+            d.copy_from_slice(&[px[r], px[g], px[b]]);
         }
     }
-    RgbImage::from_raw(w, h, out).map_err(|e| PixelError::Decode {
-        format: encoding.to_string(),
-        why: e.to_string(),
-    })
 }
 
 /// Packed RGB8 from a compressed image (`format` as logged: `jpeg`, `png`, or
@@ -200,6 +269,29 @@ mod tests {
         assert_eq!(px("rgba8", &[1, 2, 3, 4], 4), [1, 2, 3]);
         assert_eq!(px("bgra8", &[1, 2, 3, 4], 4), [3, 2, 1]);
         assert_eq!(px("mono8", &[7], 1), [7, 7, 7]);
+    }
+
+    proptest::proptest! {
+        /// Filling a frame gives what allocating one gives, for every encoding, pad and
+        /// size, and refuses a frame of another size without touching it.
+        #[test]
+        fn into_a_frame_matches_a_new_one(
+            w in 1u32..9, h in 1u32..9, enc in 0usize..7, pad in 0u32..5, seed in proptest::prelude::any::<u64>()
+        ) {
+            let (name, bpp) = [("rgb8", 3), ("bgr8", 3), ("rgba8", 4), ("bgra8", 4), ("mono8", 1), ("8UC1", 1), ("BGR8", 3)][enc];
+            let step = w * bpp + pad;
+            let mut x = seed | 1;
+            let data: Vec<u8> = (0..step * h).map(|_| { x ^= x << 13; x ^= x >> 7; x ^= x << 17; x as u8 }).collect();
+            let want = rgb_from_raw(w, h, name, step, &data).unwrap();
+            let mut frame = RgbImage::new(w as usize, h as usize);
+            rgb_into_raw(w, h, name, step, &data, &mut frame).unwrap();
+            proptest::prop_assert_eq!(frame.as_bytes(), want.as_bytes());
+            let mut other = RgbImage::new(w as usize + 1, h as usize);
+            let before = other.as_bytes().to_vec();
+            let is_frame_error = matches!(rgb_into_raw(w, h, name, step, &data, &mut other), Err(PixelError::Frame { .. }));
+            proptest::prop_assert!(is_frame_error);
+            proptest::prop_assert_eq!(other.as_bytes(), &before[..]);
+        }
     }
 
     #[test]

@@ -11,6 +11,7 @@ use super::keys::{RmwPublisher, now_ns};
 use crate::kinematics::DriveCommand;
 use crate::perception::RgbImage;
 use crate::replay::cdr::{decode_compressed_image, decode_image, decode_odometry};
+use crate::replay::pixels::rgb_into_raw;
 use crate::robot::{Camera, Drive, Exposure, HardwareError, Odometer};
 use crate::schemas::OdometryReading;
 use std::sync::{Arc, Condvar, Mutex};
@@ -101,6 +102,17 @@ impl TopicCamera {
         }
     }
 
+    /// A frame of another size than the profile's camera is a fault, named.
+    fn check_size(&self, width: usize, height: usize) -> Result<(), HardwareError> {
+        if (width, height) == self.size {
+            return Ok(());
+        }
+        Err(self.fault(format!(
+            "frame is {width}x{height}, the profile's camera is {}x{}",
+            self.size.0, self.size.1
+        )))
+    }
+
     fn fault(&self, detail: String) -> HardwareError {
         HardwareError::Fault {
             device: format!("camera on {}", self.topic),
@@ -118,26 +130,24 @@ impl Camera for TopicCamera {
         let Some(payload) = self.frames.take(self.wait) else {
             return Err(HardwareError::NotReady);
         };
-        let (rgb, stamp) = match self.kind {
+        // A raw frame is converted straight into the loop's frame; a compressed one goes
+        // through its decoder's own buffer (the JPEG and PNG decoders allocate).
+        let stamp = match self.kind {
             ImageKind::Raw => {
                 let im = decode_image(&payload).map_err(|e| self.fault(e.to_string()))?;
-                (im.to_rgb().map_err(|e| self.fault(e.to_string()))?, im.header.stamp)
+                self.check_size(im.width as usize, im.height as usize)?;
+                rgb_into_raw(im.width, im.height, im.encoding, im.step, im.data, frame)
+                    .map_err(|e| self.fault(e.to_string()))?;
+                im.header.stamp
             }
             ImageKind::Compressed => {
                 let im = decode_compressed_image(&payload).map_err(|e| self.fault(e.to_string()))?;
-                (im.to_rgb().map_err(|e| self.fault(e.to_string()))?, im.header.stamp)
+                let rgb = im.to_rgb().map_err(|e| self.fault(e.to_string()))?;
+                self.check_size(rgb.width(), rgb.height())?;
+                frame.as_bytes_mut().copy_from_slice(rgb.as_bytes());
+                im.header.stamp
             }
         };
-        if (rgb.width(), rgb.height()) != self.size {
-            return Err(self.fault(format!(
-                "frame is {}x{}, the profile's camera is {}x{}",
-                rgb.width(),
-                rgb.height(),
-                self.size.0,
-                self.size.1
-            )));
-        }
-        frame.as_bytes_mut().copy_from_slice(rgb.as_bytes());
         let age = match stamp.ns() {
             Some(ns) if self.trust_stamps => {
                 let age = now_ns() - ns as i64;
