@@ -334,8 +334,8 @@ fn bujold_docks_over_the_bridge_from_three_starts_as_in_process() {
 }
 
 /// A camera that falls silent puts the robot in a safe stop (the runtime's staleness
-/// limit), reported in the feedback; a cancel then ends the goal `canceled` and the
-/// last command on `cmd_vel` is a stop.
+/// limit), reported in the feedback; a cancel then ends the goal `canceled`, the status
+/// topic follows it there, and the last command on `cmd_vel` is a stop.
 #[test]
 fn a_silent_camera_safe_stops_and_a_cancel_ends_the_goal() {
     let prepared = table1();
@@ -357,6 +357,11 @@ fn a_silent_camera_safe_stops_and_a_cancel_ends_the_goal() {
     let fb = feedback.clone();
     let _fb = client
         .on_feedback(true, move |_, f| fb.lock().unwrap().push(f))
+        .unwrap();
+    let statuses = Arc::new(Mutex::new(Vec::new()));
+    let st = statuses.clone();
+    let _st = client
+        .on_status(true, move |goals| st.lock().unwrap().push(goals))
         .unwrap();
     let id = send(&client, &Goal::Dock(DockGoal::default()));
     // The behavior runs while frames come, then the camera falls silent and the safe stop
@@ -395,6 +400,22 @@ fn a_silent_camera_safe_stops_and_a_cancel_ends_the_goal() {
         *last_cmd.lock().unwrap(),
         Some(Twist::default()),
         "the robot was left stopped"
+    );
+    // The status topic followed the goal: executing, canceling, canceled (2, 3, 5 in
+    // action_msgs/msg/GoalStatus), in that order, and no other goal appeared.
+    let mut codes: Vec<i8> = Vec::new();
+    for goals in statuses.lock().unwrap().iter() {
+        assert!(goals.iter().all(|(g, _, _)| *g == id), "{goals:?}");
+        if let Some(&(_, _, c)) = goals.iter().find(|(g, _, _)| *g == id)
+            && codes.last() != Some(&c)
+        {
+            codes.push(c);
+        }
+    }
+    let at = |c: i8| codes.iter().position(|&x| x == c);
+    assert!(
+        at(2) < at(3) && at(3) < at(5) && at(2).is_some() && codes.last() == Some(&5),
+        "status codes {codes:?}"
     );
     // A finished goal cannot be canceled, and an unknown one has no result.
     assert_eq!(client.cancel(&id, true, Duration::from_secs(5)).unwrap(), 3);

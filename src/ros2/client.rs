@@ -6,8 +6,9 @@ use super::interfaces::{self, ActionInterfaces};
 use super::keys::{Attachment, NodeName, gid, now_ns};
 use super::messages::{
     Goal, GoalFeedback, GoalId, GoalResult, decode_cancel_response, decode_feedback, decode_result,
-    decode_send_goal_response, encode_cancel_request, encode_goal_id, encode_send_goal,
+    decode_send_goal_response, decode_status, encode_cancel_request, encode_goal_id, encode_send_goal,
 };
+use crate::replay::ros::Time;
 use std::sync::atomic::{AtomicI64, Ordering};
 use std::time::Duration;
 use thiserror::Error;
@@ -163,6 +164,32 @@ impl ActionClient {
             .callback(move |s| {
                 if let Ok((id, fb)) = decode_feedback(&s.payload().to_bytes()) {
                     f(id, fb);
+                }
+            })
+            .wait()
+            .map_err(|e| ClientError::Zenoh(e.to_string()))
+    }
+
+    /// Calls `f` with each status message of the action (`dock`: docking): every recent
+    /// goal's id, acceptance time and `action_msgs/msg/GoalStatus` code, until the
+    /// returned subscriber is dropped. A message that does not parse is skipped.
+    ///
+    /// # Errors
+    /// [`ClientError::Zenoh`].
+    pub fn on_status(
+        &self,
+        dock: bool,
+        f: impl Fn(Vec<(GoalId, Time, i8)>) + Send + Sync + 'static,
+    ) -> Result<zenoh::pubsub::Subscriber<()>, ClientError> {
+        let (action, _) = Self::names(dock);
+        self.session
+            .declare_subscriber(
+                self.node
+                    .key(&format!("{action}/_action/status"), &interfaces::goal_status_array()),
+            )
+            .callback(move |s| {
+                if let Ok(goals) = decode_status(&s.payload().to_bytes()) {
+                    f(goals);
                 }
             })
             .wait()

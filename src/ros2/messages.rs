@@ -286,6 +286,26 @@ pub fn encode_status(buf: &mut Vec<u8>, goals: &[(GoalId, Time, i8)]) {
     }
 }
 
+/// Reads an `action_msgs/msg/GoalStatusArray` as `(id, accepted at, status)`, the
+/// layout [`encode_status`] writes (what an action client's status subscriber sees).
+///
+/// # Errors
+/// [`CdrError`] for a truncated or malformed message. A count larger than the bytes hold
+/// fails when they run out, without allocating for it.
+pub fn decode_status(buf: &[u8]) -> Result<Vec<(GoalId, Time, i8)>, CdrError> {
+    let mut r = CdrReader::new(buf)?;
+    let n = r.u32("status_list.size")?;
+    let mut goals = Vec::new();
+    for _ in 0..n {
+        let id = r.fixed_bytes::<16>("status_list.goal_info.goal_id")?;
+        let sec = r.i32("status_list.goal_info.stamp.sec")?;
+        let nanosec = r.u32("status_list.goal_info.stamp.nanosec")?;
+        let status = r.u8("status_list.status")? as i8;
+        goals.push((id, Time { sec, nanosec }, status));
+    }
+    Ok(goals)
+}
+
 /// Writes an `action_msgs/srv/CancelGoal` response: return code (0 accepted, 2 unknown
 /// goal, 3 terminated) and the goals now canceling.
 pub fn encode_cancel_response(buf: &mut Vec<u8>, code: i8, canceling: &[(GoalId, Time)]) {
@@ -319,6 +339,26 @@ pub fn decode_cancel_response(buf: &[u8]) -> Result<i8, CdrError> {
 mod tests {
     use super::*;
     use crate::replay::cdr::{decode_image, decode_odometry};
+
+    #[test]
+    fn goal_status_arrays_read_back() {
+        let goals = [
+            ([1; 16], Time { sec: 3, nanosec: 7 }, 2i8),
+            ([9; 16], Time { sec: -1, nanosec: 0 }, 5i8),
+        ];
+        let mut b = Vec::new();
+        encode_status(&mut b, &goals);
+        assert_eq!(decode_status(&b).unwrap(), goals);
+        // Two elements of 25 bytes, the second aligned to 4 for its stamp: 4 + 4 + 25 + 3 + 25.
+        assert_eq!(b.len(), 61);
+        assert!(decode_status(&b[..b.len() - 1]).is_err());
+        let mut huge = b.clone();
+        huge[4..8].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert!(decode_status(&huge).is_err());
+        let mut empty = Vec::new();
+        encode_status(&mut empty, &[]);
+        assert_eq!(decode_status(&empty).unwrap(), []);
+    }
 
     #[test]
     fn twist_layout_is_six_float64_after_the_header() {
