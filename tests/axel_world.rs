@@ -152,10 +152,14 @@ fn axel_stands_outdoors_with_seven_metre_starts_inside_the_world() {
 /// The circle marks' detection range on the profile's cameras, measured: facing the
 /// module on its axis and 20° off it, the marks each camera detects and labels at 3 to
 /// 7 m (printed with `--nocapture`). The 10 cm marks span 2·651.9·0.05/d px across, 16 px
-/// at 4 m and 9 px at 7 m; their rim is a fifth of the radius and the bar a quarter, so
-/// past about 4 m both are under 2 px and the bar (which a mark must show to count) blurs
-/// away. Asserted: every camera labels at least 5 marks (enough for a pose) to 4 m on the
-/// axis and 3.5 m at 20°, the range the behavior's `view.range_m` plans within.
+/// at 4 m and 9 px at 7 m; their rim is a fifth of the radius and the bar a quarter.
+/// With one threshold window of width/64 (17 px) the dark module face pulled a rim
+/// pixel's local mean down to its own grey past 4 m (a mark 14 px across at 4.5 m), the
+/// 1.5-px rim broke, and no mark was found there (8/5 marks at 4 m, 0/0 from 4.5 m); the
+/// 7-px window (`CircleParams::for_image`) keeps the rim whole to 4.5 m. Past that the rim
+/// (1.3 px at 5 m) and bar blur away: at 5 m one camera still labels 7 marks on the axis,
+/// the other none. Asserted: every camera labels at least 5 marks (enough for a pose) to
+/// 4.5 m, on the axis and at 20°.
 #[test]
 fn the_marks_are_detected_to_the_range_the_behavior_plans_within() {
     use marsupial::perception::circles::{CircleDetector, CircleModel, CircleParams, CorrespondenceParams, correspond};
@@ -180,8 +184,7 @@ fn the_marks_are_detected_to_the_range_the_behavior_plans_within() {
                 "{d} m, α {alpha}°: marks labelled left {}, right {}",
                 labelled[0], labelled[1]
             );
-            let within = if alpha == 0.0 { 4.0 } else { 3.5 };
-            if d <= within {
+            if d <= 4.5 {
                 assert!(
                     labelled.iter().all(|&n| n >= 5),
                     "{d} m, α {alpha}°: {labelled:?} marks labelled"

@@ -14,10 +14,11 @@
 //!
 //! **Per frame**, into buffers the detector owns (nothing is allocated after
 //! [`CircleDetector::new`] or [`CircleDetector::resize`]):
-//! 1. grey levels, then the local-mean threshold ([`AdaptiveThreshold`]) into a black and
-//!    a white mask, labelled with Euler numbers ([`RunIndex`]): black 8-connected, white
-//!    4-connected (the consistent pair: a thin black rim closed only diagonally still
-//!    holds the white ring in);
+//! 1. grey levels, then the local-mean threshold ([`AdaptiveThreshold`], a 7-px window for
+//!    the thin rims of far marks and a wider one for the pixels it leaves undecided in
+//!    the wide black areas of near ones) into a black and a white mask, labelled with
+//!    Euler numbers ([`RunIndex`]): black 8-connected, white 4-connected (the consistent
+//!    pair: a thin black rim closed only diagonally still holds the white ring in);
 //! 2. black candidates: area within limits, the moment ellipse's axis ratio at least
 //!    `min_axis_ratio`, Euler number in `black_euler`, not touching the image border
 //!    (a cut mark's centre would be biased). White candidates: area and axis ratio;
@@ -147,10 +148,17 @@ pub struct CircleParams {
 
 impl CircleParams {
     /// Defaults for a `width`-pixel-wide image (our choices; the paper gives none):
-    /// * window: width/64, odd, at least 11 px (17 px at 1024): about a small mark's size,
-    ///   so its mean is the mark's own mid-grey and not its surroundings' (a dark module
-    ///   face otherwise leaves a 2-px rim in the dead band), yet wider than the rim and
-    ///   ring of a mark at docking range;
+    /// * window: 7 px, then width/64 (odd, at least 11 px; 17 px at 1024) for the pixels
+    ///   the first leaves in its dead band. The narrow window is no wider than the
+    ///   smallest mark reported (minor semi-axis ≥ 4 px, 8 px across), so that a rim
+    ///   pixel's mean is the mark's own bright ring and margin and not the dark module face
+    ///   around it: with width/64 alone the face pulled the mean of a mark 14 px across
+    ///   (Axel at 4.5 m) down to its 1.5-px rim's grey, the rim fell into the dead band
+    ///   and broke (Euler number 1, no hole), and no mark past 4 m was found. The narrow
+    ///   window alone leaves the middle of a rim wider than about 6 px (Axel's marks
+    ///   nearer than about 1 m) in its dead band, hollow; the wide one, wider than the
+    ///   rim and ring of a mark at docking range, fills it in. Measured range on Axel's
+    ///   1024 px fish-eye: `tests/axel_world.rs`;
     /// * offset 8 grey levels: above the sensor noise of a flat surface, far below a
     ///   printed mark's black-to-white contrast even in shade;
     /// * black blob from 12 px (a rim about 9 px across) to 5 % of the image;
@@ -169,8 +177,9 @@ impl CircleParams {
     pub fn for_image(width: usize) -> Self {
         Self {
             threshold: AdaptiveThreshold {
-                window_px: ((width / 64).max(11)) | 1,
+                window_px: 7,
                 offset: 8,
+                wide_window_px: ((width / 64).max(11)) | 1,
             },
             min_area_px: 12,
             max_area_frac: 0.05,

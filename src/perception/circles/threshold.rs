@@ -7,6 +7,11 @@
 //! when g > m + offset, neither in between. The dead band keeps flat regions (where m ≈ g
 //! and only noise differs) out of both masks, so they cannot join a mark's blobs.
 //!
+//! Two scales: a pixel the window leaves in its dead band is decided by a second, wider
+//! window when one is given ([`AdaptiveThreshold::wide_window_px`]), so that both thin rims
+//! of far marks (which need a window no wider than the mark) and wide black areas of near
+//! ones (which need a window wider than the area) are thresholded.
+//!
 //! Grey is the luma approximation (R + 2G + B)/4.
 
 use crate::perception::Mask;
@@ -35,6 +40,12 @@ pub struct AdaptiveThreshold {
     pub window_px: usize,
     /// Dead band either side of the local mean, grey levels.
     pub offset: u8,
+    /// A wider window (made odd; 0, or not wider than `window_px`: none) that decides the
+    /// pixels the first leaves in its dead band. A narrow window sees a small mark's thin
+    /// rim against its own bright ring and margin, but in the middle of a black area wider
+    /// than itself (a near mark's rim or core) its mean is the pixel's own grey, and the
+    /// area goes hollow; there the wider window still sees the surround.
+    pub wide_window_px: usize,
 }
 
 /// The threshold's reusable integral image (the masks are the caller's).
@@ -84,46 +95,75 @@ impl Thresholder {
                 here[x + 1] = above[x + 1] + row;
             }
         }
-        let r = (params.window_px.max(3) | 1) / 2;
         let off = params.offset as u32;
         let (bd, wd) = (black.data_mut(), white.data_mut());
-        for y in 0..height {
-            let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(height));
-            let (top, bot) = (
-                &self.integral[y0 * iw..(y0 + 1) * iw],
-                &self.integral[y1 * iw..(y1 + 1) * iw],
-            );
-            let rows = (y1 - y0) as u32;
-            let g_row = &grey[y * width..(y + 1) * width];
-            let (b_row, w_row) = (&mut bd[y * width..(y + 1) * width], &mut wd[y * width..(y + 1) * width]);
-            // g < m − off  ⇔  (g + off)·n < Σ;  g > m + off  ⇔  g·n > Σ + off·n.
-            let mut one = |x: usize| {
-                let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(width));
-                let sum = bot[x1] + top[x0] - top[x1] - bot[x0];
-                let n = rows * (x1 - x0) as u32;
-                let g = g_row[x] as u32;
-                b_row[x] = ((g + off) * n < sum) as u8;
-                w_row[x] = (g * n > sum + off * n) as u8;
-            };
-            if width <= 2 * r + 1 {
-                (0..width).for_each(&mut one);
-                continue;
+        let r = (params.window_px.max(3) | 1) / 2;
+        decide(&self.integral, grey, width, height, r, off, bd, wd, false);
+        if params.wide_window_px > 0 {
+            let wide = (params.wide_window_px.max(3) | 1) / 2;
+            if wide > r {
+                decide(&self.integral, grey, width, height, wide, off, bd, wd, true);
             }
-            (0..r).for_each(&mut one);
-            (width - r - 1..width).for_each(&mut one);
-            // Interior: the whole window in the row, a constant n; branch-free so it
-            // vectorises.
-            let n = rows * (2 * r + 1) as u32;
-            let m = width - 2 * r - 1;
-            let (tl, tr, bl, br) = (&top[..m], &top[2 * r + 1..][..m], &bot[..m], &bot[2 * r + 1..][..m]);
-            let g_mid = &g_row[r..][..m];
-            let (b_mid, w_mid) = (&mut b_row[r..][..m], &mut w_row[r..][..m]);
-            for i in 0..m {
-                let sum = br[i] + tl[i] - tr[i] - bl[i];
-                let g = g_mid[i] as u32;
-                b_mid[i] = ((g + off) * n < sum) as u8;
-                w_mid[i] = (g * n > sum + off * n) as u8;
-            }
+        }
+    }
+}
+
+/// Sets `bd`/`wd` (black and white mask rows) by the mean of the (2r + 1)² window from the
+/// integral image `integral`: every pixel when `dead_only` is false, else only the pixels
+/// left in neither mask (the narrower window's dead band).
+#[allow(clippy::too_many_arguments)]
+fn decide(
+    integral: &[u32],
+    grey: &[u8],
+    width: usize,
+    height: usize,
+    r: usize,
+    off: u32,
+    bd: &mut [u8],
+    wd: &mut [u8],
+    dead_only: bool,
+) {
+    let iw = width + 1;
+    // Where a pixel may be set: always (keep = 0, set = 1), or only when it is in neither
+    // mask yet. `(b | w) ^ 1` is 1 exactly for those; with `dead_only` off it is forced 1.
+    let all = (!dead_only) as u8;
+    for y in 0..height {
+        let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(height));
+        let (top, bot) = (&integral[y0 * iw..(y0 + 1) * iw], &integral[y1 * iw..(y1 + 1) * iw]);
+        let rows = (y1 - y0) as u32;
+        let g_row = &grey[y * width..(y + 1) * width];
+        let (b_row, w_row) = (&mut bd[y * width..(y + 1) * width], &mut wd[y * width..(y + 1) * width]);
+        // g < m − off  ⇔  (g + off)·n < Σ;  g > m + off  ⇔  g·n > Σ + off·n.
+        let mut one = |x: usize| {
+            let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(width));
+            let sum = bot[x1] + top[x0] - top[x1] - bot[x0];
+            let n = rows * (x1 - x0) as u32;
+            let g = g_row[x] as u32;
+            let free = all | ((b_row[x] | w_row[x]) ^ 1);
+            let (b, w) = (((g + off) * n < sum) as u8, (g * n > sum + off * n) as u8);
+            b_row[x] = (b_row[x] & (free ^ 1)) | (b & free);
+            w_row[x] = (w_row[x] & (free ^ 1)) | (w & free);
+        };
+        if width <= 2 * r + 1 {
+            (0..width).for_each(&mut one);
+            continue;
+        }
+        (0..r).for_each(&mut one);
+        (width - r - 1..width).for_each(&mut one);
+        // Interior: the whole window in the row, a constant n; branch-free so it
+        // vectorises.
+        let n = rows * (2 * r + 1) as u32;
+        let m = width - 2 * r - 1;
+        let (tl, tr, bl, br) = (&top[..m], &top[2 * r + 1..][..m], &bot[..m], &bot[2 * r + 1..][..m]);
+        let g_mid = &g_row[r..][..m];
+        let (b_mid, w_mid) = (&mut b_row[r..][..m], &mut w_row[r..][..m]);
+        for i in 0..m {
+            let sum = br[i] + tl[i] - tr[i] - bl[i];
+            let g = g_mid[i] as u32;
+            let free = all | ((b_mid[i] | w_mid[i]) ^ 1);
+            let (b, w) = (((g + off) * n < sum) as u8, (g * n > sum + off * n) as u8);
+            b_mid[i] = (b_mid[i] & (free ^ 1)) | (b & free);
+            w_mid[i] = (w_mid[i] & (free ^ 1)) | (w & free);
         }
     }
 }
@@ -145,6 +185,7 @@ mod tests {
         let p = AdaptiveThreshold {
             window_px: 15,
             offset: 8,
+            wide_window_px: 0,
         };
         Thresholder::new(w, h).apply(&grey, w, h, &p, &mut b, &mut wh);
         assert!(b.get(20, 15) && !wh.get(20, 15), "inside the square");
@@ -155,6 +196,54 @@ mod tests {
     }
 
     #[test]
+    fn a_wide_window_decides_only_the_narrow_ones_dead_band() {
+        // A dark square 21 px wide on grey: a 7-px window leaves its middle in the dead
+        // band (the mean there is the pixel's own grey), a 41-px one fills it in.
+        let (w, h) = (60, 50);
+        let mut grey = vec![120u8; w * h];
+        for y in 15..36 {
+            for x in 20..41 {
+                grey[y * w + x] = 20;
+            }
+        }
+        let narrow = AdaptiveThreshold {
+            window_px: 7,
+            offset: 8,
+            wide_window_px: 0,
+        };
+        let both = AdaptiveThreshold {
+            wide_window_px: 41,
+            ..narrow
+        };
+        let mut t = Thresholder::new(w, h);
+        let (mut b1, mut w1) = (Mask::new(1, 1), Mask::new(1, 1));
+        t.apply(&grey, w, h, &narrow, &mut b1, &mut w1);
+        assert!(
+            b1.get(20, 25) && !b1.get(30, 25),
+            "narrow alone: the edge is black, the middle hollow"
+        );
+        let (mut b2, mut w2) = (Mask::new(1, 1), Mask::new(1, 1));
+        t.apply(&grey, w, h, &both, &mut b2, &mut w2);
+        assert!(b2.get(30, 25) && !w2.get(30, 25), "the wide window fills the middle");
+        // Every pixel the narrow window decided keeps its decision; none is in both masks.
+        for i in 0..w * h {
+            let (x, y) = (i % w, i / w);
+            if b1.get(x, y) || w1.get(x, y) {
+                assert_eq!((b2.get(x, y), w2.get(x, y)), (b1.get(x, y), w1.get(x, y)), "({x}, {y})");
+            }
+            assert!(!(b2.get(x, y) && w2.get(x, y)), "({x}, {y})");
+        }
+        // A wide window no wider than the narrow one changes nothing.
+        let same = AdaptiveThreshold {
+            wide_window_px: 7,
+            ..narrow
+        };
+        let (mut b3, mut w3) = (Mask::new(1, 1), Mask::new(1, 1));
+        t.apply(&grey, w, h, &same, &mut b3, &mut w3);
+        assert_eq!((b3.data(), w3.data()), (b1.data(), w1.data()));
+    }
+
+    #[test]
     fn the_integral_agrees_with_a_direct_window_mean() {
         let (w, h) = (17, 13);
         let grey: Vec<u8> = (0..w * h).map(|i| ((i * 37 + i / 7 * 11) % 256) as u8).collect();
@@ -162,6 +251,7 @@ mod tests {
         let p = AdaptiveThreshold {
             window_px: 5,
             offset: 3,
+            wide_window_px: 0,
         };
         // The buffers are reused, not cleared: first a larger frame and then a bright one
         // of the same size leave every mask pixel and integral entry set before the frame
@@ -240,6 +330,7 @@ mod tests {
         let p = AdaptiveThreshold {
             window_px: 9,
             offset: 8,
+            wide_window_px: 0,
         };
         let mut t = Thresholder::default();
         t.apply(&[], 0, 0, &p, &mut b, &mut wh);
