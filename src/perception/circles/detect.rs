@@ -16,9 +16,10 @@
 //! [`CircleDetector::new`] or [`CircleDetector::resize`]):
 //! 1. grey levels, then the local-mean threshold ([`AdaptiveThreshold`], a 7-px window for
 //!    the thin rims of far marks and a wider one for the pixels it leaves undecided in
-//!    the wide black areas of near ones) into a black and a white mask, labelled with
-//!    Euler numbers ([`RunIndex`]): black 8-connected, white 4-connected (the consistent
-//!    pair: a thin black rim closed only diagonally still holds the white ring in);
+//!    the wide black areas of near ones) into a black and a white mask, labelled black
+//!    8-connected, white 4-connected (the consistent pair: a thin black rim closed only
+//!    diagonally still holds the white ring in), the black blobs with their Euler numbers
+//!    ([`RunIndex`]);
 //! 2. black candidates: area within limits, the moment ellipse's axis ratio at least
 //!    `min_axis_ratio`, Euler number in `black_euler`, not touching the image border
 //!    (a cut mark's centre would be biased). White candidates: area and axis ratio;
@@ -48,8 +49,8 @@
 
 use super::blobs::RunIndex;
 use super::ellipse::{Ellipse, fit_ellipse};
-use super::threshold::{AdaptiveThreshold, Thresholder, grey_from_view};
-use crate::perception::components::{Component, Labeler};
+use super::threshold::{AdaptiveThreshold, Thresholder};
+use crate::perception::components::{Component, Labeler, Run};
 use crate::perception::image::RgbView;
 use crate::perception::{Mask, VisionError, check_same_size};
 use serde::Serialize;
@@ -246,7 +247,9 @@ pub struct CircleDetector {
     thresholder: Thresholder,
     masks: [Mask; 2],
     labelers: [Labeler; 2],
-    index: [RunIndex; 2],
+    /// Euler numbers and run lists of the black blobs (the white ones need neither: their
+    /// Euler number is not filtered, and the few that pair are read by rows).
+    index: RunIndex,
     black: Vec<u32>,
     white: Vec<u32>,
     col_top: Vec<u32>,
@@ -270,7 +273,7 @@ impl CircleDetector {
             thresholder: Thresholder::new(width, height),
             masks: [Mask::new(width, height), Mask::new(width, height)],
             labelers: [Labeler::new(width, height), Labeler::new_four_connected(width, height)],
-            index: [RunIndex::new(width, height), RunIndex::new(width, height)],
+            index: RunIndex::new(width, height),
             black: Vec::with_capacity(max_runs),
             white: Vec::with_capacity(max_runs),
             col_top: Vec::with_capacity(width),
@@ -318,19 +321,18 @@ impl CircleDetector {
         check_same_size((self.width, self.height), (view.width(), view.height()))?;
         self.marks.clear();
         let (w, h) = (self.width, self.height);
-        grey_from_view(view, &mut self.grey);
         let [black_mask, white_mask] = &mut self.masks;
         self.thresholder
-            .apply(&self.grey, w, h, &self.params.threshold, black_mask, white_mask);
+            .apply_rgb(view, &mut self.grey, &self.params.threshold, black_mask, white_mask);
         for k in [BLACK, WHITE] {
             self.labelers[k].label(&self.masks[k])?;
-            self.index[k].build(&self.labelers[k]);
         }
+        self.index.build(&self.labelers[BLACK]);
         let p = self.params;
         let max_area = (p.max_area_frac * (w * h) as f64) as u64;
         self.black.clear();
         for (i, c) in self.labelers[BLACK].components().iter().enumerate() {
-            let e = self.index[BLACK].euler(i);
+            let e = self.index.euler(i);
             let inside = c.bbox[0] > 0 && c.bbox[1] > 0 && (c.bbox[2] as usize) + 1 < w && (c.bbox[3] as usize) + 1 < h;
             if c.count >= p.min_area_px
                 && c.count <= max_area
@@ -405,13 +407,28 @@ impl CircleDetector {
         best.map(|(_, i)| i)
     }
 
-    /// Mean grey level over component `label` of mask `k`.
+    /// Mean grey level over component `label` of mask `k`: the black blob's runs from
+    /// the index, the white blob's from the rows of its box (the labeller's runs are in
+    /// raster order).
     fn mean_grey(&self, k: usize, label: usize) -> f64 {
         let (mut s, mut n) = (0u64, 0u64);
-        for r in self.index[k].runs_of(&self.labelers[k], label) {
+        let mut add = |r: &Run| {
             let row = &self.grey[r.y as usize * self.width..][r.x0 as usize..r.x1 as usize];
             s += row.iter().map(|&g| g as u64).sum::<u64>();
             n += row.len() as u64;
+        };
+        if k == BLACK {
+            self.index.runs_of(&self.labelers[k], label).for_each(&mut add);
+        } else {
+            let lab = &self.labelers[k];
+            let [_, y0, _, y1] = lab.components()[label].bbox;
+            let runs = lab.runs();
+            let from = runs.partition_point(|r| r.y < y0);
+            runs[from..]
+                .iter()
+                .take_while(|r| r.y <= y1)
+                .filter(|r| r.label as usize == label)
+                .for_each(&mut add);
         }
         s as f64 / n.max(1) as f64
     }
@@ -445,7 +462,7 @@ impl CircleDetector {
         };
         let mut row_y = u32::MAX;
         let (mut left, mut right) = (0usize, 0usize);
-        let runs = self.index[BLACK].runs_of(&self.labelers[BLACK], b);
+        let runs = self.index.runs_of(&self.labelers[BLACK], b);
         for r in runs {
             if r.y != row_y {
                 if row_y != u32::MAX {

@@ -10,7 +10,11 @@
 //! Two scales: a pixel the window leaves in its dead band is decided by a second, wider
 //! window when one is given ([`AdaptiveThreshold::wide_window_px`]), so that both thin rims
 //! of far marks (which need a window no wider than the mark) and wide black areas of near
-//! ones (which need a window wider than the area) are thresholded.
+//! ones (which need a window wider than the area) are thresholded. Both means come from
+//! the one integral image in the same pass over the pixels, branch-free (the wide verdict
+//! is computed for every pixel and kept only in the dead band), so the second window adds
+//! a few vector operations per pixel, not a second pass over the frame. The grey image
+//! ([`Thresholder::apply_rgb`]) is made row by row as the integral image is summed.
 //!
 //! Grey is the luma approximation (R + 2G + B)/4.
 
@@ -21,16 +25,6 @@ use crate::perception::image::RgbView;
 #[inline]
 pub fn grey_from_rgb(p: [u8; 3]) -> u8 {
     ((p[0] as u16 + 2 * p[1] as u16 + p[2] as u16 + 2) / 4) as u8
-}
-
-/// Writes the grey image of `src` into `grey` (resized to width × height).
-pub fn grey_from_view(src: &RgbView<'_>, grey: &mut Vec<u8>) {
-    grey.clear();
-    grey.extend(
-        src.as_bytes()
-            .chunks_exact(3)
-            .map(|p| grey_from_rgb([p[0], p[1], p[2]])),
-    );
 }
 
 /// The local-mean threshold's parameters.
@@ -78,92 +72,209 @@ impl Thresholder {
             white.reset(width, height);
             return;
         }
-        // Every pixel of both masks, and every entry of the integral image off its zero
-        // first row and column, is written below, so none is cleared first.
-        black.resize_for_overwrite(width, height);
-        white.resize_for_overwrite(width, height);
+        self.start(width, height);
+        for (y, g_row) in grey.chunks_exact(width).enumerate() {
+            self.integral_row(y, g_row);
+        }
+        self.decide(grey, width, height, params, black, white);
+    }
+
+    /// [`Thresholder::apply`] on the grey image of `src` ([`grey_from_rgb`]), which it
+    /// writes into `grey` (resized to the frame) row by row as it builds the integral
+    /// image: each grey row is summed while it is still in cache.
+    pub fn apply_rgb(
+        &mut self,
+        src: &RgbView<'_>,
+        grey: &mut Vec<u8>,
+        params: &AdaptiveThreshold,
+        black: &mut Mask,
+        white: &mut Mask,
+    ) {
+        let (width, height) = (src.width(), src.height());
+        grey.resize(width * height, 0);
+        if width == 0 || height == 0 {
+            black.reset(width, height);
+            white.reset(width, height);
+            return;
+        }
+        self.start(width, height);
+        for (y, (g_row, rgb)) in grey
+            .chunks_exact_mut(width)
+            .zip(src.as_bytes().chunks_exact(3 * width))
+            .enumerate()
+        {
+            for (g, p) in g_row.iter_mut().zip(rgb.chunks_exact(3)) {
+                *g = grey_from_rgb([p[0], p[1], p[2]]);
+            }
+            self.integral_row(y, g_row);
+        }
+        self.decide(grey, width, height, params, black, white);
+    }
+
+    /// Sizes the integral image for `width × height` and zeroes its first row. Every
+    /// other entry, and every pixel of the masks, is written before it is read, so none
+    /// is cleared.
+    fn start(&mut self, width: usize, height: usize) {
         let iw = width + 1;
         self.integral.resize(iw * (height + 1), 0);
         self.integral[..iw].fill(0);
-        for y in 0..height {
-            let mut row = 0u32;
-            let (above, here) = self.integral.split_at_mut((y + 1) * iw);
-            let above = &above[y * iw..];
-            here[0] = 0;
-            for x in 0..width {
-                row += grey[y * width + x] as u32;
-                here[x + 1] = above[x + 1] + row;
-            }
+    }
+
+    /// Writes row `y` + 1 of the integral image from grey row `y` and the row above.
+    fn integral_row(&mut self, y: usize, g_row: &[u8]) {
+        let iw = g_row.len() + 1;
+        let (above, here) = self.integral.split_at_mut((y + 1) * iw);
+        let above = &above[y * iw + 1..][..iw - 1];
+        let here = &mut here[..iw];
+        here[0] = 0;
+        let mut row = 0u32;
+        for ((h, &a), &g) in here[1..].iter_mut().zip(above).zip(g_row) {
+            // Wrapping: see `box_sum`.
+            row = row.wrapping_add(g as u32);
+            *h = a.wrapping_add(row);
         }
-        let off = params.offset as u32;
+    }
+
+    /// Both masks from the integral image [`Thresholder::start`] and
+    /// [`Thresholder::integral_row`] built.
+    fn decide(
+        &self,
+        grey: &[u8],
+        width: usize,
+        height: usize,
+        params: &AdaptiveThreshold,
+        black: &mut Mask,
+        white: &mut Mask,
+    ) {
+        black.resize_for_overwrite(width, height);
+        white.resize_for_overwrite(width, height);
+        let off = params.offset as i32;
         let (bd, wd) = (black.data_mut(), white.data_mut());
         let r = (params.window_px.max(3) | 1) / 2;
-        decide(&self.integral, grey, width, height, r, off, bd, wd, false);
-        if params.wide_window_px > 0 {
-            let wide = (params.wide_window_px.max(3) | 1) / 2;
-            if wide > r {
-                decide(&self.integral, grey, width, height, wide, off, bd, wd, true);
-            }
+        let wide = (params.wide_window_px.max(3) | 1) / 2;
+        if params.wide_window_px > 0 && wide > r {
+            decide::<true>(&self.integral, grey, width, height, r, wide, off, bd, wd);
+        } else {
+            decide::<false>(&self.integral, grey, width, height, r, r, off, bd, wd);
         }
     }
 }
 
-/// Sets `bd`/`wd` (black and white mask rows) by the mean of the (2r + 1)² window from the
-/// integral image `integral`: every pixel when `dead_only` is false, else only the pixels
-/// left in neither mask (the narrower window's dead band).
+/// One window's integral rows for image row `y`: the rows bounding the (2r + 1)² window,
+/// clipped to the image, and how many image rows that spans.
+#[derive(Clone, Copy)]
+struct Window<'a> {
+    top: &'a [u32],
+    bot: &'a [u32],
+    rows: u32,
+    r: usize,
+}
+
+impl<'a> Window<'a> {
+    fn at(integral: &'a [u32], iw: usize, height: usize, y: usize, r: usize) -> Self {
+        let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(height));
+        Self {
+            top: &integral[y0 * iw..(y0 + 1) * iw],
+            bot: &integral[y1 * iw..(y1 + 1) * iw],
+            rows: (y1 - y0) as u32,
+            r,
+        }
+    }
+
+    /// Sum and pixel count of the window around column `x`, clipped to `width`.
+    #[inline(always)]
+    fn clipped(&self, x: usize, width: usize) -> (i32, i32) {
+        let (x0, x1) = (x.saturating_sub(self.r), (x + self.r + 1).min(width));
+        (
+            box_sum(self.bot[x1], self.top[x0], self.top[x1], self.bot[x0]),
+            (self.rows * (x1 - x0) as u32) as i32,
+        )
+    }
+}
+
+/// A window's sum from its integral corners (bottom-right, top-left, top-right,
+/// bottom-left). The integral image wraps modulo 2³², so this is exact for any window
+/// of fewer than 2³¹ / 255 (8.4 M) pixels, however large the image.
+#[inline(always)]
+fn box_sum(br: u32, tl: u32, tr: u32, bl: u32) -> i32 {
+    br.wrapping_add(tl).wrapping_sub(tr).wrapping_sub(bl) as i32
+}
+
+/// Black and white verdicts (0 or 1) of grey level `g` against a window of `n` pixels
+/// summing to `sum`, mean m = Σ/n: with d = Σ − g·n = n·(m − g), g < m − off ⇔ d > off·n
+/// and g > m + off ⇔ d < −off·n (`off_n` = off·n). Signed, so that both are one compare.
+#[inline(always)]
+fn verdict(g: i32, off_n: i32, sum: i32, n: i32) -> (u8, u8) {
+    let d = sum - g * n;
+    ((d > off_n) as u8, (d < -off_n) as u8)
+}
+
+/// The narrow window's verdict, and where it is in neither mask (its dead band) the wide
+/// one's: `(b, w)` of the narrow window, `(bw, ww)` of the wide.
+#[inline(always)]
+fn combine((b, w): (u8, u8), (bw, ww): (u8, u8)) -> (u8, u8) {
+    let dead = (b | w) ^ 1;
+    (b | (dead & bw), w | (dead & ww))
+}
+
+/// Sets every pixel of `bd`/`wd` (black and white mask rows) in one pass: by the mean of
+/// the (2r + 1)² window from the integral image `integral`, and when `TWO`, the pixels
+/// that leaves in its dead band by the mean of the (2·wide + 1)² window (`wide` > r).
 #[allow(clippy::too_many_arguments)]
-fn decide(
+fn decide<const TWO: bool>(
     integral: &[u32],
     grey: &[u8],
     width: usize,
     height: usize,
     r: usize,
-    off: u32,
+    wide: usize,
+    off: i32,
     bd: &mut [u8],
     wd: &mut [u8],
-    dead_only: bool,
 ) {
     let iw = width + 1;
-    // Where a pixel may be set: always (keep = 0, set = 1), or only when it is in neither
-    // mask yet. `(b | w) ^ 1` is 1 exactly for those; with `dead_only` off it is forced 1.
-    let all = (!dead_only) as u8;
+    // The widest window in use: columns closer than this to a side clip it.
+    let reach = if TWO { wide } else { r };
     for y in 0..height {
-        let (y0, y1) = (y.saturating_sub(r), (y + r + 1).min(height));
-        let (top, bot) = (&integral[y0 * iw..(y0 + 1) * iw], &integral[y1 * iw..(y1 + 1) * iw]);
-        let rows = (y1 - y0) as u32;
+        let nw = Window::at(integral, iw, height, y, r);
+        let ww = Window::at(integral, iw, height, y, wide);
         let g_row = &grey[y * width..(y + 1) * width];
         let (b_row, w_row) = (&mut bd[y * width..(y + 1) * width], &mut wd[y * width..(y + 1) * width]);
-        // g < m − off  ⇔  (g + off)·n < Σ;  g > m + off  ⇔  g·n > Σ + off·n.
         let mut one = |x: usize| {
-            let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(width));
-            let sum = bot[x1] + top[x0] - top[x1] - bot[x0];
-            let n = rows * (x1 - x0) as u32;
-            let g = g_row[x] as u32;
-            let free = all | ((b_row[x] | w_row[x]) ^ 1);
-            let (b, w) = (((g + off) * n < sum) as u8, (g * n > sum + off * n) as u8);
-            b_row[x] = (b_row[x] & (free ^ 1)) | (b & free);
-            w_row[x] = (w_row[x] & (free ^ 1)) | (w & free);
+            let g = g_row[x] as i32;
+            let (s, n) = nw.clipped(x, width);
+            let mut v = verdict(g, off * n, s, n);
+            if TWO {
+                let (s, n) = ww.clipped(x, width);
+                v = combine(v, verdict(g, off * n, s, n));
+            }
+            (b_row[x], w_row[x]) = v;
         };
-        if width <= 2 * r + 1 {
+        if width <= 2 * reach + 1 {
             (0..width).for_each(&mut one);
             continue;
         }
-        (0..r).for_each(&mut one);
-        (width - r - 1..width).for_each(&mut one);
-        // Interior: the whole window in the row, a constant n; branch-free so it
-        // vectorises.
-        let n = rows * (2 * r + 1) as u32;
-        let m = width - 2 * r - 1;
-        let (tl, tr, bl, br) = (&top[..m], &top[2 * r + 1..][..m], &bot[..m], &bot[2 * r + 1..][..m]);
-        let g_mid = &g_row[r..][..m];
-        let (b_mid, w_mid) = (&mut b_row[r..][..m], &mut w_row[r..][..m]);
+        (0..reach).for_each(&mut one);
+        (width - reach - 1..width).for_each(&mut one);
+        // Interior: both windows whole within the row, constant counts; branch-free so
+        // it vectorises.
+        let m = width - 2 * reach - 1;
+        let nn = (nw.rows * (2 * r + 1) as u32) as i32;
+        let (tl, tr) = (&nw.top[reach - r..][..m], &nw.top[reach + r + 1..][..m]);
+        let (bl, br) = (&nw.bot[reach - r..][..m], &nw.bot[reach + r + 1..][..m]);
+        let nwide = (ww.rows * (2 * wide + 1) as u32) as i32;
+        let (off_nn, off_nw) = (off * nn, off * nwide);
+        let (wtl, wtr) = (&ww.top[reach - wide..][..m], &ww.top[reach + wide + 1..][..m]);
+        let (wbl, wbr) = (&ww.bot[reach - wide..][..m], &ww.bot[reach + wide + 1..][..m]);
+        let g_mid = &g_row[reach..][..m];
+        let (b_mid, w_mid) = (&mut b_row[reach..][..m], &mut w_row[reach..][..m]);
         for i in 0..m {
-            let sum = br[i] + tl[i] - tr[i] - bl[i];
-            let g = g_mid[i] as u32;
-            let free = all | ((b_mid[i] | w_mid[i]) ^ 1);
-            let (b, w) = (((g + off) * n < sum) as u8, (g * n > sum + off * n) as u8);
-            b_mid[i] = (b_mid[i] & (free ^ 1)) | (b & free);
-            w_mid[i] = (w_mid[i] & (free ^ 1)) | (w & free);
+            let g = g_mid[i] as i32;
+            let mut v = verdict(g, off_nn, box_sum(br[i], tl[i], tr[i], bl[i]), nn);
+            if TWO {
+                v = combine(v, verdict(g, off_nw, box_sum(wbr[i], wtl[i], wtr[i], wbl[i]), nwide));
+            }
+            (b_mid[i], w_mid[i]) = v;
         }
     }
 }
@@ -277,43 +388,103 @@ mod tests {
         }
     }
 
+    /// The reference: each pixel's verdict from a plain 64-bit window sum, clipped to
+    /// the image, by the narrow window, and where that leaves it in the dead band by the
+    /// wide one (when it is wider).
+    fn reference(grey: &[u8], w: usize, h: usize, p: &AdaptiveThreshold) -> (Vec<bool>, Vec<bool>) {
+        let mut cum = vec![0u64; (w + 1) * (h + 1)];
+        for y in 0..h {
+            for x in 0..w {
+                cum[(y + 1) * (w + 1) + x + 1] =
+                    grey[y * w + x] as u64 + cum[y * (w + 1) + x + 1] + cum[(y + 1) * (w + 1) + x]
+                        - cum[y * (w + 1) + x];
+            }
+        }
+        let off = p.offset as u64;
+        let at = |x: usize, y: usize, r: usize| {
+            let (y0, y1, x0, x1) = (
+                y.saturating_sub(r),
+                (y + r + 1).min(h),
+                x.saturating_sub(r),
+                (x + r + 1).min(w),
+            );
+            let s = cum[y1 * (w + 1) + x1] + cum[y0 * (w + 1) + x0] - cum[y0 * (w + 1) + x1] - cum[y1 * (w + 1) + x0];
+            let n = ((y1 - y0) * (x1 - x0)) as u64;
+            let g = grey[y * w + x] as u64;
+            ((g + off) * n < s, g * n > s + off * n)
+        };
+        let r = (p.window_px.max(3) | 1) / 2;
+        let wide = (p.wide_window_px.max(3) | 1) / 2;
+        let (mut b, mut wh) = (vec![false; w * h], vec![false; w * h]);
+        for y in 0..h {
+            for x in 0..w {
+                let mut v = at(x, y, r);
+                if v == (false, false) && p.wide_window_px > 0 && wide > r {
+                    v = at(x, y, wide);
+                }
+                (b[y * w + x], wh[y * w + x]) = v;
+            }
+        }
+        (b, wh)
+    }
+
     proptest::proptest! {
-        /// The integral image, the branch-free interior and the clipped borders against
-        /// a plain 64-bit window sum, over small and large images, windows from 3 to
-        /// 238 px, and every offset.
+        /// The integral image, the branch-free interior and the clipped borders of one
+        /// window or two against the plain reference, over small and large images,
+        /// windows from 3 to 238 px, wide windows narrower (ignored) and wider, and every
+        /// offset; the images are noise or blocks of noise (wide flat areas, where the
+        /// narrow window's dead band leaves the pixels to the wide one).
         #[test]
         fn the_masks_agree_with_a_plain_window_sum(
-            (w, h, window) in proptest::prop_oneof![
-                (1usize..48, 1usize..40, 3usize..15),
-                (240usize..300, 240usize..260, 183usize..239),
+            (w, h, window, wide) in proptest::prop_oneof![
+                (1usize..48, 1usize..40, 3usize..15, 0usize..40),
+                (240usize..300, 240usize..260, 183usize..239, 0usize..300),
+                (60usize..200, 40usize..120, 3usize..11, 11usize..41),
             ],
             offset in proptest::prelude::any::<u8>(),
+            block in 1usize..12,
             seed in 0u64..1000,
         ) {
-            let grey: Vec<u8> = (0..w * h).map(|i| (mix(seed, i as u64) % 256) as u8).collect();
-            let p = AdaptiveThreshold { window_px: window, offset };
+            let grey: Vec<u8> =
+                (0..w * h).map(|i| (mix(seed, ((i % w) / block + (i / w / block) * w) as u64) % 256) as u8).collect();
+            let p = AdaptiveThreshold { window_px: window, offset, wide_window_px: wide };
             let (mut b, mut wh) = (Mask::new(1, 1), Mask::new(1, 1));
             Thresholder::new(w, h).apply(&grey, w, h, &p, &mut b, &mut wh);
-            // Reference: 64-bit cumulative sums, clipped windows.
-            let mut cum = vec![0u64; (w + 1) * (h + 1)];
+            let (rb, rw) = reference(&grey, w, h, &p);
             for y in 0..h {
                 for x in 0..w {
-                    cum[(y + 1) * (w + 1) + x + 1] = grey[y * w + x] as u64 + cum[y * (w + 1) + x + 1]
-                        + cum[(y + 1) * (w + 1) + x]
-                        - cum[y * (w + 1) + x];
+                    proptest::prop_assert_eq!(b.get(x, y), rb[y * w + x], "black ({}, {})", x, y);
+                    proptest::prop_assert_eq!(wh.get(x, y), rw[y * w + x], "white ({}, {})", x, y);
                 }
             }
-            let r = (window.max(3) | 1) / 2;
-            for y in 0..h {
-                for x in 0..w {
-                    let (y0, y1, x0, x1) = (y.saturating_sub(r), (y + r + 1).min(h), x.saturating_sub(r), (x + r + 1).min(w));
-                    let s = cum[y1 * (w + 1) + x1] + cum[y0 * (w + 1) + x0] - cum[y0 * (w + 1) + x1] - cum[y1 * (w + 1) + x0];
-                    let n = ((y1 - y0) * (x1 - x0)) as u64;
-                    let (g, off) = (grey[y * w + x] as u64, offset as u64);
-                    proptest::prop_assert_eq!(b.get(x, y), (g + off) * n < s, "black ({}, {})", x, y);
-                    proptest::prop_assert_eq!(wh.get(x, y), g * n > s + off * n, "white ({}, {})", x, y);
-                }
+        }
+
+        /// The fused grey-and-integral pass from RGB writes each pixel's
+        /// [`grey_from_rgb`] and the masks [`Thresholder::apply`] gives on that grey
+        /// image, with the buffers reused across frames of different sizes.
+        #[test]
+        fn the_rgb_pass_is_the_grey_pass_on_its_grey_image(
+            (w, h) in (1usize..90, 1usize..70),
+            offset in 0u8..40,
+            seed in 0u64..1000,
+        ) {
+            use crate::perception::RgbImage;
+            let mut im = RgbImage::new(w, h);
+            for (i, v) in im.as_bytes_mut().iter_mut().enumerate() {
+                *v = (mix(seed, (i / 3 / 4) as u64 * 3 + (i % 3) as u64) % 256) as u8;
             }
+            let p = AdaptiveThreshold { window_px: 7, offset, wide_window_px: 17 };
+            let mut t = Thresholder::default();
+            let (mut b, mut wh, mut grey) = (Mask::new(1, 1), Mask::new(1, 1), vec![9u8; 5000]);
+            t.apply_rgb(&RgbImage::new(w + 3, h + 2).view(), &mut grey, &p, &mut b, &mut wh);
+            t.apply_rgb(&im.view(), &mut grey, &p, &mut b, &mut wh);
+            let expect: Vec<u8> = im.as_bytes().chunks_exact(3).map(|q| grey_from_rgb([q[0], q[1], q[2]])).collect();
+            proptest::prop_assert_eq!(&grey, &expect);
+            let (mut b2, mut w2) = (Mask::new(1, 1), Mask::new(1, 1));
+            Thresholder::new(w, h).apply(&expect, w, h, &p, &mut b2, &mut w2);
+            proptest::prop_assert_eq!(b.data(), b2.data());
+            proptest::prop_assert_eq!(wh.data(), w2.data());
+            proptest::prop_assert_eq!(b.size(), (w, h));
         }
     }
 
