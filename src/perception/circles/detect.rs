@@ -14,7 +14,7 @@
 //!
 //! **Per frame**, into buffers the detector owns (nothing is allocated after
 //! [`CircleDetector::new`] or [`CircleDetector::resize`]):
-//! 1. grey levels, then the local-mean threshold ([`AdaptiveThreshold`], a 7-px window for
+//! 1. grey levels, then the local-mean threshold ([`AdaptiveThreshold`], a 5-px window for
 //!    the thin rims of far marks and a wider one for the pixels it leaves undecided in
 //!    the wide black areas of near ones) into a black and a white mask, labelled black
 //!    8-connected, white 4-connected (the consistent pair: a thin black rim closed only
@@ -149,17 +149,21 @@ pub struct CircleParams {
 
 impl CircleParams {
     /// Defaults for a `width`-pixel-wide image (our choices; the paper gives none):
-    /// * window: 7 px, then width/64 (odd, at least 11 px; 17 px at 1024) for the pixels
-    ///   the first leaves in its dead band. The narrow window is no wider than the
-    ///   smallest mark reported (minor semi-axis ≥ 4 px, 8 px across), so that a rim
-    ///   pixel's mean is the mark's own bright ring and margin and not the dark module face
-    ///   around it: with width/64 alone the face pulled the mean of a mark 14 px across
-    ///   (Axel at 4.5 m) down to its 1.5-px rim's grey, the rim fell into the dead band
-    ///   and broke (Euler number 1, no hole), and no mark past 4 m was found. The narrow
-    ///   window alone leaves the middle of a rim wider than about 6 px (Axel's marks
-    ///   nearer than about 1 m) in its dead band, hollow; the wide one, wider than the
-    ///   rim and ring of a mark at docking range, fills it in. Measured range on Axel's
-    ///   1024 px fish-eye: `tests/axel_world.rs`;
+    /// * window: 5 px, then width/64 (odd, at least 11 px; 17 px at 1024) for the pixels
+    ///   the first leaves in its dead band. The narrow window reaches 2 px either side of
+    ///   a rim pixel, no further than the mark's own bright ring inside and white margin
+    ///   outside (each 0.2–0.3 R: 1.2–1.8 px for a mark 12 px across, Axel's at 5.5 m), so
+    ///   that its mean is the mark's and not the dark core's and module face's around the
+    ///   thin rim. A wider window pulls the mean of a far mark's blurred rim pixel down to
+    ///   its own grey, the rim falls into the dead band, breaks (Euler number 1, no hole)
+    ///   and the mark is lost at the Euler filter: with width/64 alone no mark past 4 m
+    ///   was found, with 7 px none past 5 m (measured on rendered frames, each projected
+    ///   mark's black blob and its Euler number; `tests/axel_world.rs`). A 3-px window
+    ///   keeps rims to 6.5 m but decides the flat inside of near marks by noise (σ ≈ 6
+    ///   grey levels), and no mark at 1 m survives it. The narrow window alone leaves the
+    ///   middle of a rim wider than about 4 px (Axel's marks nearer than about 1.5 m) in
+    ///   its dead band, hollow; the wide one, wider than the rim and ring of a mark at
+    ///   docking range, fills it in;
     /// * offset 8 grey levels: above the sensor noise of a flat surface, far below a
     ///   printed mark's black-to-white contrast even in shade;
     /// * black blob from 12 px (a rim about 9 px across) to 5 % of the image;
@@ -178,7 +182,7 @@ impl CircleParams {
     pub fn for_image(width: usize) -> Self {
         Self {
             threshold: AdaptiveThreshold {
-                window_px: 7,
+                window_px: 5,
                 offset: 8,
                 wide_window_px: ((width / 64).max(11)) | 1,
             },
