@@ -10,7 +10,8 @@
 //! Axel's circle fiducials (issue 16): detection, correspondence, the module's pose
 //! (stereo triangulation and rigid fit; the monocular fallback), and the whole stereo
 //! pipeline (detect, correspond and pose both frames), on rendered 640×480 frames of the
-//! central module 1.5 m away, 15° off its axis. Target (issue 16): detection,
+//! central module 1.5 m away, 15° off its axis, with the detection's stages apart (grey and
+//! threshold, labelling, the Euler index). Target (issue 16): detection,
 //! correspondence and pose for a stereo pair under 5 ms on one core.
 //!
 //! The AutoKrawler's stages so far (issue 17), on rendered 640×480 belly-fisheye frames:
@@ -237,6 +238,44 @@ fn bench_circles(c: &mut Criterion) {
     g.bench_function("detect_one_frame", |b| {
         b.iter(|| black_box(det.detect(black_box(&frames[0].view())).expect("detect").len()))
     });
+    // The detection's stages, each on the same frame with its own reusable buffers: the
+    // grey image and both masks, labelling both masks, the black blobs' Euler index. What
+    // `detect_one_frame` spends beyond their sum is the blob filters, pairing and refinement.
+    {
+        use marsupial::perception::circles::{RunIndex, Thresholder};
+        let det_params = *det.params();
+        det.detect(&frames[0].view()).expect("detect");
+        let [black, white] = det.masks().clone();
+        let mut thr = Thresholder::new(w, h);
+        let (mut grey, mut bm, mut wm) = (Vec::with_capacity(w * h), Mask::new(w, h), Mask::new(w, h));
+        g.bench_function("stage_grey_and_threshold", |b| {
+            b.iter(|| {
+                thr.apply_rgb(
+                    black_box(&frames[0].view()),
+                    &mut grey,
+                    &det_params.threshold,
+                    &mut bm,
+                    &mut wm,
+                );
+                black_box(bm.data()[w * h / 2])
+            })
+        });
+        let (mut lb, mut lw) = (Labeler::new(w, h), Labeler::new_four_connected(w, h));
+        g.bench_function("stage_label_both_masks", |b| {
+            b.iter(|| {
+                let nb = lb.label(black_box(&black)).expect("label").len();
+                black_box(nb + lw.label(black_box(&white)).expect("label").len())
+            })
+        });
+        let mut index = RunIndex::new(w, h);
+        lb.label(&black).expect("label");
+        g.bench_function("stage_euler_index_black", |b| {
+            b.iter(|| {
+                index.build(black_box(&lb));
+                black_box(index.euler(0))
+            })
+        });
+    }
     g.bench_function("correspond_eight_marks", |b| {
         b.iter(|| black_box(correspond(&model, black_box(&marks), &params).expect("fit").inliers))
     });
