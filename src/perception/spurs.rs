@@ -13,7 +13,8 @@
 //! The detector leaves the mask and its components as they are (pruning the mask itself
 //! breaks the ragged blocks of a poorly fitting colour model apart, measured on
 //! `bujold-robustness`'s static mode), and takes a block's spurs out of its count only,
-//! the count the ratio cue compares.
+//! the count the ratio cue compares, and only while they are a small share of it
+//! (`two_block::MAX_SPUR_SHARE`): past that the block is ragged and its spurs are paint.
 
 use super::components::Run;
 use super::segment::Mask;
