@@ -282,16 +282,21 @@ fn decide<const TWO: bool>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::ops::Range;
+
+    /// A `w`×`h` grey (120) image with a dark (20) square over columns `xs`, rows `ys`.
+    fn dark_square_on_grey(w: usize, h: usize, xs: Range<usize>, ys: Range<usize>) -> Vec<u8> {
+        let mut grey = vec![120u8; w * h];
+        for y in ys {
+            grey[y * w + xs.start..y * w + xs.end].fill(20);
+        }
+        grey
+    }
 
     #[test]
     fn a_dark_square_on_grey_is_black_its_surround_white_and_flat_areas_neither() {
         let (w, h) = (40, 30);
-        let mut grey = vec![120u8; w * h];
-        for y in 10..20 {
-            for x in 15..25 {
-                grey[y * w + x] = 20;
-            }
-        }
+        let grey = dark_square_on_grey(w, h, 15..25, 10..20);
         let (mut b, mut wh) = (Mask::new(1, 1), Mask::new(1, 1));
         let p = AdaptiveThreshold {
             window_px: 15,
@@ -311,12 +316,7 @@ mod tests {
         // A dark square 21 px wide on grey: a 7-px window leaves its middle in the dead
         // band (the mean there is the pixel's own grey), a 41-px one fills it in.
         let (w, h) = (60, 50);
-        let mut grey = vec![120u8; w * h];
-        for y in 15..36 {
-            for x in 20..41 {
-                grey[y * w + x] = 20;
-            }
-        }
+        let grey = dark_square_on_grey(w, h, 20..41, 15..36);
         let narrow = AdaptiveThreshold {
             window_px: 7,
             offset: 8,
