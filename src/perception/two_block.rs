@@ -44,6 +44,12 @@ use serde::Serialize;
 /// holes and notches whose spurs are paint, and taking them out biases the count.
 pub const MAX_SPUR_SHARE: f64 = 0.05;
 
+/// The smaller block's pixel count over the larger's, in (0, 1]: the balance the pairing
+/// limits and prefers, and the ratio a [`Pair`] reports.
+fn count_ratio(a: u64, b: u64) -> f64 {
+    a.min(b) as f64 / a.max(b) as f64
+}
+
 /// Pairing limits (a profile's `[perception]` gives them: `PairLimits::from(&spec)`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PairLimits {
@@ -249,7 +255,7 @@ impl TwoBlockDetector {
                 if hl.max(hr) > lim.max_height_ratio * hl.min(hr) {
                     continue;
                 }
-                let ratio = l.count.min(r.count) as f64 / l.count.max(r.count) as f64;
+                let ratio = count_ratio(l.count, r.count);
                 if ratio < lim.min_count_ratio {
                     continue;
                 }
@@ -293,8 +299,7 @@ impl TwoBlockDetector {
                 block.count = block.count.saturating_sub(spurs).max(1);
             }
         }
-        let (l, r) = (pair.left.count, pair.right.count);
-        pair.ratio = l.min(r) as f64 / l.max(r) as f64;
+        pair.ratio = count_ratio(pair.left.count, pair.right.count);
         pair
     }
 
