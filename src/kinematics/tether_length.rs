@@ -50,9 +50,34 @@ impl TetherGeometry {
         exposed_length(self.arm, dx.hypot(dy), dy.atan2(dx), wrap_angle(pose.theta - PI))
     }
 
+    /// The farthest the axle can be from the mouth with `exposed` m of tether paid out, m:
+    /// the tip lies within `exposed` of the anchor and the axle within the arm of the tip.
+    /// Exact for a taut tether with the arm pointing at the anchor from the module's axis;
+    /// off the axis the anchor's depth shortens the span by `depth·(1 − cos α)`, under
+    /// 6 cm within α = 40°. Slack only makes the true distance shorter. The paper had no
+    /// range sensor beyond the cameras; the reel's own length reading is this one.
+    pub fn farthest_from_mouth(&self, exposed: f64) -> f64 {
+        exposed.max(0.0) + self.arm + self.anchor.0
+    }
+
     /// The change of exposed length over `arc` from `from`, m (negative: shorter).
     pub fn change_along(&self, from: &Pose2, arc: &Arc) -> f64 {
         self.length_at(&arc.end(from)) - self.length_at(from)
+    }
+
+    /// How far the paper's linear approximation strays along `arc` from `from`, m: the
+    /// largest difference, over 32 equal steps, between the exact exposed length and the
+    /// straight line from its start value to its end value that a constant reel rate
+    /// pays out. The paper found the approximation sufficient for turns under about 30°
+    /// (§V-F); `tests`' table measures it over the approach workspace.
+    pub fn linear_error(&self, from: &Pose2, arc: &Arc) -> f64 {
+        let (l0, l1) = (self.length_at(from), self.length_at(&arc.end(from)));
+        (1..32)
+            .map(|i| {
+                let f = i as f64 / 32.0;
+                (self.length_at(&arc.at(from, arc.length * f)) - (l0 + (l1 - l0) * f)).abs()
+            })
+            .fold(0.0, f64::max)
     }
 
     /// The reel rate (m/s, positive reels in) that follows `arc` from `from` driven at
@@ -98,6 +123,62 @@ mod tests {
         assert!((g.reel_rate(&p, &back, 0.08) + 0.08).abs() < 1e-12);
     }
 
+    /// The linear approximation's error against the arc's turn, over 4 000 arcs from the
+    /// approach workspace (axle 1.5–5 m from the mouth, |α| ≤ 40°, |h| ≤ 30°; radius
+    /// 0.5–4 m, at most 1.5 m long: an approach step), Axel's arm and anchor. Prints the
+    /// table the README quotes (`cargo test --lib linear_approximation -- --nocapture`).
+    #[test]
+    fn the_linear_approximation_strays_with_the_turn() {
+        let g = TetherGeometry::new(0.25, 0.55);
+        let mut s = 0x2013u64;
+        let mut rnd = move |lo: f64, hi: f64| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            lo + (hi - lo) * ((s >> 11) as f64 / (1u64 << 53) as f64)
+        };
+        let edges = [0.0, 15.0, 30.0, 45.0, 90.0];
+        let mut errs: Vec<Vec<f64>> = vec![Vec::new(); 4];
+        while errs.iter().map(Vec::len).sum::<usize>() < 4000 {
+            let (r, a, h) = (
+                rnd(1.5, 5.0),
+                rnd(-40.0, 40.0).to_radians(),
+                rnd(-30.0, 30.0).to_radians(),
+            );
+            let from = Pose2::new(r * a.cos(), r * a.sin(), PI + h);
+            let turn = rnd(2.0, 90.0);
+            let radius = rnd(0.5, 4.0);
+            let length = turn.to_radians() * radius;
+            if length > 1.5 {
+                continue;
+            }
+            let sign = if rnd(0.0, 1.0) < 0.5 { -1.0 } else { 1.0 };
+            let arc = Arc {
+                curvature: sign / radius,
+                length,
+            };
+            let bin = edges.windows(2).position(|w| turn >= w[0] && turn < w[1]).unwrap();
+            errs[bin].push(g.linear_error(&from, &arc));
+        }
+        let mut means = [0.0; 4];
+        println!("| turn | arcs | mean error | 95th percentile |");
+        for (i, e) in errs.iter_mut().enumerate() {
+            e.sort_by(f64::total_cmp);
+            means[i] = e.iter().sum::<f64>() / e.len() as f64;
+            let p95 = e[(e.len() * 95) / 100];
+            println!(
+                "| {}–{}° | {} | {:.1} cm | {:.1} cm |",
+                edges[i],
+                edges[i + 1],
+                e.len(),
+                means[i] * 100.0,
+                p95 * 100.0
+            );
+        }
+        // The error grows with the turn, bin by bin.
+        assert!(means.windows(2).all(|w| w[0] < w[1]), "{means:?}");
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(128))]
 
@@ -116,6 +197,24 @@ mod tests {
             }
             let change = g.change_along(&from, &arc);
             prop_assert!((change - (direct(&g, &arc.end(&from)) - direct(&g, &from))).abs() < 1e-9);
+        }
+
+        /// Whatever the heading and slack, the axle is no farther from the mouth than the
+        /// reel's length says, give or take the anchor's depth off the axis; and the bound
+        /// is exact facing the anchor from the axis.
+        #[test]
+        fn the_reel_length_bounds_the_distance_to_the_mouth(
+            r in 0.7f64..8.0, alpha in -0.7f64..0.7, th in -PI..PI,
+            slack in 0.0f64..1.0, arm in 0.1f64..1.0, depth in 0.0f64..0.5,
+        ) {
+            let g = TetherGeometry::new(depth, arm);
+            let p = Pose2::new(r * alpha.cos(), r * alpha.sin(), th);
+            let bound = g.farthest_from_mouth(g.length_at(&p) + slack);
+            prop_assert!(r <= bound + depth * (1.0 - alpha.cos()) + 1e-9, "{r} > {bound}");
+            if r > arm {
+                let facing = Pose2::new(r, 0.0, PI);
+                prop_assert!((g.farthest_from_mouth(g.length_at(&facing)) - r).abs() < 1e-9);
+            }
         }
     }
 }

@@ -9,6 +9,21 @@
 //! side the module was last seen on, counter-clockwise when it was never seen. After
 //! `behavior.search_timeout_s` without a trusted pose the docking fails: `target_lost`
 //! if the module was seen this docking, `target_never_detected` otherwise.
+//!
+//! **Reeling closer** (`reel_beyond_range`, ours). With no recovery step to take, the
+//! reel's length reading still bounds the range
+//! ([`TetherGeometry::farthest_from_mouth`](crate::kinematics::tether_length::TetherGeometry::farthest_from_mouth)).
+//! When that bound lies beyond the detection range (`view.range_m`), turning cannot
+//! help: the module may be dead ahead with its marks too small to resolve (the paper's
+//! marks were "designed to be discernable from 5 m", §V-B). The rover then reels in one
+//! step (at most `step_m`, to 0.3 m inside the range) with its wheels free, as in the
+//! paper's pure reeling (§V-C): the tether drags it toward the module and turns its
+//! leading arm, and with it the cameras, to face the module. Then it looks again. The
+//! paper suggests combining tether-based and vision-based docking "for significantly
+//! improved docking range and heading capability" (§V-C); this is that combination, only
+//! while nothing is seen and only far from the cone, where reeling cannot push the arm
+//! into it. A reel step restarts the search's clock: it is progress, and the steps
+//! end once the tether is within range.
 
 use super::cycle::{Cycle, CycleParams, Decision};
 use super::memory::{Memory, Trust, ViewLimits};
@@ -38,6 +53,10 @@ pub struct AcquireParams {
     pub near_m: f64,
     /// The detection range the recovery closes into (`range_m`; the margin is unused).
     pub view: ViewLimits,
+    /// With nothing seen and no recovery step to take, reel in closer while the reel's
+    /// length puts the module possibly beyond `view.range_m` (module docs). Off: the
+    /// paper's vision-only search, which turns in place.
+    pub reel_beyond_range: bool,
 }
 
 impl Default for AcquireParams {
@@ -50,8 +69,16 @@ impl Default for AcquireParams {
             step_m: 1.0,
             near_m: 1.3,
             view: ViewLimits::default(),
+            reel_beyond_range: false,
         }
     }
+}
+
+/// How much to reel in (wheels free) before looking again, m, when the module may lie
+/// farther than `range` m from the mouth: `farthest` m by the reel's length (at most
+/// `step` m, to 0.3 m inside the range). `None` when it cannot be beyond the range.
+pub fn reel_closer(farthest: f64, range: f64, step: f64) -> Option<f64> {
+    (farthest > range).then(|| (farthest - range + 0.3).min(step))
 }
 
 /// One recovery step from the dead-reckoned module-frame pose `at`: turn to face the
@@ -134,6 +161,9 @@ impl Behavior for Acquire {
         }
         let p = self.params;
         let recovered = &mut self.recovered;
+        // A reel step is progress, not search: the search's clock restarts with it (the
+        // steps are bounded: each shortens the tether until it is within range).
+        let since = &mut self.since;
         Some(self.cycle.tick(&mut m, "acquire", |m, seen| match seen {
             Some(s) => {
                 m.search_sign = Polar::from_pose(&s.pose).bearing().signum();
@@ -148,12 +178,20 @@ impl Behavior for Acquire {
                     }
                     recovery(&at, p.near_m, p.view.range_m, p.step_m)
                 });
-                match back {
-                    Some(d) => {
+                let farthest = m.reel.map(|r| m.geometry.tether.farthest_from_mouth(r.length));
+                let reel = farthest
+                    .filter(|_| p.reel_beyond_range)
+                    .and_then(|f| reel_closer(f, p.view.range_m, p.step_m));
+                match (back, reel) {
+                    (Some(d), _) => {
                         *recovered += 1;
                         d
                     }
-                    None => Decision::Turn(p.turn_deg.to_radians() * m.search_sign),
+                    (None, Some(length)) => {
+                        *since = m.now;
+                        Decision::Reel(length)
+                    }
+                    (None, None) => Decision::Turn(p.turn_deg.to_radians() * m.search_sign),
                 }
             }
         }))
@@ -194,5 +232,15 @@ mod tests {
         }
         // Facing it within range: nothing to recover, the sweep takes over.
         assert_eq!(recovery(&Pose2::new(3.0, 0.1, PI), 1.3, 4.0, 1.0), None);
+    }
+
+    #[test]
+    fn reels_closer_only_beyond_the_range() {
+        // 6 m by the reel with a 4 m range: a full 1 m step; 4.4 m: to 0.3 m inside.
+        assert_eq!(reel_closer(6.0, 4.0, 1.0), Some(1.0));
+        assert!((reel_closer(4.4, 4.0, 1.0).unwrap() - 0.7).abs() < 1e-12);
+        // Within the range the sweep takes over.
+        assert_eq!(reel_closer(4.0, 4.0, 1.0), None);
+        assert_eq!(reel_closer(2.5, 4.0, 1.0), None);
     }
 }

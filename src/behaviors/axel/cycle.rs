@@ -43,6 +43,11 @@ pub enum Decision {
     },
     /// Turn in place by this much, rad (counter-clockwise positive), then look again.
     Turn(f64),
+    /// Wheels in free rotation, reel in this much tether, m, by the reel's own length
+    /// reading, then look again: the tether drags the rover toward the module and turns
+    /// its leading arm (and the cameras) to face it (the paper's pure reeling, §V-C, as a
+    /// step).
+    Reel(f64),
     /// End this state with the event.
     Event(&'static str),
     /// End the docking with this outcome.
@@ -67,6 +72,10 @@ enum State {
         omega: f64,
         left: f64,
         last: f64,
+    },
+    Reel {
+        until: f64,
+        deadline: f64,
     },
 }
 
@@ -154,6 +163,7 @@ impl Cycle {
                         };
                         m.drive(DriveCommand::Turn { omega }, 0.0, phase)
                     }
+                    Decision::Reel(length) => self.begin_reel(m, length, phase),
                     Decision::Event(e) => {
                         self.restart(now);
                         m.hold(phase).with_event(e)
@@ -193,7 +203,30 @@ impl Cycle {
                 };
                 m.drive(DriveCommand::Turn { omega }, 0.0, phase)
             }
+            State::Reel { until, deadline } => {
+                if now >= deadline || m.reel.is_none_or(|r| r.length <= until) {
+                    self.restart(now);
+                    return m.hold(phase);
+                }
+                m.free_reel(phase)
+            }
         }
+    }
+
+    /// Starts reeling in `length` m with the wheels free. The reel's length reading ends
+    /// it; so does twice the time the reel needs at its top rate, plus 2 s (a reel
+    /// pulling against a caught arm is the `axel.stall` leaf's to judge, by its current).
+    /// Without a reel reading there is nothing to measure by: hold and look again.
+    fn begin_reel(&mut self, m: &mut Memory, length: f64, phase: &'static str) -> Step {
+        let Some(r) = m.reel.filter(|_| length > 0.0) else {
+            self.restart(m.now);
+            return m.hold(phase);
+        };
+        self.state = State::Reel {
+            until: r.length - length,
+            deadline: m.now + 2.0 * length / m.geometry.max_reel_rate.max(1e-6) + 2.0,
+        };
+        m.free_reel(phase)
     }
 
     /// [`Cycle::tick`] for a schema that plans only on a trusted pose: `decide` gets the

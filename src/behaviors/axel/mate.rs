@@ -15,9 +15,7 @@ use super::memory::Memory;
 use crate::arbiter::Blackboard;
 use crate::geometry::Pose2;
 use crate::kinematics::two_arc::Arc;
-use crate::schemas::{
-    Auxiliary, Behavior, DriveCommand, FailureReason, Inputs, MotorOutput, Outcome, Step, TetherCommand,
-};
+use crate::schemas::{Behavior, DriveCommand, FailureReason, Inputs, Outcome, Step};
 use serde::Deserialize;
 
 /// `axel.mate`'s params.
@@ -125,14 +123,7 @@ impl Behavior for Mate {
                     );
                 }
                 let reeled = m.reel.is_some_and(|r| r.length <= until);
-                let out = MotorOutput::drive(DriveCommand::Stop).with_aux(Auxiliary {
-                    tether: Some(TetherCommand {
-                        reel_rate: g.max_reel_rate,
-                        free_wheel: true,
-                    }),
-                    ..Default::default()
-                });
-                let step = Step::running(out, m.feedback("mate_reel"));
+                let step = m.free_reel("mate_reel");
                 Some(if reeled { step.finishing(Outcome::Docked) } else { step })
             }
         }

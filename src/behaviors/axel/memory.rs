@@ -353,6 +353,19 @@ impl Memory {
         Step::running(out, self.feedback(phase))
     }
 
+    /// The base stopped with its wheels in free rotation, the reel winding in at its top
+    /// rate (pure reeling), feedback `phase`.
+    pub fn free_reel(&self, phase: &'static str) -> Step {
+        let out = MotorOutput::stop().with_aux(crate::schemas::Auxiliary {
+            tether: Some(TetherCommand {
+                reel_rate: self.geometry.max_reel_rate,
+                free_wheel: true,
+            }),
+            ..Default::default()
+        });
+        Step::running(out, self.feedback(phase))
+    }
+
     /// Records a trusted sighting as the last fix, with this tick's odometry.
     pub fn fix(&mut self, s: &Sighting) {
         self.seen = true;

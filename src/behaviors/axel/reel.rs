@@ -12,7 +12,7 @@
 
 use super::memory::Memory;
 use crate::arbiter::Blackboard;
-use crate::schemas::{Auxiliary, Behavior, Inputs, MotorOutput, Step, TetherCommand};
+use crate::schemas::{Behavior, Inputs, Step};
 
 /// See the module docs.
 pub struct Reel {
@@ -33,14 +33,6 @@ impl Behavior for Reel {
     }
 
     fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let m = self.mem.lock();
-        let out = MotorOutput::stop().with_aux(Auxiliary {
-            tether: Some(TetherCommand {
-                reel_rate: m.geometry.max_reel_rate,
-                free_wheel: true,
-            }),
-            ..Default::default()
-        });
-        Some(Step::running(out, m.feedback("reel")))
+        Some(self.mem.lock().free_reel("reel"))
     }
 }
