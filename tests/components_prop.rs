@@ -8,6 +8,11 @@ use std::collections::VecDeque;
 /// Reference: BFS flood fill, 8-connected, components numbered in raster order of their
 /// first pixel, with the same integer statistics.
 fn flood_fill(mask: &Mask) -> Vec<Component> {
+    flood_fill_with(mask, true)
+}
+
+/// [`flood_fill`], 8-connected when `eight`, else 4-connected.
+fn flood_fill_with(mask: &Mask, eight: bool) -> Vec<Component> {
     let (w, h) = mask.size();
     let mut seen = vec![false; w * h];
     let mut out = Vec::new();
@@ -38,6 +43,9 @@ fn flood_fill(mask: &Mask) -> Vec<Component> {
                 ];
                 for dy in -1i64..=1 {
                     for dx in -1i64..=1 {
+                        if !eight && dx != 0 && dy != 0 {
+                            continue;
+                        }
                         let (nx, ny) = (x as i64 + dx, y as i64 + dy);
                         if nx < 0 || ny < 0 || nx >= w as i64 || ny >= h as i64 {
                             continue;
@@ -177,5 +185,107 @@ proptest! {
             }
         }
         check(&m);
+    }
+}
+
+/// `mask` with every pixel outside the inclusive box `b` cleared.
+fn cropped(mask: &Mask, b: [u32; 4]) -> Mask {
+    let inside = |x: usize, y: usize| {
+        (b[0] as usize..=b[2] as usize).contains(&x) && (b[1] as usize..=b[3] as usize).contains(&y)
+    };
+    mask_from(mask.width(), mask.height(), |x, y| inside(x, y) && mask.get(x, y))
+}
+
+/// `label_box` against the flood fill of the mask cleared outside the box, both
+/// connectivities; and every box component clear of the box's border is one of the whole
+/// frame's components, statistics and all (what the circle detector relies on).
+fn check_box(mask: &Mask, b: [u32; 4]) {
+    let (w, h) = mask.size();
+    for eight in [true, false] {
+        let new = |w, h| {
+            if eight {
+                Labeler::new(w, h)
+            } else {
+                Labeler::new_four_connected(w, h)
+            }
+        };
+        let mut l = new(w, h);
+        let got = l.label_box(mask, b).unwrap().to_vec();
+        assert_eq!(
+            got,
+            flood_fill_with(&cropped(mask, b), eight),
+            "eight {eight} box {b:?}"
+        );
+        for r in l.runs() {
+            assert!(
+                r.x0 >= b[0] && r.x1 <= b[2] + 1 && r.y >= b[1] && r.y <= b[3],
+                "{r:?} outside {b:?}"
+            );
+        }
+        let mut whole = new(w, h);
+        let all = whole.label(mask).unwrap();
+        for c in &got {
+            if c.bbox[0] > b[0] && c.bbox[1] > b[1] && c.bbox[2] < b[2] && c.bbox[3] < b[3] {
+                assert!(
+                    all.contains(c),
+                    "eight {eight}: {c:?} of box {b:?} is no whole-frame component"
+                );
+            }
+        }
+        for c in all {
+            if c.bbox[0] > b[0] && c.bbox[1] > b[1] && c.bbox[2] < b[2] && c.bbox[3] < b[3] {
+                assert!(
+                    got.contains(c),
+                    "eight {eight}: {c:?} inside {b:?} was not found in the box"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn boxes_at_the_edges_and_beyond() {
+    let m = mask_from(17, 13, |x, y| (x / 3 + y) % 2 == 0 || x == y);
+    for b in [
+        [0, 0, 16, 12],
+        [0, 0, 0, 0],
+        [16, 12, 16, 12],
+        [3, 2, 40, 40],
+        [5, 5, 4, 9],
+        [2, 3, 9, 3],
+    ] {
+        check_box(&m, b);
+    }
+    let mut l = Labeler::new(17, 13);
+    assert!(
+        l.label_box(&m, [20, 0, 30, 5]).unwrap().is_empty(),
+        "a box off the mask"
+    );
+    assert!(l.label_box(&Mask::new(4, 4), [0, 0, 3, 3]).is_err());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 1500, ..ProptestConfig::default() })]
+
+    #[test]
+    fn boxes_match_the_flood_fill_of_the_cropped_mask(
+        w in 1usize..40,
+        h in 1usize..30,
+        density in 0.0f64..1.0,
+        seed in any::<u64>(),
+        corners in any::<[u8; 4]>(),
+    ) {
+        let mut s = seed | 1;
+        let mut next = move || { s ^= s << 13; s ^= s >> 7; s ^= s << 17; s };
+        let threshold = (density * u64::MAX as f64) as u64;
+        let mut m = Mask::new(w, h);
+        for y in 0..h {
+            for x in 0..w {
+                m.set(x, y, next() < threshold);
+            }
+        }
+        let (xa, xb) = (corners[0] as u32 % w as u32, corners[1] as u32 % w as u32);
+        let (ya, yb) = (corners[2] as u32 % h as u32, corners[3] as u32 % h as u32);
+        check_box(&m, [xa.min(xb), ya.min(yb), xa.max(xb), ya.max(yb)]);
     }
 }

@@ -1,7 +1,7 @@
 //! 8-connected component labelling, run-based, linear in the pixel count.
 //!
-//! Each mask row is scanned once for runs of set pixels (eight bytes at a time across
-//! empty stretches). A run joins every run of the previous row it touches, including
+//! Each mask row is scanned once for runs of set pixels, eight bytes at a time across
+//! both the gaps and the runs. A run joins every run of the previous row it touches, including
 //! diagonally; equivalences live in a flat union-find array (the paper used a hash table,
 //! seed 004 §IV.B; a flat array is the same O(n·m) and faster). A second pass over the runs,
 //! not the pixels, flattens labels and accumulates statistics.
@@ -180,6 +180,70 @@ fn find(parent: &mut [u32], mut i: u32) -> u32 {
     root
 }
 
+/// Every byte set.
+const ONES: u64 = u64::from_ne_bytes([0x01; 8]);
+/// Every byte's top bit.
+const HIGHS: u64 = u64::from_ne_bytes([0x80; 8]);
+
+/// Eight bytes of `row` from `x` as a little-endian word: byte k of the row is bits
+/// 8k … 8k + 7, so a word's lowest set byte is the row's first.
+#[inline(always)]
+fn word(row: &[u8], x: usize) -> u64 {
+    let mut b = [0u8; 8];
+    b.copy_from_slice(&row[x..x + 8]);
+    u64::from_le_bytes(b)
+}
+
+/// Appends the runs of set bytes of one mask row (`row` starting at column `x_off` of
+/// row `y`), each labelled with its own index. Both the gaps and the runs are crossed
+/// eight bytes at a time: a word's first set byte is its lowest non-zero one, its first
+/// clear byte the lowest flagged by the exact zero-byte test (v − 0x01…) & !v & 0x80…
+/// (a borrow can flag only bytes above a true zero), so the bytes need not be 0/1.
+#[inline]
+fn push_runs(row: &[u8], y: u32, x_off: u32, runs: &mut Vec<Run>) {
+    let n = row.len();
+    let mut x = 0usize;
+    while x < n {
+        // To the next set byte.
+        if x + 8 <= n {
+            let v = word(row, x);
+            if v == 0 {
+                x += 8;
+                continue;
+            }
+            x += (v.trailing_zeros() / 8) as usize;
+        } else if row[x] == 0 {
+            x += 1;
+            continue;
+        }
+        let start = x;
+        // To the next clear byte (or the row's end).
+        loop {
+            if x + 8 <= n {
+                let v = word(row, x);
+                let zeros = v.wrapping_sub(ONES) & !v & HIGHS;
+                if zeros == 0 {
+                    x += 8;
+                    continue;
+                }
+                x += (zeros.trailing_zeros() / 8) as usize;
+            } else {
+                while x < n && row[x] != 0 {
+                    x += 1;
+                }
+            }
+            break;
+        }
+        let id = runs.len() as u32;
+        runs.push(Run {
+            y,
+            x0: x_off + start as u32,
+            x1: x_off + x as u32,
+            label: id,
+        });
+    }
+}
+
 impl Labeler {
     /// A labeller for masks of `width × height`, with worst-case buffers allocated now.
     pub fn new(width: usize, height: usize) -> Self {
@@ -220,42 +284,45 @@ impl Labeler {
     /// [`VisionError::SizeMismatch`] when the mask is not the labeller's size.
     pub fn label(&mut self, mask: &Mask) -> Result<&[Component], VisionError> {
         check_same_size((self.width, self.height), mask.size())?;
+        if self.width == 0 || self.height == 0 {
+            self.runs.clear();
+            self.parent.clear();
+            self.components.clear();
+            return Ok(&self.components);
+        }
+        let full = [0, 0, self.width as u32 - 1, self.height as u32 - 1];
+        self.label_box(mask, full)
+    }
+
+    /// Labels only the pixels of `mask` inside `bbox` (inclusive, `[x_min, y_min, x_max,
+    /// y_max]` as [`Component::bbox`], clipped to the mask), as if the rest were clear.
+    /// Coordinates, runs and statistics stay the frame's, and labels follow the raster
+    /// order within the box. A component of the box that does not touch its border is
+    /// exactly the whole frame's component (any link outwards would pass through the
+    /// border), which is why a caller looking for blobs inside another blob's box can
+    /// label that box alone instead of the frame.
+    ///
+    /// # Errors
+    /// [`VisionError::SizeMismatch`] when the mask is not the labeller's size.
+    pub fn label_box(&mut self, mask: &Mask, bbox: [u32; 4]) -> Result<&[Component], VisionError> {
+        check_same_size((self.width, self.height), mask.size())?;
         self.runs.clear();
         self.parent.clear();
         self.components.clear();
         let w = self.width;
+        let (x0, y0) = (bbox[0] as usize, bbox[1] as usize);
+        let (x1, y1) = ((bbox[2] as usize + 1).min(w), (bbox[3] as usize + 1).min(self.height));
+        if x0 >= x1 || y0 >= y1 {
+            return Ok(&self.components);
+        }
         let data = mask.data();
         let mut prev_start = 0usize; // index of the previous row's first run
-        for y in 0..self.height {
-            let row = &data[y * w..(y + 1) * w];
+        for y in y0..y1 {
             let row_start = self.runs.len();
-            let mut x = 0usize;
-            while x < w {
-                // Skip zeros eight at a time.
-                while x + 8 <= w && u64::from_ne_bytes(row[x..x + 8].try_into().unwrap_or([0; 8])) == 0 {
-                    x += 8;
-                }
-                while x < w && row[x] == 0 {
-                    x += 1;
-                }
-                if x >= w {
-                    break;
-                }
-                let x0 = x;
-                while x < w && row[x] != 0 {
-                    x += 1;
-                }
-                let id = self.runs.len() as u32;
-                self.runs.push(Run {
-                    y: y as u32,
-                    x0: x0 as u32,
-                    x1: x as u32,
-                    label: id,
-                });
-                self.parent.push(id);
-            }
+            push_runs(&data[y * w + x0..y * w + x1], y as u32, x0 as u32, &mut self.runs);
+            self.parent.extend(row_start as u32..self.runs.len() as u32);
             // Join with the previous row's runs (both lists are sorted by x).
-            if y > 0 {
+            if y > y0 {
                 let mut j = prev_start;
                 for i in row_start..self.runs.len() {
                     let cur = self.runs[i];

@@ -16,17 +16,18 @@
 //! [`CircleDetector::new`] or [`CircleDetector::resize`]):
 //! 1. grey levels, then the local-mean threshold ([`AdaptiveThreshold`], a 5-px window for
 //!    the thin rims of far marks and a wider one for the pixels it leaves undecided in
-//!    the wide black areas of near ones) into a black and a white mask, labelled black
-//!    8-connected, white 4-connected (the consistent pair: a thin black rim closed only
-//!    diagonally still holds the white ring in), the black blobs with their Euler numbers
-//!    ([`RunIndex`]);
+//!    the wide black areas of near ones) into a black and a white mask, the black one
+//!    labelled 8-connected, the black blobs with their Euler numbers ([`RunIndex`]);
 //! 2. black candidates: area within limits, the moment ellipse's axis ratio at least
 //!    `min_axis_ratio`, Euler number in `black_euler`, not touching the image border
-//!    (a cut mark's centre would be biased). White candidates: area and axis ratio;
-//! 3. pairs: the white blob's box inside the black blob's box, its centroid within
-//!    `max_centroid_offset` of the black blob's equivalent radius, and the white/black
-//!    area ratio within `area_ratio`. Each filter is wide; together they are strong
-//!    (seed 000);
+//!    (a cut mark's centre would be biased);
+//! 3. white candidates, for each black one: the white mask labelled 4-connected (the
+//!    consistent pair: a thin black rim closed only diagonally still holds the white ring
+//!    in) inside the black blob's box only, where its partner must lie; area and axis
+//!    ratio as for black. Pairs: the white blob's box inside the black blob's box, its
+//!    centroid within `max_centroid_offset` of the black blob's equivalent radius, and
+//!    the white/black area ratio within `area_ratio`. Each filter is wide; together they
+//!    are strong (seed 000);
 //! 4. the local threshold: halfway between the mean grey of the pair's black and white
 //!    pixels. The black blob's outer perimeter (each row's and column's extreme pixels),
 //!    placed to sub-pixel where the grey level crosses that threshold, is fitted with an
@@ -255,7 +256,6 @@ pub struct CircleDetector {
     /// Euler number is not filtered, and the few that pair are read by rows).
     index: RunIndex,
     black: Vec<u32>,
-    white: Vec<u32>,
     col_top: Vec<u32>,
     col_bot: Vec<u32>,
     points: Vec<[f64; 2]>,
@@ -279,7 +279,6 @@ impl CircleDetector {
             labelers: [Labeler::new(width, height), Labeler::new_four_connected(width, height)],
             index: RunIndex::new(width, height),
             black: Vec::with_capacity(max_runs),
-            white: Vec::with_capacity(max_runs),
             col_top: Vec::with_capacity(width),
             col_bot: Vec::with_capacity(width),
             points: Vec::with_capacity(2 * (width + height)),
@@ -328,9 +327,7 @@ impl CircleDetector {
         let [black_mask, white_mask] = &mut self.masks;
         self.thresholder
             .apply_rgb(view, &mut self.grey, &self.params.threshold, black_mask, white_mask);
-        for k in [BLACK, WHITE] {
-            self.labelers[k].label(&self.masks[k])?;
-        }
+        self.labelers[BLACK].label(&self.masks[BLACK])?;
         self.index.build(&self.labelers[BLACK]);
         let p = self.params;
         let max_area = (p.max_area_frac * (w * h) as f64) as u64;
@@ -347,29 +344,13 @@ impl CircleDetector {
                 self.black.push(i as u32);
             }
         }
-        self.white.clear();
-        let min_white = ((p.min_area_px as f64 * p.area_ratio[0]) as u64).max(1);
-        for (i, c) in self.labelers[WHITE].components().iter().enumerate() {
-            if c.count >= min_white && c.count <= max_area && axis_ratio(c) >= p.min_axis_ratio {
-                self.white.push(i as u32);
-            }
-        }
-        // White candidates by centroid x, for the pairing's range search (an unstable sort
-        // in place: no allocation; ties cannot change which partner is closest).
-        let comps = self.labelers[WHITE].components();
-        self.white.sort_unstable_by(|a, b| {
-            comps[*a as usize]
-                .centroid()
-                .0
-                .total_cmp(&comps[*b as usize].centroid().0)
-        });
         for bi in 0..self.black.len() {
             if self.marks.len() >= p.max_marks {
                 break;
             }
             let b = self.black[bi] as usize;
             let bc = self.labelers[BLACK].components()[b];
-            let Some(wl) = self.partner(&bc) else { continue };
+            let Some(wl) = self.partner(&bc)? else { continue };
             if let Some(m) = self.refine(b, wl) {
                 self.marks.push(m);
             }
@@ -377,38 +358,48 @@ impl CircleDetector {
         Ok(&self.marks)
     }
 
-    /// The white candidate that pairs with black blob `bc`, if any: inside its box, the
-    /// centroids close, the areas in proportion; the closest such centroid.
-    fn partner(&self, bc: &Component) -> Option<usize> {
+    /// The white blob that pairs with black blob `bc`, if any: inside its box, the
+    /// centroids close, the areas in proportion; the closest such centroid (of equally
+    /// close ones, the leftmost). Only the white mask inside `bc`'s box is labelled: a
+    /// partner lies strictly inside that box, and a blob of the box clear of its border is
+    /// the frame's own blob ([`Labeler::label_box`]), so the frame's white mask (as many
+    /// runs and blobs as the black one, from the ground's texture) is never labelled whole.
+    /// The white labeller then holds this box's blobs, which [`CircleDetector::refine`]
+    /// reads.
+    fn partner(&mut self, bc: &Component) -> Result<Option<usize>, VisionError> {
         let p = &self.params;
         let (bx, by) = bc.centroid();
         let radius = (bc.width() + bc.height()) as f64 / 4.0;
         let tol = (p.max_centroid_offset * radius).max(1.0);
-        let mut best: Option<(f64, usize)> = None;
-        let comps = self.labelers[WHITE].components();
-        let from = self
-            .white
-            .partition_point(|&wi| comps[wi as usize].centroid().0 < bx - tol);
-        for &wi in &self.white[from..] {
-            let wc = &comps[wi as usize];
-            if wc.centroid().0 > bx + tol {
-                break;
-            }
+        let max_area = (p.max_area_frac * (self.width * self.height) as f64) as u64;
+        let min_white = ((p.min_area_px as f64 * p.area_ratio[0]) as u64).max(1);
+        let mut best: Option<(f64, f64, usize)> = None;
+        let comps = self.labelers[WHITE].label_box(&self.masks[WHITE], bc.bbox)?;
+        for (wi, wc) in comps.iter().enumerate() {
             if wc.bbox[0] <= bc.bbox[0]
                 || wc.bbox[1] <= bc.bbox[1]
                 || wc.bbox[2] >= bc.bbox[2]
                 || wc.bbox[3] >= bc.bbox[3]
+                || wc.count < min_white
+                || wc.count > max_area
             {
                 continue;
             }
             let (wx, wy) = wc.centroid();
+            if wx < bx - tol || wx > bx + tol || axis_ratio(wc) < p.min_axis_ratio {
+                continue;
+            }
             let d = (wx - bx).hypot(wy - by);
             let ratio = wc.count as f64 / bc.count as f64;
-            if d <= tol && ratio >= p.area_ratio[0] && ratio <= p.area_ratio[1] && best.is_none_or(|(bd, _)| d < bd) {
-                best = Some((d, wi as usize));
+            if d <= tol
+                && ratio >= p.area_ratio[0]
+                && ratio <= p.area_ratio[1]
+                && best.is_none_or(|(bd, bwx, _)| d < bd || (d == bd && wx < bwx))
+            {
+                best = Some((d, wx, wi));
             }
         }
-        best.map(|(_, i)| i)
+        Ok(best.map(|(_, _, i)| i))
     }
 
     /// Mean grey level over component `label` of mask `k`: the black blob's runs from
