@@ -29,6 +29,16 @@ enum Command {
     /// (one line per finished run, in run order), DIR/summary.json, DIR/trajectories.svg,
     /// DIR/success_map.svg and per-run trajectories.
     Trials(marsupial::cli::sim_cmds::TrialsOptions),
+    /// Run a perception campaign for circle fiducials (Axel) against the simulator's truth.
+    ///
+    /// Renders both cameras through the campaign's sensor from a grid of rover poses
+    /// (distance, α, heading, noise seeds; `[occlusion]` adds marks hidden behind panels
+    /// and false marks), detects, labels and poses the module in stereo and mono, and
+    /// prints per-distance tables beside the paper's figures: pose errors, reprojection,
+    /// the ablations (mono without the distortion model, labelling from 4 marks) and what
+    /// happened per number of visible marks. `--json` prints one record per run instead;
+    /// `--out DIR` writes DIR/runs.jsonl and DIR/tables.txt. Same seed, same bytes.
+    PoseTrials(marsupial::cli::pose_trials::PoseTrialsOptions),
     /// Join the output folders of a campaign's shards (`trials S --shard K/N --out DIR`).
     ///
     /// Checks that the folders are shards 1..N of one campaign, each complete, and writes
@@ -170,6 +180,7 @@ fn main() -> ExitCode {
             };
             exit_code(marsupial::cli::sim_cmds::trials(&opts, &mut std::io::stdout()))
         }
+        Command::PoseTrials(opts) => exit_code(marsupial::cli::pose_trials::run(&opts, &mut std::io::stdout())),
         Command::Merge(opts) => exit_code(marsupial::cli::merge::run(&opts, &mut std::io::stdout())),
         Command::Detect(opts) => exit_code(marsupial::cli::detect::run(&opts, &mut std::io::stdout())),
         Command::Estimate(opts) => exit_code(marsupial::cli::estimate::run(&opts, &mut std::io::stdout())),

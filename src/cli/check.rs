@@ -6,16 +6,25 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Validates one file, choosing its kind from its contents: a scenario names its profile
-/// with a top-level `profile = "path"`; anything else is checked as a profile.
+/// with a top-level `profile = "path"` (a perception campaign for `pose-trials` also has
+/// a `[pose]` table); anything else is checked as a profile.
 ///
 /// # Errors
 /// The file's [`ConfigError`].
 pub fn check_file(path: &Path) -> Result<(), ConfigError> {
-    let is_scenario = std::fs::read_to_string(path)
+    let table = std::fs::read_to_string(path)
         .ok()
-        .and_then(|s| s.parse::<toml::Table>().ok())
+        .and_then(|s| s.parse::<toml::Table>().ok());
+    let is_scenario = table
+        .as_ref()
         .is_some_and(|t| t.get("profile").is_some_and(|v| v.is_str()));
-    if is_scenario {
+    if is_scenario
+        && table
+            .as_ref()
+            .is_some_and(super::pose_trials::PoseCampaign::is_campaign)
+    {
+        super::pose_trials::PoseCampaign::load(path).map(|_| ())
+    } else if is_scenario {
         crate::sim::scenario::Scenario::load(path).map(|_| ())
     } else {
         Profile::load(path).map(|_| ())

@@ -7,6 +7,7 @@ pub mod check;
 pub mod detect;
 pub mod estimate;
 pub mod merge;
+pub mod pose_trials;
 pub mod replay;
 #[cfg(feature = "ros2")]
 pub mod ros2;

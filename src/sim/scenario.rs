@@ -243,6 +243,76 @@ impl Default for SensorSpec {
     }
 }
 
+impl SensorSpec {
+    /// Checks every field, reporting problems under `prefix` (`sensor` in a scenario), so
+    /// any file that describes a camera's sensor validates it the same way.
+    pub fn validate_at(&self, prefix: &str, v: &mut Validator<'_>) {
+        let at = |field: &str| format!("{prefix}.{field}");
+        v.positive(&at("full_well_e"), self.full_well_e);
+        v.non_negative(&at("read_noise_e"), self.read_noise_e);
+        v.positive(&at("max_integration"), self.max_integration);
+        v.non_negative(&at("white_balance_tau_s"), self.white_balance_tau_s);
+        v.range(&at("highlight_clip_frac"), self.highlight_clip_frac, 0.0, 1.0);
+        v.range(
+            &at("rolling_shutter_readout_s"),
+            self.rolling_shutter_readout_s,
+            0.0,
+            1.0,
+        );
+        v.fraction(&at("vignetting_corner"), self.vignetting_corner);
+        if let Some(f) = self.focus_m {
+            v.positive(&at("focus_m"), f);
+        }
+        v.range(&at("f_number"), self.f_number, 0.5, 64.0);
+        v.range(&at("focal_length_mm"), self.focal_length_mm, 0.5, 300.0);
+        if let Some(f) = self.focus_m {
+            let mm = self.focal_length_mm;
+            v.require(!f.is_finite() || f > mm * 1e-3, &at("focus_m"), || {
+                format!("expected a focus farther than the focal length ({mm} mm), got {f} m")
+            });
+        }
+        v.require(self.jpeg_quality <= 100, &at("jpeg_quality"), || {
+            format!("expected 0 (off) or a quality 1–100, got {}", self.jpeg_quality)
+        });
+    }
+
+    /// The renderer's sensor parameters under `lighting` (which a fixed white balance
+    /// such as `switch` or `perfect` is set for).
+    pub fn params(&self, lighting: &Lighting) -> SensorParams {
+        use super::lighting::Illuminant as I;
+        let fixed = |i: I| WhiteBalance::Fixed(i.rgb().map(|c| 1.0 / c));
+        let white_balance = match self.white_balance {
+            WhiteBalanceSpec::GreyWorld => WhiteBalance::GreyWorld,
+            WhiteBalanceSpec::Switch if lighting.sun > 0.0 => fixed(I::Daylight),
+            WhiteBalanceSpec::Switch | WhiteBalanceSpec::Perfect => fixed(lighting.illuminant),
+            WhiteBalanceSpec::Daylight => fixed(I::Daylight),
+            WhiteBalanceSpec::Dusk => fixed(I::Dusk),
+            WhiteBalanceSpec::Tungsten => fixed(I::Tungsten),
+            WhiteBalanceSpec::Fluorescent => fixed(I::Fluorescent),
+            WhiteBalanceSpec::Dawn => fixed(I::Dawn),
+        };
+        SensorParams {
+            full_well_e: self.full_well_e as f32,
+            read_noise_e: self.read_noise_e as f32,
+            max_integration: self.max_integration as f32,
+            auto_exposure: self.auto_exposure,
+            white_balance,
+            white_balance_tau_s: self.white_balance_tau_s as f32,
+            highlight_clip: self.highlight_clip_frac as f32,
+            motion_blur: self.motion_blur,
+            rolling_shutter_readout_s: self.rolling_shutter_readout_s as f32,
+            vignetting_corner: self.vignetting_corner as f32,
+            defocus: self.focus_m.map(|focus_m| Defocus {
+                focus_m: focus_m as f32,
+                f_number: self.f_number as f32,
+                focal_length_mm: self.focal_length_mm as f32,
+            }),
+            jpeg_quality: self.jpeg_quality.min(100) as u8,
+            ..SensorParams::default()
+        }
+    }
+}
+
 /// `[motion]`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -558,32 +628,7 @@ impl Validate for Scenario {
         for (name, l) in &self.lighting {
             l.validate_at(&format!("lighting.{name}"), v);
         }
-        v.positive("sensor.full_well_e", self.sensor.full_well_e);
-        v.non_negative("sensor.read_noise_e", self.sensor.read_noise_e);
-        v.positive("sensor.max_integration", self.sensor.max_integration);
-        v.non_negative("sensor.white_balance_tau_s", self.sensor.white_balance_tau_s);
-        v.range("sensor.highlight_clip_frac", self.sensor.highlight_clip_frac, 0.0, 1.0);
-        v.range(
-            "sensor.rolling_shutter_readout_s",
-            self.sensor.rolling_shutter_readout_s,
-            0.0,
-            1.0,
-        );
-        v.fraction("sensor.vignetting_corner", self.sensor.vignetting_corner);
-        if let Some(f) = self.sensor.focus_m {
-            v.positive("sensor.focus_m", f);
-        }
-        v.range("sensor.f_number", self.sensor.f_number, 0.5, 64.0);
-        v.range("sensor.focal_length_mm", self.sensor.focal_length_mm, 0.5, 300.0);
-        if let Some(f) = self.sensor.focus_m {
-            let mm = self.sensor.focal_length_mm;
-            v.require(!f.is_finite() || f > mm * 1e-3, "sensor.focus_m", || {
-                format!("expected a focus farther than the focal length ({mm} mm), got {f} m")
-            });
-        }
-        v.require(self.sensor.jpeg_quality <= 100, "sensor.jpeg_quality", || {
-            format!("expected 0 (off) or a quality 1–100, got {}", self.sensor.jpeg_quality)
-        });
+        self.sensor.validate_at("sensor", v);
         v.non_negative("motion.latency_s", self.motion.latency_s);
         v.positive("motion.accel_mps2", self.motion.accel_mps2);
         v.positive("motion.yaw_accel_dps2", self.motion.yaw_accel_dps2);
@@ -821,37 +866,7 @@ impl Scenario {
 
     /// Sensor parameters for a run under `lighting`.
     pub fn sensor_params(&self, lighting: &Lighting) -> SensorParams {
-        use super::lighting::Illuminant as I;
-        let fixed = |i: I| WhiteBalance::Fixed(i.rgb().map(|c| 1.0 / c));
-        let white_balance = match self.sensor.white_balance {
-            WhiteBalanceSpec::GreyWorld => WhiteBalance::GreyWorld,
-            WhiteBalanceSpec::Switch if lighting.sun > 0.0 => fixed(I::Daylight),
-            WhiteBalanceSpec::Switch | WhiteBalanceSpec::Perfect => fixed(lighting.illuminant),
-            WhiteBalanceSpec::Daylight => fixed(I::Daylight),
-            WhiteBalanceSpec::Dusk => fixed(I::Dusk),
-            WhiteBalanceSpec::Tungsten => fixed(I::Tungsten),
-            WhiteBalanceSpec::Fluorescent => fixed(I::Fluorescent),
-            WhiteBalanceSpec::Dawn => fixed(I::Dawn),
-        };
-        SensorParams {
-            full_well_e: self.sensor.full_well_e as f32,
-            read_noise_e: self.sensor.read_noise_e as f32,
-            max_integration: self.sensor.max_integration as f32,
-            auto_exposure: self.sensor.auto_exposure,
-            white_balance,
-            white_balance_tau_s: self.sensor.white_balance_tau_s as f32,
-            highlight_clip: self.sensor.highlight_clip_frac as f32,
-            motion_blur: self.sensor.motion_blur,
-            rolling_shutter_readout_s: self.sensor.rolling_shutter_readout_s as f32,
-            vignetting_corner: self.sensor.vignetting_corner as f32,
-            defocus: self.sensor.focus_m.map(|focus_m| Defocus {
-                focus_m: focus_m as f32,
-                f_number: self.sensor.f_number as f32,
-                focal_length_mm: self.sensor.focal_length_mm as f32,
-            }),
-            jpeg_quality: self.sensor.jpeg_quality.min(100) as u8,
-            ..SensorParams::default()
-        }
+        self.sensor.params(lighting)
     }
 
     /// Slip on `terrain` for this scenario.

@@ -36,6 +36,14 @@ pub struct ClutterSpec {
     /// approach zone).
     #[serde(default)]
     pub facing_deg: f64,
+    /// A circle mark's bar rotation on its panel, degrees (`circle_mark` only; 0: the bar
+    /// along the panel's width).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub mark_rotation_deg: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 impl ClutterSpec {
@@ -68,6 +76,11 @@ pub enum ClutterKind {
     FiducialCopy,
     /// A copy of the fiducial turned upside down (rotated 180° in its plane).
     FiducialCopyUpsideDown,
+    /// One circle mark of a `[fiducial.circles]` profile (its diameter and pattern, the
+    /// bar at `mark_rotation_deg`) on an upright panel of `size_m` (width, height) in
+    /// `color` (default: the module's grey): a false mark near the module, the kind of
+    /// circle-like blob seed 000's correspondence had to reject.
+    CircleMark,
 }
 
 /// 2-D geometry the motion model and judge need.
@@ -152,6 +165,24 @@ pub(super) fn paint(c: NamedColor) -> [f32; 3] {
 /// # Errors
 /// [`SimError::Unsupported`] for a fiducial kind the simulator cannot build yet.
 pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbImage>]) -> Result<World, SimError> {
+    build_covering(profile, clutter, backdrops, &[])
+}
+
+/// [`build`], with the circle marks `covered` (indices into `[fiducial.circles]
+/// .placements`) covered flush with a patch of the face's paint: the module keeps its
+/// size and the other marks, and those are not painted (`marsupial pose-trials`'
+/// occlusion campaign hides marks this way; a panel held in front of a mark would be
+/// drawn behind the face, since the renderer orders primitives by their centres'
+/// distance).
+///
+/// # Errors
+/// As [`build`].
+pub fn build_covering(
+    profile: &Profile,
+    clutter: &[ClutterSpec],
+    backdrops: &[Arc<RgbImage>],
+    covered: &[usize],
+) -> Result<World, SimError> {
     let mut prims = Vec::new();
     let mut target_prims = Vec::new();
     let dock_spec = profile
@@ -325,7 +356,7 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
             Tag::Body,
         ));
     } else if let Some(circles) = &profile.fiducial.circles {
-        build_central_module(circles, &mut dock, &mut prims, &mut target_prims, body_grey);
+        build_central_module(circles, covered, &mut dock, &mut prims, &mut target_prims, body_grey);
     } else {
         return Err(SimError::Unsupported(format!(
             "the simulator builds two-block, pyramid and circle targets so far; profile `{}` has another fiducial",
@@ -401,6 +432,7 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
 /// station's forward tilt acts in the contact model ([`Cone`]) but is not drawn.
 fn build_central_module(
     circles: &CirclesSpec,
+    covered: &[usize],
     dock: &mut DockGeometry,
     prims: &mut Vec<Prim>,
     target_prims: &mut Vec<usize>,
@@ -427,7 +459,9 @@ fn build_central_module(
     let marks: Vec<CircleMark> = circles
         .placements
         .iter()
-        .map(|p| {
+        .enumerate()
+        .filter(|(i, _)| !covered.contains(i))
+        .map(|(_, p)| {
             CircleMark::new(
                 p.y_m as f32,
                 (p.z_m - face_zc) as f32,
@@ -552,6 +586,28 @@ fn add_clutter(prims: &mut Vec<Prim>, c: &ClutterSpec, profile: &Profile) {
                     },
                     Tag::Clutter,
                 ));
+            }
+        }
+        ClutterKind::CircleMark => {
+            if let Some(f) = &profile.fiducial.circles {
+                let base = c.color.map(paint).unwrap_or(albedo([70, 72, 75], 1.0));
+                let mark = CircleMark::new(0.0, 0.0, c.mark_rotation_deg.to_radians() as f32);
+                let mut p = Prim::new(
+                    Shape::Rect {
+                        centre: Point3::new(c.x_m, c.y_m, c.z_m.max(c.size(1) / 2.0)),
+                        u,
+                        v: z_axis(),
+                        half: [c.size(0) / 2.0, c.size(1) / 2.0],
+                    },
+                    Material::Circles {
+                        base,
+                        radius: (f.diameter_m / 2.0) as f32,
+                        marks: vec![mark].into(),
+                    },
+                    Tag::Clutter,
+                );
+                p.two_sided = true;
+                prims.push(p);
             }
         }
     }

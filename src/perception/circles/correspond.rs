@@ -30,7 +30,9 @@
 //! Seed 000 §V-D: "5 of the 11 failures were attributed to a known bug … only 4 were input
 //! to the consensus-based homography algorithm"; with 4 points and one false, the fit is
 //! exact and wrong. Here a fit needs at least 5 inliers ([`CorrespondenceParams::min_inliers`]
-//! is raised to 5 if set lower), so 4 true marks and a false one are refused.
+//! is raised to 5 if set lower), so 4 true marks and a false one are refused. Only the
+//! ablation switch [`CorrespondenceParams::ablation_four_point_fits`] lowers the floor to
+//! 4, to measure that bug (`marsupial pose-trials`).
 //!
 //! Nothing allocates: at most [`MAX_DETECTIONS`] detections are considered (the first in
 //! the detector's order), and every array is fixed.
@@ -68,6 +70,12 @@ pub struct CorrespondenceParams {
     /// homography has only 2 redundant degrees of freedom and can bend to take a false
     /// point; the marks' sizes and shapes are a check the positions alone do not give.
     pub max_size_ratio: f64,
+    /// **Ablation only** (`marsupial pose-trials`, seed 000 §V-D's bug): accept a
+    /// labelling from 4 marks. Four points fit a homography exactly, so a false positive
+    /// among them leaves no residual to expose it; with this set `min_inliers` may be 4.
+    /// Off by default and never set by a robot's perception: it exists to measure what
+    /// the 5-mark floor buys.
+    pub ablation_four_point_fits: bool,
 }
 
 impl Default for CorrespondenceParams {
@@ -78,6 +86,7 @@ impl Default for CorrespondenceParams {
             gate_min_px: 3.0,
             max_roll_deg: 60.0,
             max_size_ratio: 1.5,
+            ablation_four_point_fits: false,
         }
     }
 }
@@ -208,7 +217,9 @@ pub fn correspond(
     marks: &[DetectedMark],
     params: &CorrespondenceParams,
 ) -> Result<ModelFit, CorrespondenceError> {
-    let need = params.min_inliers.max(5);
+    let need = params
+        .min_inliers
+        .max(if params.ablation_four_point_fits { 4 } else { 5 });
     let marks = &marks[..marks.len().min(MAX_DETECTIONS)];
     if marks.len() < need {
         return Err(CorrespondenceError::TooFewMarks {
@@ -354,7 +365,7 @@ fn verify(
         *best_inliers = (*best_inliers).max(m.n.min(need - 1));
         let mut keep = m.keep;
         let (refit, count) =
-            Homography::fit_trimmed(&m.src[..m.n], &m.dst[..m.n], &mut keep[..m.n], need, |k| m.gate[k])?;
+            Homography::trimmed_with_floor(&m.src[..m.n], &m.dst[..m.n], &mut keep[..m.n], need, |k| m.gate[k])?;
         h = refit;
         out = Some((m, keep, count));
     }
@@ -604,6 +615,16 @@ mod tests {
             correspond(&model, &marks, &p),
             Err(CorrespondenceError::TooFewMarks { needed: 5, .. })
         ));
+        // The four-point ablation (seed 000's bug) takes them, and its fit is exact
+        // whatever the labelling: no residual is left to tell a wrong one.
+        let p = CorrespondenceParams {
+            min_inliers: 4,
+            ablation_four_point_fits: true,
+            ..Default::default()
+        };
+        let fit = correspond(&model, &marks, &p).expect("a four-point fit");
+        assert_eq!(fit.inliers, 4);
+        assert!(fit.rms_px < 1e-6, "{}", fit.rms_px);
     }
 
     #[test]

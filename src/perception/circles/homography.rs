@@ -394,7 +394,21 @@ impl Homography {
         min_pairs: usize,
         gate: impl Fn(usize) -> f64,
     ) -> Option<(Self, usize)> {
-        let need = min_pairs.max(5);
+        Self::trimmed_with_floor(src, dst, keep, min_pairs.max(5), gate)
+    }
+
+    /// [`Homography::fit_trimmed`] needing `need` inliers, at least 4: the crate's
+    /// correspondence passes 5 or more, and 4 only for its four-point ablation
+    /// ([`super::CorrespondenceParams::ablation_four_point_fits`]), which reproduces seed
+    /// 000's bug and is never what a robot runs.
+    pub(crate) fn trimmed_with_floor(
+        src: &[[f64; 2]],
+        dst: &[[f64; 2]],
+        keep: &mut [bool],
+        need: usize,
+        gate: impl Fn(usize) -> f64,
+    ) -> Option<(Self, usize)> {
+        let need = need.max(4);
         if keep.len() != src.len() || keep.iter().filter(|k| **k).count() < need {
             return None;
         }
