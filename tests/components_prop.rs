@@ -76,7 +76,7 @@ fn check(mask: &Mask) {
     assert_eq!(l.label(mask).unwrap(), &want[..]);
 }
 
-fn mask_from(w: usize, h: usize, f: impl Fn(usize, usize) -> bool) -> Mask {
+fn mask_from(w: usize, h: usize, mut f: impl FnMut(usize, usize) -> bool) -> Mask {
     let mut m = Mask::new(w, h);
     for y in 0..h {
         for x in 0..w {
@@ -175,17 +175,22 @@ proptest! {
         density in 0.0f64..1.0,
         seed in any::<u64>(),
     ) {
-        let mut s = seed | 1;
-        let mut next = move || { s ^= s << 13; s ^= s >> 7; s ^= s << 17; s };
-        let threshold = (density * u64::MAX as f64) as u64;
-        let mut m = Mask::new(w, h);
-        for y in 0..h {
-            for x in 0..w {
-                m.set(x, y, next() < threshold);
-            }
-        }
+        let m = random_mask(w, h, density, seed);
         check(&m);
     }
+}
+
+/// A `w` × `h` mask with each pixel set with probability `density` (xorshift from `seed`).
+fn random_mask(w: usize, h: usize, density: f64, seed: u64) -> Mask {
+    let mut s = seed | 1;
+    let mut next = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        s
+    };
+    let threshold = (density * u64::MAX as f64) as u64;
+    mask_from(w, h, |_, _| next() < threshold)
 }
 
 /// `mask` with every pixel outside the inclusive box `b` cleared.
@@ -275,15 +280,7 @@ proptest! {
         seed in any::<u64>(),
         corners in any::<[u8; 4]>(),
     ) {
-        let mut s = seed | 1;
-        let mut next = move || { s ^= s << 13; s ^= s >> 7; s ^= s << 17; s };
-        let threshold = (density * u64::MAX as f64) as u64;
-        let mut m = Mask::new(w, h);
-        for y in 0..h {
-            for x in 0..w {
-                m.set(x, y, next() < threshold);
-            }
-        }
+        let m = random_mask(w, h, density, seed);
         let (xa, xb) = (corners[0] as u32 % w as u32, corners[1] as u32 % w as u32);
         let (ya, yb) = (corners[2] as u32 % h as u32, corners[3] as u32 % h as u32);
         check_box(&m, [xa.min(xb), ya.min(yb), xa.max(xb), ya.max(yb)]);
