@@ -1,6 +1,7 @@
 //! Malformed scenarios fail with the file, field path, line and expectation, like profiles,
 //! and no mutant of a shipped scenario makes loading panic.
 
+use marsupial::cli::check::check_file;
 use marsupial::config::ConfigError;
 use marsupial::sim::scenario::Scenario;
 use std::path::{Path, PathBuf};
@@ -398,7 +399,7 @@ fn shipped_scenarios_are_valid_and_check_accepts_them() {
 
 #[test]
 fn mutated_scenarios_never_panic() {
-    // Every shipped scenario, truncated, with bytes flipped, values swapped for other types
+    // Every shipped scenario (and perception campaign), truncated, with bytes flipped, values swapped for other types
     // and lines deleted, loaded from a folder beside a copy of the shipped profiles (so
     // `profile = "../profiles/…"` resolves and the `[profile_patch]` is merged): loading
     // each (parse, validate, its profile's too) must return, Ok or Err. Loading runs no
@@ -426,12 +427,14 @@ fn mutated_scenarios_never_panic() {
         let src = std::fs::read_to_string(file).unwrap();
         // The original loads from there.
         std::fs::write(&mutant, &src).unwrap();
-        Scenario::load(&mutant).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        // `check_file` loads each file as its kind: a docking scenario, or a perception
+        // campaign (`pose-trials`, a `[pose]` table); a mutant may change its kind.
+        check_file(&mutant).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
         let mutants = mutate::mutants(&src, 0x5CE7_0000 + k as u64, 30, 11, 3);
         tried += mutants.len();
         for what in mutate::panicking(&mutants, |m| {
             std::fs::write(&mutant, &m.bytes).unwrap();
-            let _ = Scenario::load(&mutant);
+            let _ = check_file(&mutant);
         }) {
             bad.push(format!("{}: {what}", file.display()));
         }
