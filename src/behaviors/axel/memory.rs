@@ -1,4 +1,4 @@
-//! What Axel's schemas share: the circle-fiducial perceptual schema (both cameras'
+//! What Axel's schemas share: the circle-fiducial perceptual schema (`stereo.rs`: both cameras'
 //! detectors, the module's model, the stereo rig), this tick's odometry and reel reading,
 //! the planning geometry taken from the profile, the retry counter and the arc counter.
 //!
@@ -8,15 +8,13 @@
 //! look yields a [`Sighting`]: the rover's pose in the module frame with the pose's
 //! quality figures. A schema trusts a sighting only by its quality ([`Trust`]).
 
+use super::stereo::Perception;
 use crate::behaviors::BuildError;
 use crate::behaviors::composed::SharedMemory;
 use crate::geometry::Pose2;
 use crate::kinematics::tether_length::TetherGeometry;
 use crate::kinematics::two_arc::{PlanParams, Regions};
-use crate::perception::circles::{
-    CircleDetector, CircleModel, CircleParams, CorrespondenceParams, MarkObservations, ModulePose, PoseBuffers,
-    PoseParams, PoseSource, RigCamera, correspond, module_pose,
-};
+use crate::perception::circles::{PoseSource, RigCamera};
 use crate::profile::Profile;
 use crate::schemas::{
     AgentStats, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Step, TetherCommand, TetherReading,
@@ -121,67 +119,6 @@ impl ViewLimits {
 /// applied to the fix.
 pub fn dead_reckon(at: &Pose2, odo_then: &Pose2, odo_now: &Pose2) -> Pose2 {
     at.compose(&odo_then.relative(odo_now))
-}
-
-/// The circle pipeline for both cameras, every buffer owned and reused.
-struct Perception {
-    detectors: [CircleDetector; 2],
-    model: CircleModel,
-    cams: [RigCamera; 2],
-    corr: CorrespondenceParams,
-    params: PoseParams,
-    buf: PoseBuffers,
-}
-
-impl Perception {
-    fn from_profile(profile: &Profile) -> Result<Self, BuildError> {
-        let err = |what: String| BuildError::Profile {
-            profile: profile.name.clone(),
-            what,
-        };
-        if profile.cameras.len() < 2 {
-            return Err(err("Axel's behavior needs the stereo pair: two [[cameras]]".into()));
-        }
-        let detector = |i: usize| {
-            let c = &profile.cameras[i];
-            CircleDetector::new(c.width_px, c.height_px, CircleParams::for_image(c.width_px))
-        };
-        let cam = |i: usize| RigCamera::from_profile(profile, i).map_err(|e| err(e.to_string()));
-        Ok(Self {
-            detectors: [detector(0), detector(1)],
-            model: CircleModel::from_profile(profile).map_err(|e| err(e.to_string()))?,
-            cams: [cam(0)?, cam(1)?],
-            corr: CorrespondenceParams::default(),
-            params: PoseParams::default(),
-            buf: PoseBuffers::new(),
-        })
-    }
-
-    /// The module's pose from this tick's frames, if both cameras have one and the rig
-    /// makes a pose of what they saw.
-    fn look(&mut self, inputs: &Inputs<'_>) -> Option<(f64, ModulePose)> {
-        let mut obs = [MarkObservations::new(self.model.len()); 2];
-        let mut stamp = f64::NEG_INFINITY;
-        for (i, o) in obs.iter_mut().enumerate() {
-            let Some(frame) = inputs.camera(i) else { continue };
-            stamp = stamp.max(frame.stamp);
-            let Ok(marks) = self.detectors[i].detect(&frame.image) else {
-                continue;
-            };
-            if let Ok(fit) = correspond(&self.model, marks, &self.corr) {
-                *o = MarkObservations::from_fit(&fit, marks);
-            }
-        }
-        let pose = module_pose(
-            &self.model,
-            [&self.cams[0], &self.cams[1]],
-            [&obs[0], &obs[1]],
-            &self.params,
-            &mut self.buf,
-        )
-        .ok()?;
-        Some((stamp, pose))
-    }
 }
 
 /// The planning geometry every schema shares, from the profile.

@@ -27,6 +27,7 @@ pub mod mate;
 pub mod memory;
 pub mod reel;
 pub mod stall;
+mod stereo;
 
 use super::agent::BuildError;
 use super::composed::Composed;
