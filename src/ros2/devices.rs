@@ -5,7 +5,10 @@
 //! safe stops, watchdog and typed outcomes are the ones every robot gets.
 //!
 //! Each subscription's callback (on Zenoh's threads) only stores the latest payload; the
-//! device decodes it when the runtime asks, so a slow decode never backs Zenoh up.
+//! device decodes it when the runtime asks, so a slow decode never backs Zenoh up. The
+//! payload is kept as Zenoh's own reference-counted buffer, not copied: storing one costs
+//! no allocation, and a payload that arrived in one piece (every frame that was not
+//! fragmented on the wire) is decoded in place.
 
 use super::keys::{RmwPublisher, now_ns};
 use crate::kinematics::DriveCommand;
@@ -17,18 +20,20 @@ use crate::schemas::OdometryReading;
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::Duration;
 use zenoh::Wait;
+use zenoh::bytes::ZBytes;
 use zenoh::pubsub::Subscriber;
 
 /// The latest payload of a topic, and a condition to wait on for a new one.
 #[derive(Default)]
 pub(super) struct LatestPayload {
-    slot: Mutex<Option<Vec<u8>>>,
+    slot: Mutex<Option<ZBytes>>,
     arrived: Condvar,
 }
 
 impl LatestPayload {
-    /// Keeps `payload`, replacing an unread one.
-    pub(super) fn put(&self, payload: Vec<u8>) {
+    /// Keeps `payload` (a reference to Zenoh's buffer: no copy, no allocation), replacing
+    /// an unread one.
+    pub(super) fn put(&self, payload: ZBytes) {
         if let Ok(mut s) = self.slot.lock() {
             *s = Some(payload);
             self.arrived.notify_all();
@@ -36,7 +41,8 @@ impl LatestPayload {
     }
 
     /// The unread payload, waiting up to `wait` for one.
-    pub(super) fn take(&self, wait: Duration) -> Option<Vec<u8>> {
+    /// Its bytes are `to_bytes()`: borrowed when the payload is one contiguous slice.
+    pub(super) fn take(&self, wait: Duration) -> Option<ZBytes> {
         let s = self.slot.lock().ok()?;
         let (mut s, _) = self.arrived.wait_timeout_while(s, wait, |s| s.is_none()).ok()?;
         s.take()
@@ -52,7 +58,7 @@ pub(super) fn subscribe(session: &zenoh::Session, key: &str) -> Result<(Arc<Late
     let sink = latest.clone();
     let sub = session
         .declare_subscriber(key.to_owned())
-        .callback(move |sample| sink.put(sample.payload().to_bytes().into_owned()))
+        .callback(move |sample| sink.put(sample.payload().clone()))
         .wait()
         .map_err(|e| e.to_string())?;
     Ok((latest, sub))
@@ -130,6 +136,7 @@ impl Camera for TopicCamera {
         let Some(payload) = self.frames.take(self.wait) else {
             return Err(HardwareError::NotReady);
         };
+        let payload = payload.to_bytes();
         // A raw frame is converted straight into the loop's frame; a compressed one goes
         // through its decoder's own buffer (the JPEG and PNG decoders allocate).
         let stamp = match self.kind {
@@ -182,6 +189,7 @@ impl Odometer for TopicOdometer {
         let Some(payload) = self.odometry.take(Duration::ZERO) else {
             return Err(HardwareError::NotReady);
         };
+        let payload = payload.to_bytes();
         let o = decode_odometry(&payload).map_err(|e| HardwareError::Fault {
             device: format!("odometry on {}", self.topic),
             detail: e.to_string(),
@@ -262,10 +270,11 @@ mod tests {
     #[test]
     fn the_latest_payload_wins_and_is_taken_once() {
         let l = LatestPayload::default();
-        assert_eq!(l.take(Duration::ZERO), None);
-        l.put(vec![1]);
-        l.put(vec![2]);
-        assert_eq!(l.take(Duration::ZERO), Some(vec![2]));
-        assert_eq!(l.take(Duration::from_millis(1)), None);
+        assert!(l.take(Duration::ZERO).is_none());
+        l.put(ZBytes::from(vec![1u8]));
+        l.put(ZBytes::from(vec![2u8]));
+        let taken = l.take(Duration::ZERO).map(|p| p.to_bytes().into_owned());
+        assert_eq!(taken, Some(vec![2]));
+        assert!(l.take(Duration::from_millis(1)).is_none());
     }
 }

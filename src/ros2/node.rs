@@ -751,6 +751,7 @@ impl DockSensor for TopicSwitch {
         let Some(p) = self.latest.take(Duration::ZERO) else {
             return Err(HardwareError::NotReady);
         };
+        let p = p.to_bytes();
         let mut r = crate::replay::cdr::CdrReader::new(&p).map_err(|e| self.fault(e))?;
         Ok(r.u8("data").map_err(|e| self.fault(e))? != 0)
     }
