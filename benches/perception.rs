@@ -253,7 +253,7 @@ fn bench_circles(c: &mut Criterion) {
         let (mut grey, mut bm, mut wm) = (Vec::with_capacity(w * h), Mask::new(w, h), Mask::new(w, h));
         g.bench_function("stage_grey_and_threshold", |b| {
             b.iter(|| {
-                thr.apply_rgb(
+                thr.apply_rgb_with(
                     black_box(&frames[0].view()),
                     &mut grey,
                     &det_params.threshold,

@@ -65,6 +65,12 @@ const CASES: &[(&str, &str, Option<usize>, &str)] = &[
         "expected one of −45, 0, 45, 90, got 30",
     ),
     (
+        "bad_fixed_threshold.toml",
+        "fiducial.circles.fixed_threshold",
+        Some(83),
+        "black_below ≤ white_above, got [150, 70]",
+    ),
+    (
         "stale_below_tick.toml",
         "loop.camera_stale_s",
         Some(67),

@@ -10,8 +10,8 @@ use crate::config::ConfigError;
 use crate::image_io::{ImageFileError, load_rgb, save_png};
 use crate::perception::circles::{
     CircleDetector, CircleModel, CircleParams, CorrespondenceError, CorrespondenceParams, DetectedMark,
-    MarkObservations, ModelFit, ModulePose, PoseBuffers, PoseError, PoseParams, RigCamera, correspond, mono_pose,
-    stereo_pose,
+    MarkObservations, ModelFit, ModulePose, PoseBuffers, PoseError, PoseParams, RigCamera, Threshold, correspond,
+    mono_pose, stereo_pose,
 };
 use crate::perception::overlay::{CirclesDrawing, paint_circles_overlay, paint_overlay};
 use crate::perception::{RgbImage, TwoBlockPercept, VisionError};
@@ -380,7 +380,11 @@ impl CirclesRun {
     fn new(profile: &Profile, camera: usize) -> Result<Self, DetectError> {
         let spec = &profile.cameras[camera];
         Ok(Self {
-            detector: CircleDetector::new(spec.width_px, spec.height_px, CircleParams::for_image(spec.width_px)),
+            detector: CircleDetector::new(
+                spec.width_px,
+                spec.height_px,
+                CircleParams::from_profile(profile, spec.width_px),
+            ),
             model: CircleModel::from_profile(profile)?,
             cam: RigCamera::from_profile(profile, camera)?,
             camera,
@@ -393,7 +397,12 @@ impl CirclesRun {
 
     fn process(&mut self, im: &RgbImage) -> Result<CirclesOutcome, VisionError> {
         if self.detector.size() != (im.width(), im.height()) {
-            self.detector = CircleDetector::new(im.width(), im.height(), CircleParams::for_image(im.width()));
+            // The adaptive threshold's windows follow the width; fixed levels stay.
+            let mut params = CircleParams::for_image(im.width());
+            if let fixed @ Threshold::Fixed(_) = self.detector.params().threshold {
+                params.threshold = fixed;
+            }
+            self.detector = CircleDetector::new(im.width(), im.height(), params);
         }
         let marks = self.detector.detect(&im.view())?;
         let fit = correspond(&self.model, marks, &self.corr);

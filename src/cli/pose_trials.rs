@@ -764,7 +764,9 @@ pub fn run_campaign(
                         .cameras
                         .iter()
                         .take(2)
-                        .map(|c| CircleDetector::new(c.width_px, c.height_px, CircleParams::for_image(c.width_px)))
+                        .map(|c| {
+                            CircleDetector::new(c.width_px, c.height_px, CircleParams::from_profile(p, c.width_px))
+                        })
                         .collect(),
                     image: RgbImage::default(),
                     marks: Vec::new(),

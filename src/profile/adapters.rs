@@ -9,7 +9,7 @@
 
 use super::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount, PerceptionSpec, Profile};
 use super::{PyramidPerceptionSpec, TwoBlockSpec};
-use crate::perception::circles::{CircleModel, MarkRotation, RigCamera};
+use crate::perception::circles::{CircleModel, CircleParams, FixedThreshold, MarkRotation, RigCamera, Threshold};
 use crate::perception::krawler::rotation::{HUB_BELOW_PLATE_M, PLATE_MARKER_Y_M, TREAD_WIDTH_M};
 use crate::perception::krawler::{AxleGeometry, GearLayout, SteeringPoly};
 use crate::perception::{
@@ -236,6 +236,22 @@ impl CircleModel {
         }
         CircleModel::new(c.diameter_m / 2.0, &marks)
             .map_err(|e| missing(format!("profile `{}`: [fiducial.circles]: {e}", profile.name)))
+    }
+}
+
+impl CircleParams {
+    /// The detector's parameters for frames `width_px` wide ([`CircleParams::for_image`]),
+    /// with the fixed threshold of the profile's `[fiducial.circles]` when it sets one.
+    pub fn from_profile(profile: &Profile, width_px: usize) -> Self {
+        let mut p = CircleParams::for_image(width_px);
+        let levels = profile.fiducial.circles.as_ref().and_then(|c| c.fixed_threshold);
+        if let Some([black_below, white_above]) = levels {
+            p.threshold = Threshold::Fixed(FixedThreshold {
+                black_below,
+                white_above,
+            });
+        }
+        p
     }
 }
 

@@ -114,6 +114,13 @@ pub struct CirclesSpec {
     pub diameter_m: f64,
     /// Placements in an asymmetric layout.
     pub placements: Vec<CirclePlacement>,
+    /// The paper's fixed thresholds in place of our adaptive one, `[black_below,
+    /// white_above]` grey levels (0–255, grey = (R + 2G + B)/4): darker pixels are black,
+    /// brighter ones white, everywhere in the frame. Seed 000 §V-E docked 8 of 15 runs
+    /// with fixed thresholds under an uneven shadow and gives no levels. For comparison
+    /// only; absent (the default), the detector thresholds against the local mean.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fixed_threshold: Option<[u8; 2]>,
 }
 
 /// The AutoKrawler's magenta body markers (seed 003).
@@ -233,6 +240,11 @@ pub(crate) fn validate_fiducial(f: &FiducialSpec, v: &mut Validator<'_>) {
                 &format!("fiducial.circles.placements[{i}].rotation_deg"),
                 || format!("expected one of −45, 0, 45, 90, got {}", pl.rotation_deg),
             );
+        }
+        if let Some([black, white]) = c.fixed_threshold {
+            v.require(black <= white, "fiducial.circles.fixed_threshold", || {
+                format!("expected [black_below, white_above] with black_below ≤ white_above, got [{black}, {white}]")
+            });
         }
     }
     if let Some(m) = &f.markers {

@@ -23,19 +23,17 @@ pub fn facing(d: f64, alpha_deg: f64, turn_deg: f64) -> Pose2 {
 /// Camera `cam` of `p` at robot pose `robot` in world `w`: the default sensor (noisy,
 /// auto-exposed) after four frames, so the exposure has settled.
 pub fn render(p: &Profile, w: &world::World, cam: usize, robot: &Pose2, seed: u64) -> RgbImage {
+    render_lit(p, w, cam, robot, seed, &LightState::uniform(1.0))
+}
+
+/// [`render`] under `light`.
+pub fn render_lit(p: &Profile, w: &world::World, cam: usize, robot: &Pose2, seed: u64, light: &LightState) -> RgbImage {
     let spec = &p.cameras[cam];
     let mut r = Renderer::new(CameraModel::from_spec(spec), spec.width_px, spec.height_px, seed);
     let pose = camera_pose(robot, &spec.mount);
     let mut im = RgbImage::default();
     for k in 0..4 {
-        r.render(
-            &w.scene,
-            &pose,
-            &LightState::uniform(1.0),
-            &SensorParams::default(),
-            seed + k,
-            &mut im,
-        );
+        r.render(&w.scene, &pose, light, &SensorParams::default(), seed + k, &mut im);
     }
     im
 }

@@ -32,7 +32,7 @@ impl Perception {
         }
         let detector = |i: usize| {
             let c = &profile.cameras[i];
-            CircleDetector::new(c.width_px, c.height_px, CircleParams::for_image(c.width_px))
+            CircleDetector::new(c.width_px, c.height_px, CircleParams::from_profile(profile, c.width_px))
         };
         let cam = |i: usize| RigCamera::from_profile(profile, i).map_err(|e| err(e.to_string()));
         Ok(Self {

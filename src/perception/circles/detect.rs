@@ -50,7 +50,7 @@
 
 use super::blobs::RunIndex;
 use super::ellipse::{Ellipse, fit_ellipse};
-use super::threshold::{AdaptiveThreshold, Thresholder};
+use super::threshold::{AdaptiveThreshold, Threshold, Thresholder};
 use crate::perception::components::{Component, Labeler, Run};
 use crate::perception::image::RgbView;
 use crate::perception::{Mask, VisionError, check_same_size};
@@ -111,8 +111,9 @@ impl MarkRotation {
 /// large data set"); [`CircleParams::for_image`] gives ours, each explained there.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CircleParams {
-    /// The local-mean threshold.
-    pub threshold: AdaptiveThreshold,
+    /// The first threshold: the local mean ([`Threshold::Adaptive`], the default) or
+    /// two global levels ([`Threshold::Fixed`], the paper's comparison).
+    pub threshold: Threshold,
     /// Smallest black blob (the rim), px.
     pub min_area_px: u64,
     /// Largest black blob, as a fraction of the image's area.
@@ -182,11 +183,11 @@ impl CircleParams {
     /// * at most 64 marks.
     pub fn for_image(width: usize) -> Self {
         Self {
-            threshold: AdaptiveThreshold {
+            threshold: Threshold::Adaptive(AdaptiveThreshold {
                 window_px: 5,
                 offset: 8,
                 wide_window_px: ((width / 64).max(11)) | 1,
-            },
+            }),
             min_area_px: 12,
             max_area_frac: 0.05,
             min_axis_ratio: 0.2,
@@ -326,7 +327,7 @@ impl CircleDetector {
         let (w, h) = (self.width, self.height);
         let [black_mask, white_mask] = &mut self.masks;
         self.thresholder
-            .apply_rgb(view, &mut self.grey, &self.params.threshold, black_mask, white_mask);
+            .apply_rgb_with(view, &mut self.grey, &self.params.threshold, black_mask, white_mask);
         self.labelers[BLACK].label(&self.masks[BLACK])?;
         self.index.build(&self.labelers[BLACK]);
         let p = self.params;

@@ -41,4 +41,4 @@ pub use pose::{
     MarkObservations, ModulePose, PoseBuffers, PoseError, PoseParams, PoseSource, RigCamera, module_pose, mono_pose,
     rigid_fit, stereo_pose,
 };
-pub use threshold::{AdaptiveThreshold, Thresholder, grey_from_rgb};
+pub use threshold::{AdaptiveThreshold, FixedThreshold, Threshold, Thresholder, grey_from_rgb};

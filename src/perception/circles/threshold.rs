@@ -17,6 +17,12 @@
 //! ([`Thresholder::apply_rgb`]) is made row by row as the integral image is summed.
 //!
 //! Grey is the luma approximation (R + 2G + B)/4.
+//!
+//! [`Threshold::Fixed`] is the alternative the paper measured against its own (seed 000
+//! §V-E: fixed thresholds docked 8 of 15 runs under an uneven shadow): two global grey
+//! levels, the same everywhere in the frame. It exists to be compared with the adaptive
+//! one (a shadow across the module's face darkens the white of its marks below any
+//! level that also keeps the lit ones' black), not as a default.
 
 use crate::perception::Mask;
 use crate::perception::image::RgbView;
@@ -40,6 +46,24 @@ pub struct AdaptiveThreshold {
     /// than itself (a near mark's rim or core) its mean is the pixel's own grey, and the
     /// area goes hollow; there the wider window still sees the surround.
     pub wide_window_px: usize,
+}
+
+/// Two global grey levels: black below the first, white above the second.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FixedThreshold {
+    /// Pixels darker than this are black.
+    pub black_below: u8,
+    /// Pixels brighter than this are white.
+    pub white_above: u8,
+}
+
+/// How grey levels become the black and white masks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Threshold {
+    /// Against the local mean (ours, the default).
+    Adaptive(AdaptiveThreshold),
+    /// Against two global levels (the comparison of seed 000 §V-E).
+    Fixed(FixedThreshold),
 }
 
 /// The threshold's reusable integral image (the masks are the caller's).
@@ -109,6 +133,33 @@ impl Thresholder {
             self.integral_row(y, g_row);
         }
         self.decide(grey, width, height, params, black, white);
+    }
+
+    /// Thresholds the grey image of `src` by `threshold`: [`Thresholder::apply_rgb`] for
+    /// the adaptive one; for fixed levels, the grey image (written into `grey` likewise)
+    /// against the two levels, pixel by pixel, with no integral image.
+    pub fn apply_rgb_with(
+        &mut self,
+        src: &RgbView<'_>,
+        grey: &mut Vec<u8>,
+        threshold: &Threshold,
+        black: &mut Mask,
+        white: &mut Mask,
+    ) {
+        let levels = match threshold {
+            Threshold::Adaptive(p) => return self.apply_rgb(src, grey, p, black, white),
+            Threshold::Fixed(levels) => *levels,
+        };
+        let (width, height) = (src.width(), src.height());
+        grey.resize(width * height, 0);
+        black.resize_for_overwrite(width, height);
+        white.resize_for_overwrite(width, height);
+        let pixels = grey.iter_mut().zip(src.as_bytes().chunks_exact(3));
+        for (((g, p), b), w) in pixels.zip(black.data_mut()).zip(white.data_mut()) {
+            *g = grey_from_rgb([p[0], p[1], p[2]]);
+            *b = (*g < levels.black_below) as u8;
+            *w = (*g > levels.white_above) as u8;
+        }
     }
 
     /// Sizes the integral image for `width × height` and zeroes its first row. Every
@@ -493,6 +544,40 @@ mod tests {
         let mut z = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ i.wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z ^= z >> 31;
         z.wrapping_mul(0x94D0_49BB_1331_11EB) >> 17
+    }
+
+    #[test]
+    fn fixed_levels_split_the_grey_image_globally() {
+        use crate::perception::RgbImage;
+        // Grey levels 0, 10, …, 250 along a row: below 60 black, above 180 white, the
+        // same wherever the pixel is (no local mean).
+        let mut im = RgbImage::new(26, 2);
+        for (i, px) in im.as_bytes_mut().chunks_exact_mut(3).enumerate() {
+            px.fill(((i % 26) * 10) as u8);
+        }
+        let levels = Threshold::Fixed(FixedThreshold {
+            black_below: 60,
+            white_above: 180,
+        });
+        let (mut b, mut wh, mut grey) = (Mask::new(1, 1), Mask::new(1, 1), Vec::new());
+        Thresholder::default().apply_rgb_with(&im.view(), &mut grey, &levels, &mut b, &mut wh);
+        for y in 0..2 {
+            for x in 0..26 {
+                assert_eq!(b.get(x, y), x * 10 < 60, "black at grey {}", x * 10);
+                assert_eq!(wh.get(x, y), x * 10 > 180, "white at grey {}", x * 10);
+            }
+        }
+        // The adaptive one through the same call is `apply_rgb`.
+        let p = AdaptiveThreshold {
+            window_px: 7,
+            offset: 8,
+            wide_window_px: 17,
+        };
+        let (mut b2, mut w2) = (Mask::new(1, 1), Mask::new(1, 1));
+        let mut t = Thresholder::default();
+        t.apply_rgb_with(&im.view(), &mut grey, &Threshold::Adaptive(p), &mut b, &mut wh);
+        t.apply_rgb(&im.view(), &mut grey, &p, &mut b2, &mut w2);
+        assert_eq!((b.data(), wh.data()), (b2.data(), w2.data()));
     }
 
     #[test]
