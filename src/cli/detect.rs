@@ -10,8 +10,8 @@ use crate::config::ConfigError;
 use crate::image_io::{ImageFileError, load_rgb, save_png};
 use crate::perception::circles::{
     CircleDetector, CircleModel, CircleParams, CorrespondenceError, CorrespondenceParams, DetectedMark,
-    MarkObservations, ModelFit, ModulePose, PoseBuffers, PoseError, PoseParams, RigCamera, Threshold, correspond,
-    mono_pose, stereo_pose,
+    MarkObservations, ModelFit, ModulePose, PoseBuffers, PoseError, PoseParams, RigCamera, correspond, mono_pose,
+    stereo_pose,
 };
 use crate::perception::overlay::{CirclesDrawing, paint_circles_overlay, paint_overlay};
 use crate::perception::{RgbImage, TwoBlockPercept, VisionError};
@@ -397,11 +397,7 @@ impl CirclesRun {
 
     fn process(&mut self, im: &RgbImage) -> Result<CirclesOutcome, VisionError> {
         if self.detector.size() != (im.width(), im.height()) {
-            // The adaptive threshold's windows follow the width; fixed levels stay.
-            let mut params = CircleParams::for_image(im.width());
-            if let fixed @ Threshold::Fixed(_) = self.detector.params().threshold {
-                params.threshold = fixed;
-            }
+            let params = self.detector.params().for_width(im.width());
             self.detector = CircleDetector::new(im.width(), im.height(), params);
         }
         let marks = self.detector.detect(&im.view())?;

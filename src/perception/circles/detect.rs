@@ -150,6 +150,17 @@ pub struct CircleParams {
 }
 
 impl CircleParams {
+    /// These parameters for frames `width` wide: the width-dependent defaults of
+    /// [`CircleParams::for_image`], keeping a [`Threshold::Fixed`] (its levels do not
+    /// depend on the frame's size). What a detector uses when its frames change size.
+    pub fn for_width(&self, width: usize) -> Self {
+        let mut p = Self::for_image(width);
+        if let fixed @ Threshold::Fixed(_) = self.threshold {
+            p.threshold = fixed;
+        }
+        p
+    }
+
     /// Defaults for a `width`-pixel-wide image (our choices; the paper gives none):
     /// * window: 5 px, then width/64 (odd, at least 11 px; 17 px at 1024) for the pixels
     ///   the first leaves in its dead band. The narrow window reaches 2 px either side of
