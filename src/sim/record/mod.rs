@@ -32,6 +32,7 @@ pub mod base64;
 pub mod messages;
 pub mod schemas;
 pub mod tracing_log;
+pub mod uncached;
 
 use super::run::TraceLine;
 use crate::geometry::Pose2;
@@ -42,10 +43,9 @@ use crate::schemas::{MotorOutput, Observation};
 use messages::{CameraCalibration, FrameTransform, Log, PoseInFrame, Quaternion, Time, Vector3};
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
+use uncached::UncachedFile;
 
 /// How a recording is made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -143,7 +143,7 @@ const MISSION_GAP_NS: u64 = 100_000_000;
 /// never stopped by its recording.
 pub struct McapRecorder {
     path: PathBuf,
-    writer: Option<mcap::Writer<BufWriter<File>>>,
+    writer: Option<mcap::Writer<UncachedFile>>,
     opts: RecordOptions,
     ch: Channels,
     sequence: u32,
@@ -177,23 +177,22 @@ impl McapRecorder {
     /// # Errors
     /// [`RecordError`] when the file cannot be created or written.
     pub fn create(path: &Path, cameras: &[CameraSpec], opts: RecordOptions) -> Result<Self, RecordError> {
-        let file = File::create(path).map_err(|source| RecordError::Io {
+        let file = UncachedFile::create(path).map_err(|source| RecordError::Io {
             path: path.to_path_buf(),
             source,
         })?;
         let e = mcap_err(path);
         // No compression, no CRCs: two passes less over every frame's bytes (readers
         // accept a zero CRC as "not computed"), to keep recording cheap. The writer
-        // streams each chunk's records to the file as they come (it seeks back to patch
-        // the chunk's header), so the buffer gathers only the small records: a write
-        // larger than a `BufWriter`'s capacity goes straight through, so at 64 KiB a frame
-        // (over 64 KiB at any useful size) is not copied into it.
+        // streams each chunk's records to the file as they come and seeks back to patch
+        // the chunk's header; the file ([`uncached`]) stages the stream in aligned
+        // segments that a thread writes past the page cache.
         let mut w = mcap::WriteOptions::new()
             .compression(None)
             .calculate_chunk_crcs(false)
             .calculate_data_section_crc(false)
             .profile("")
-            .create(BufWriter::with_capacity(1 << 16, file))
+            .create(file)
             .map_err(&e)?;
         let json =
             |w: &mut mcap::Writer<_>, name: &str, schema: &str| w.add_schema(name, "jsonschema", schema.as_bytes());
