@@ -1,7 +1,7 @@
 //! The papers' published figures, for side-by-side tables printed by `marsupial trials`.
 //! A scenario opts in with `compare = "bujold-table1"` (or `"bujold-table2"`,
 //! `"raposa-table1"`, `"raposa-range"`, `"raposa-wide"`, `"axel-field"`,
-//! `"axel-reel-only"`).
+//! `"axel-reel-only"`, `"axel-lighting"`).
 
 use super::campaign::{RunRecord, summarise};
 use serde::{Deserialize, Serialize};
@@ -30,10 +30,18 @@ pub enum PaperTable {
     /// h the rover's heading from it); the table has one cell per (α, h), over every
     /// distance and terrain, beside the paper's limit.
     AxelReelOnly,
+    /// Seed 000 §V-E: docked under uniform light and under an intense uneven shadow on
+    /// the module's face, with the paper's fixed thresholds. Lighting programmes named
+    /// `uniform` and `shadow` are set beside those figures.
+    AxelLighting,
 }
 
 /// Seed 000 §V-B: (docked, runs) overall and away from the workspace boundary.
 pub const AXEL_FIELD: [(&str, usize, usize); 2] = [("all starts", 29, 40), ("away from the boundary", 20, 24)];
+
+/// Seed 000 §V-E, fixed thresholds: (lighting, docked, runs) in uniform light and under
+/// the shadow.
+pub const AXEL_LIGHTING: [(&str, usize, usize); 2] = [("uniform", 21, 25), ("shadow", 8, 15)];
 
 /// Seed 000 §V-C's limits of pure reeling, degrees: it docks for |α| below the first and
 /// tolerates |h| below the second.
@@ -293,6 +301,26 @@ pub fn comparison(table: PaperTable, records: &[RunRecord]) -> String {
             }
         }
         PaperTable::AxelReelOnly => reel_only_table(&mut s, records),
+        PaperTable::AxelLighting => {
+            let _ = writeln!(s, "versus seed 000 §V-E (the paper's fixed thresholds)");
+            let _ = writeln!(s, "lighting     runs  docked  ours     | paper");
+            let mut lights: Vec<&str> = records.iter().map(|r| r.lighting.as_str()).collect();
+            lights.sort_unstable();
+            lights.dedup();
+            for light in lights {
+                let rs: Vec<&RunRecord> = records.iter().filter(|r| r.lighting == light).collect();
+                let (n, ok, _) = stats(&rs);
+                let paper = match AXEL_LIGHTING.iter().find(|p| p.0 == light) {
+                    Some((_, d, t)) => format!("{d}/{t} = {:.0} %", 100.0 * *d as f64 / *t as f64),
+                    None => "-".into(),
+                };
+                let _ = writeln!(
+                    s,
+                    "{light:<12} {n:>4}  {ok:>6}  {:>5.0} %  | {paper}",
+                    100.0 * ok as f64 / n.max(1) as f64
+                );
+            }
+        }
     }
     s
 }
@@ -360,6 +388,25 @@ mod tests {
         for bad in ["fig10", "r4/a-7", "r4/x3/h0", "r4/a3/hx", ""] {
             assert_eq!(reel_only_cell(bad), None, "{bad}");
         }
+    }
+
+    #[test]
+    fn the_lighting_table_sets_each_light_beside_the_paper() {
+        let lit = |light: &str, ok: bool| RunRecord {
+            lighting: light.into(),
+            ..RunRecord::for_test("i1", ok)
+        };
+        let records = [
+            lit("uniform", true),
+            lit("shadow", true),
+            lit("uniform", true),
+            lit("shadow", false),
+            lit("dusk", true),
+        ];
+        let t = comparison(PaperTable::AxelLighting, &records);
+        assert!(t.contains("uniform         2       2    100 %  | 21/25 = 84 %"), "{t}");
+        assert!(t.contains("shadow          2       1     50 %  | 8/15 = 53 %"), "{t}");
+        assert!(t.contains("dusk            1       1    100 %  | -"), "{t}");
     }
 
     #[test]
