@@ -186,10 +186,15 @@ impl UncachedFile {
         self.direct
     }
 
-    /// Sends `job` to the writer thread.
+    /// Sends `job` to the writer thread. If the thread is gone, a segment the job held
+    /// comes back as the current one.
     fn send(&mut self, job: Job) -> io::Result<()> {
         match self.jobs.as_ref().map(|j| j.send(job)) {
             Some(Ok(())) => Ok(()),
+            Some(Err(std::sync::mpsc::SendError(Job::Finish { segment, .. }))) => {
+                self.current = segment;
+                Err(self.broken())
+            }
             _ => Err(self.broken()),
         }
     }
@@ -217,7 +222,10 @@ impl UncachedFile {
         )
     }
 
-    fn broken(&self) -> io::Error {
+    /// The writer thread is gone: the file fails from here on (so no write touches a
+    /// segment the thread took with it).
+    fn broken(&mut self) -> io::Error {
+        self.failed.get_or_insert(io::ErrorKind::BrokenPipe);
         io::Error::new(
             io::ErrorKind::BrokenPipe,
             format!("{}: the recording's writer thread stopped", self.path.display()),
