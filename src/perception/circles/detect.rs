@@ -150,13 +150,14 @@ pub struct CircleParams {
 }
 
 impl CircleParams {
-    /// These parameters for frames `width` wide: the width-dependent defaults of
-    /// [`CircleParams::for_image`], keeping a [`Threshold::Fixed`] (its levels do not
-    /// depend on the frame's size). What a detector uses when its frames change size.
+    /// These parameters for frames `width` wide: the one width-dependent default of
+    /// [`CircleParams::for_image`], the adaptive threshold's wide window, recomputed;
+    /// every other field kept (a [`Threshold::Fixed`]'s levels do not depend on the
+    /// frame's size). What a detector uses when its frames change size.
     pub fn for_width(&self, width: usize) -> Self {
-        let mut p = Self::for_image(width);
-        if let fixed @ Threshold::Fixed(_) = self.threshold {
-            p.threshold = fixed;
+        let mut p = *self;
+        if let (Threshold::Adaptive(a), Threshold::Adaptive(d)) = (&mut p.threshold, Self::for_image(width).threshold) {
+            a.wide_window_px = d.wide_window_px;
         }
         p
     }
@@ -743,5 +744,29 @@ mod tests {
         assert!(tiny.detect(&RgbImage::new(1, 1).view()).unwrap().is_empty());
         let mut line = CircleDetector::new(3, 1, CircleParams::for_image(3));
         assert!(line.detect(&RgbImage::new(3, 1).view()).unwrap().is_empty());
+    }
+
+    #[test]
+    fn for_width_recomputes_only_the_wide_window() {
+        let tuned = CircleParams {
+            min_contrast: 25.0,
+            ..CircleParams::for_image(640)
+        };
+        let at_1024 = tuned.for_width(1024);
+        assert_eq!(
+            at_1024,
+            CircleParams {
+                min_contrast: 25.0,
+                ..CircleParams::for_image(1024)
+            }
+        );
+        let fixed = CircleParams {
+            threshold: Threshold::Fixed(super::super::FixedThreshold {
+                black_below: 70,
+                white_above: 150,
+            }),
+            ..tuned
+        };
+        assert_eq!(fixed.for_width(1024), fixed);
     }
 }
