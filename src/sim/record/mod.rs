@@ -32,7 +32,7 @@ pub mod base64;
 pub mod messages;
 pub mod schemas;
 pub mod tracing_log;
-pub mod uncached;
+mod uncached;
 
 use super::run::TraceLine;
 use crate::geometry::Pose2;

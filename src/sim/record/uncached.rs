@@ -16,8 +16,8 @@
 //! one comes back (a pool of [`SEGMENTS`], so the simulation waits only when the disk is
 //! that far behind). The MCAP writer seeks back over its current chunk to patch the
 //! chunk's header: in the current segment that is a write to memory; further back, the
-//! writer thread reads the aligned blocks around it, patches them and writes them back,
-//! after the segments before it. [`std::io::Write::flush`] waits for the thread to write
+//! header's fields are gathered into one patch, and the writer thread reads the aligned
+//! blocks around it, patches them and writes them back, after the segments before it. [`std::io::Write::flush`] waits for the thread to write
 //! everything, the last segment padded to a whole block, and truncates the file to the
 //! stream's length.
 //!
@@ -33,11 +33,11 @@ use std::thread::JoinHandle;
 
 /// Alignment of every direct transfer: address, offset and length (a page; any block
 /// device's logical block divides it).
-pub const ALIGN: usize = 4096;
+const ALIGN: usize = 4096;
 /// Bytes staged in one segment (about a millisecond of the disk's time).
-pub const SEGMENT: usize = 2 << 20;
+const SEGMENT: usize = 2 << 20;
 /// Segments per file: one being filled, the others being written or free.
-pub const SEGMENTS: usize = 3;
+const SEGMENTS: usize = 3;
 /// Segments kept for the next files once a file is closed, so that a campaign's files
 /// do not each fault in fresh memory.
 const SPARE: usize = 4 * SEGMENTS;
@@ -45,7 +45,8 @@ const SPARE: usize = 4 * SEGMENTS;
 /// Segments of closed files, for the next ones.
 static SPARES: std::sync::Mutex<Vec<Segment>> = std::sync::Mutex::new(Vec::new());
 
-/// An aligned buffer.
+/// An aligned buffer (empty by default: a placeholder while the real one is away).
+#[derive(Default)]
 struct Segment {
     /// Backing store, [`ALIGN`] bytes longer than the segment.
     mem: Vec<u8>,
@@ -94,7 +95,7 @@ impl Segment {
 enum Job {
     /// Write `len` bytes of the segment at `offset`, then hand the segment back.
     Write { offset: u64, segment: Segment, len: usize },
-    /// Overwrite bytes already written.
+    /// Overwrite bytes already written (a chunk header's fields, gathered into one run).
     Patch { offset: u64, bytes: Vec<u8> },
     /// Write `len` bytes of the segment at `offset` padded to a block, truncate the file
     /// to `end`, and answer with the segment and the first error so far.
@@ -116,6 +117,12 @@ pub struct UncachedFile {
     current: Segment,
     /// Stream offset of the current segment's first byte, a multiple of `segment_len`.
     start: u64,
+    /// Bytes written over the stream before `start`, gathered until the cursor leaves
+    /// them (the MCAP writer patches a chunk's header a field at a time), so the thread
+    /// reads and rewrites their blocks once.
+    patch: Vec<u8>,
+    /// Stream offset of `patch`'s first byte.
+    patch_at: u64,
     /// The cursor.
     pos: u64,
     /// The stream's length.
@@ -124,8 +131,6 @@ pub struct UncachedFile {
     /// Segments the thread is done with, with the thread's first error.
     free: Receiver<(Segment, Option<io::ErrorKind>)>,
     thread: Option<JoinHandle<()>>,
-    /// The file is open with `O_DIRECT` (as opened; the thread may fall back).
-    direct: bool,
     /// The first error the thread met.
     failed: Option<io::ErrorKind>,
     /// Written to since the last flush.
@@ -137,7 +142,7 @@ impl UncachedFile {
     ///
     /// # Errors
     /// The error of opening the file or starting the thread.
-    pub fn create(path: &Path) -> io::Result<Self> {
+    pub(super) fn create(path: &Path) -> io::Result<Self> {
         Self::with_segments(path, SEGMENT, SEGMENTS, true)
     }
 
@@ -161,6 +166,7 @@ impl UncachedFile {
             path: path.to_path_buf(),
             direct,
             failed: None,
+            scratch: Segment::default(),
         };
         let thread = std::thread::Builder::new()
             .name("recording-writer".into())
@@ -170,20 +176,16 @@ impl UncachedFile {
             segment_len: len,
             current: Segment::reuse(len),
             start: 0,
+            patch: Vec::new(),
+            patch_at: 0,
             pos: 0,
             end: 0,
             jobs: Some(jobs),
             free,
             thread: Some(thread),
-            direct,
             failed: None,
             dirty: true,
         })
-    }
-
-    /// Whether the file was opened past the page cache.
-    pub fn is_direct(&self) -> bool {
-        self.direct
     }
 
     /// Sends `job` to the writer thread. If the thread is gone, a segment the job held
@@ -232,6 +234,18 @@ impl UncachedFile {
         )
     }
 
+    /// Sends the gathered patch, if any, to the thread.
+    fn send_patch(&mut self) -> io::Result<()> {
+        if self.patch.is_empty() {
+            return Ok(());
+        }
+        let bytes = std::mem::take(&mut self.patch);
+        self.send(Job::Patch {
+            offset: self.patch_at,
+            bytes,
+        })
+    }
+
     /// Hands the full current segment to the thread and starts the next.
     fn spill(&mut self) -> io::Result<()> {
         let next = self.take_free()?;
@@ -256,14 +270,16 @@ impl Write for UncachedFile {
         }
         if self.pos < self.start {
             let n = data.len().min((self.start - self.pos) as usize);
+            if self.patch_at + self.patch.len() as u64 != self.pos {
+                self.send_patch()?;
+                self.patch_at = self.pos;
+            }
+            self.patch.extend_from_slice(&data[..n]);
             self.dirty = true;
-            self.send(Job::Patch {
-                offset: self.pos,
-                bytes: data[..n].to_vec(),
-            })?;
             self.pos += n as u64;
             return Ok(n);
         }
+        self.send_patch()?;
         let mut i = (self.pos - self.start) as usize;
         if i == self.segment_len {
             self.spill()?;
@@ -283,14 +299,9 @@ impl Write for UncachedFile {
         if let Some(kind) = self.failed {
             return Err(self.error(kind));
         }
+        self.send_patch()?;
         // The current segment goes to the thread and comes back with the answer.
-        let segment = std::mem::replace(
-            &mut self.current,
-            Segment {
-                mem: Vec::new(),
-                base: 0,
-            },
-        );
+        let segment = std::mem::take(&mut self.current);
         let (done, answer) = channel();
         self.send(Job::Finish {
             offset: self.start,
@@ -347,27 +358,10 @@ impl Drop for UncachedFile {
         if let Some(t) = self.thread.take() {
             let _ = t.join();
         }
-        let current = std::mem::replace(
-            &mut self.current,
-            Segment {
-                mem: Vec::new(),
-                base: 0,
-            },
-        );
-        current.retire();
+        std::mem::take(&mut self.current).retire();
         while let Ok((segment, _)) = self.free.try_recv() {
             segment.retire();
         }
-    }
-}
-
-impl std::fmt::Debug for UncachedFile {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("UncachedFile")
-            .field("path", &self.path)
-            .field("direct", &self.direct)
-            .field("len", &self.end)
-            .finish()
     }
 }
 
@@ -377,6 +371,8 @@ struct Disk {
     path: PathBuf,
     direct: bool,
     failed: Option<io::Error>,
+    /// The blocks around a patch, reused from patch to patch.
+    scratch: Segment,
 }
 
 impl Disk {
@@ -459,12 +455,17 @@ impl Disk {
         let first = offset / a * a;
         let last = (offset + data.len() as u64).div_ceil(a) * a;
         let n = (last - first) as usize;
-        let mut blocks = Segment::new(n);
+        if self.scratch.mem.len() < n + ALIGN {
+            self.scratch = Segment::new(n);
+        }
         let at = (offset - first) as usize;
-        match read_at(&self.file, blocks.bytes_mut(n), first) {
+        match read_at(&self.file, self.scratch.bytes_mut(n), first) {
             Ok(()) => {
-                blocks.bytes_mut(n)[at..at + data.len()].copy_from_slice(data);
-                self.write(blocks.bytes(n), first)
+                self.scratch.bytes_mut(n)[at..at + data.len()].copy_from_slice(data);
+                let blocks = std::mem::take(&mut self.scratch);
+                let r = self.write(blocks.bytes(n), first);
+                self.scratch = blocks;
+                r
             }
             Err(e) if refused(&e) => {
                 self.cached()?;
@@ -559,8 +560,12 @@ mod tests {
                     let at = (at % reference.len() as u64) as usize;
                     let n = n.min(reference.len() - at);
                     f.seek(SeekFrom::Start(at as u64)).unwrap();
-                    let data = vec![b; n];
-                    f.write_all(&data).unwrap();
+                    let data: Vec<u8> = (0..n).map(|i| b.wrapping_add(i as u8)).collect();
+                    // In pieces of 1–8 bytes, as the MCAP writer patches a header field
+                    // by field.
+                    for piece in data.chunks(1 + b as usize % 8) {
+                        f.write_all(piece).unwrap();
+                    }
                     reference[at..at + n].copy_from_slice(&data);
                     assert_eq!(f.stream_position().unwrap(), (at + n) as u64);
                 }
