@@ -109,6 +109,11 @@ fn stats(rs: &[&RunRecord]) -> (usize, usize, Option<f64>) {
     (g.runs, g.successes, g.mean_time_s)
 }
 
+/// A published success figure: `docked/runs = rate %`.
+fn published(docked: usize, runs: usize) -> String {
+    format!("{docked}/{runs} = {:.0} %", 100.0 * docked as f64 / runs as f64)
+}
+
 /// Formats an optional number, "-" when absent (also used by the trials table).
 pub(crate) fn cell(v: Option<f64>, prec: usize) -> String {
     v.map(|x| format!("{x:.prec$}")).unwrap_or_else(|| "-".into())
@@ -289,7 +294,7 @@ pub fn comparison(table: PaperTable, records: &[RunRecord]) -> String {
                 }
                 let (n, ok, _) = stats(&rs);
                 let paper = match AXEL_FIELD.iter().find(|p| p.0 == name) {
-                    Some((_, d, t)) => format!("{d}/{t} = {:.0} %", 100.0 * *d as f64 / *t as f64),
+                    Some(&(_, d, t)) => published(d, t),
                     None if name.starts_with("boundary") => "9/16 = 56 % (29 − 20 of 40 − 24)".into(),
                     None => "docked (Fig. 10)".into(),
                 };
@@ -311,7 +316,7 @@ pub fn comparison(table: PaperTable, records: &[RunRecord]) -> String {
                 let rs: Vec<&RunRecord> = records.iter().filter(|r| r.lighting == light).collect();
                 let (n, ok, _) = stats(&rs);
                 let paper = match AXEL_LIGHTING.iter().find(|p| p.0 == light) {
-                    Some((_, d, t)) => format!("{d}/{t} = {:.0} %", 100.0 * *d as f64 / *t as f64),
+                    Some(&(_, d, t)) => published(d, t),
                     None => "-".into(),
                 };
                 let _ = writeln!(
