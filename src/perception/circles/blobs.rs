@@ -7,9 +7,16 @@
 //! one background region, 4-connected for an 8-connected foreground and 8-connected for a
 //! 4-connected one. E = 1 − holes, so a filled disc has E = 1 and a ring E = 0.
 //!
+//! **Pinholes.** A hole of a few pixels is sensor noise, not shape: a dark blob's pixels
+//! that noise lifts over the threshold. In shade, where the camera's gamma stretches dark
+//! noise, a printed black ring 100 px across shows a dozen of them (most of one pixel, a
+//! few of two to four). [`RunIndex::pinholes`] counts the holes of a component up to a
+//! size, so that a filter on the Euler number can ask about the holes of the shape.
+//!
 //! All buffers are sized for the labeller's worst case when built, so indexing never
 //! allocates.
 
+use crate::perception::Mask;
 use crate::perception::components::{Labeler, Run};
 
 /// Euler numbers and per-component run lists of one labelled mask.
@@ -121,6 +128,137 @@ impl RunIndex {
         self.euler.get(label).copied().unwrap_or(1)
     }
 
+    /// Whether pixel (`x`, `y`) belongs to component `label` of `labeler` (the labelling
+    /// this index was built from): a binary search of its runs, O(log runs).
+    pub fn contains(&self, labeler: &Labeler, label: usize, x: u32, y: u32) -> bool {
+        let order = self.order_of(label);
+        let runs = labeler.runs();
+        // The component's runs are in raster order and disjoint, so (y, x1) rises too.
+        let k = order.partition_point(|&i| runs.get(i as usize).is_some_and(|r| (r.y, r.x1) <= (y, x)));
+        order
+            .get(k)
+            .and_then(|&i| runs.get(i as usize))
+            .is_some_and(|r| r.y == y && r.x0 <= x)
+    }
+
+    /// The number of holes of component `label` of `labeler` with at most `max_px`
+    /// pixels each, `mask` being the mask it labelled (`0` is background). A hole is a
+    /// background region (4-connected for an 8-connected labelling, 8-connected for a
+    /// 4-connected one) that the component encloses, and a pinhole one that holds no
+    /// other component; `E + pinholes` is the Euler number the component would have with
+    /// those holes filled.
+    ///
+    /// Only the pixels next to the component's runs are read. The pixel after each run
+    /// that could be the first in raster order of its region starts a fill that gives up
+    /// past `max_px` pixels, held in `fill` (reserve `max_px + 1` to keep it from
+    /// allocating), so the cost is O(runs × `max_px`²).
+    pub fn pinholes(&self, labeler: &Labeler, mask: &Mask, label: usize, max_px: usize, fill: &mut Vec<usize>) -> u32 {
+        let Some(c) = labeler.components().get(label) else {
+            return 0;
+        };
+        if max_px == 0 || mask.size() != labeler.size() {
+            return 0;
+        }
+        let w = mask.width();
+        let data = mask.data();
+        let background_eight = labeler.is_four_connected();
+        let [x0, y0, x1, y1] = c.bbox.map(|v| v as usize);
+        let inside = |j: usize| {
+            let (x, y) = (j % w, j / w);
+            x > x0 && x < x1 && y > y0 && y < y1
+        };
+        // The pixels joined to `j` (all in the image when `j` is inside the box).
+        let neighbours = |j: usize| {
+            let n = if background_eight { 8 } else { 4 };
+            [j - 1, j + 1, j - w, j + w, j - w - 1, j - w + 1, j + w - 1, j + w + 1]
+                .into_iter()
+                .take(n)
+        };
+        let mut count = 0;
+        // A region's first pixel in raster order has a foreground pixel to its left, and
+        // for a hole of this component that pixel is the end of one of its runs.
+        for r in self.runs_of(labeler, label) {
+            let (x, y) = (r.x1 as usize, r.y as usize);
+            if x >= x1 || y <= y0 || y >= y1 {
+                continue;
+            }
+            let i = y * w + x;
+            // The pixels before it in raster order that would join it are foreground.
+            let first = data[i] == 0
+                && data[i - w] != 0
+                && (!background_eight || (data[i - w - 1] != 0 && data[i - w + 1] != 0));
+            if !first {
+                continue;
+            }
+            fill.clear();
+            fill.push(i);
+            let mut head = 0;
+            let mut small = true;
+            'fill: while head < fill.len() {
+                let j = fill[head];
+                head += 1;
+                // A region that reaches the box's edge is not enclosed by the
+                // component (whose pixels all lie in the box).
+                if !inside(j) {
+                    small = false;
+                    break;
+                }
+                for k in neighbours(j) {
+                    if data[k] == 0 && !fill.contains(&k) {
+                        if fill.len() == max_px {
+                            small = false;
+                            break 'fill;
+                        }
+                        fill.push(k);
+                    }
+                }
+            }
+            // Counted once, from its first pixel, when every foreground pixel
+            // around it is this component's (not an island of another inside it).
+            let enclosed = || {
+                fill.iter().all(|&j| {
+                    neighbours(j)
+                        .filter(|&k| data[k] != 0)
+                        .all(|k| self.contains(labeler, label, (k % w) as u32, (k / w) as u32))
+                })
+            };
+            if small && fill.iter().all(|&j| j >= i) && enclosed() {
+                count += 1;
+            }
+        }
+        count
+    }
+
+    /// Whether component `label` surrounds pixel (`x`, `y`) as a ring surrounds its
+    /// centre: the pixel is not the component's, and the component has pixels to its
+    /// left and right in its row and above and below in its column. One pass over the
+    /// component's runs. (A necessary condition for the pixel to lie in one of its holes,
+    /// and cheap: a filter ahead of costlier tests.)
+    pub fn surrounds(&self, labeler: &Labeler, label: usize, x: u32, y: u32) -> bool {
+        let (mut left, mut right, mut above, mut below) = (false, false, false, false);
+        for r in self.runs_of(labeler, label) {
+            if r.y == y {
+                if r.x0 <= x && x < r.x1 {
+                    return false;
+                }
+                left |= r.x1 <= x;
+                right |= r.x0 > x;
+            } else if r.x0 <= x && x < r.x1 {
+                above |= r.y < y;
+                below |= r.y > y;
+            }
+        }
+        left && right && above && below
+    }
+
+    /// This component's run indices, in raster order.
+    fn order_of(&self, label: usize) -> &[u32] {
+        match (self.start.get(label), self.start.get(label + 1)) {
+            (Some(&a), Some(&b)) => self.order.get(a as usize..b as usize).unwrap_or(&[]),
+            _ => &[],
+        }
+    }
+
     /// The runs of component `label` of `labeler` (the labelling this index was built
     /// from), in raster order; none for an unknown label.
     pub fn runs_of<'a>(&'a self, labeler: &'a Labeler, label: usize) -> impl Iterator<Item = &'a Run> + 'a {
@@ -218,6 +356,146 @@ mod tests {
             }
         }
         assert!(checked > 100, "{checked}");
+    }
+
+    /// Pinholes by flood-filling every background region of the padded mask: the slow
+    /// reference. A region counts for `label` when it stays off the padding, has at most
+    /// `max_px` pixels, and every foreground pixel joined to it is `label`'s.
+    fn pinholes_reference(mask: &Mask, lab: &Labeler, label: usize, max_px: usize) -> u32 {
+        let (w, h) = mask.size();
+        let mut owner = vec![u32::MAX; w * h];
+        for r in lab.runs() {
+            for x in r.x0..r.x1 {
+                owner[r.y as usize * w + x as usize] = r.label;
+            }
+        }
+        let eight = lab.is_four_connected();
+        let (pw, ph) = (w as i64 + 2, h as i64 + 2);
+        let fg = |x: i64, y: i64| {
+            x >= 1 && y >= 1 && x <= w as i64 && y <= h as i64 && mask.get(x as usize - 1, y as usize - 1)
+        };
+        let mut seen = vec![false; (pw * ph) as usize];
+        let steps: &[(i64, i64)] = &[(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, 1), (1, -1), (-1, -1)];
+        let steps = if eight { steps } else { &steps[..4] };
+        let mut count = 0;
+        for sy in 0..ph {
+            for sx in 0..pw {
+                if fg(sx, sy) || seen[(sy * pw + sx) as usize] {
+                    continue;
+                }
+                let (mut size, mut outside, mut only_label) = (0, false, true);
+                let mut stack = vec![(sx, sy)];
+                seen[(sy * pw + sx) as usize] = true;
+                while let Some((x, y)) = stack.pop() {
+                    size += 1;
+                    outside |= x == 0 || y == 0 || x == pw - 1 || y == ph - 1;
+                    for &(dx, dy) in steps {
+                        let (nx, ny) = (x + dx, y + dy);
+                        if nx < 0 || ny < 0 || nx >= pw || ny >= ph {
+                            continue;
+                        }
+                        if fg(nx, ny) {
+                            only_label &= owner[((ny - 1) * w as i64 + nx - 1) as usize] == label as u32;
+                        } else if !seen[(ny * pw + nx) as usize] {
+                            seen[(ny * pw + nx) as usize] = true;
+                            stack.push((nx, ny));
+                        }
+                    }
+                }
+                if !outside && size <= max_px && only_label {
+                    count += 1;
+                }
+            }
+        }
+        count
+    }
+
+    proptest::proptest! {
+        /// Pinhole counts and pixel membership agree with the flood fill on random masks,
+        /// for both connectivities, every component and every size limit up to 6.
+        #[test]
+        fn pinholes_match_a_flood_fill(
+            bits in proptest::collection::vec(proptest::bool::weighted(0.7), 11 * 9),
+            four in proptest::bool::ANY,
+            max_px in 0usize..7,
+        ) {
+            let (w, h) = (11, 9);
+            let mask = Mask::from_vec(w, h, bits.iter().map(|&b| b as u8).collect()).unwrap();
+            let mut lab = if four { Labeler::new_four_connected(w, h) } else { Labeler::new(w, h) };
+            let n = lab.label(&mask).unwrap().len();
+            let mut idx = RunIndex::new(w, h);
+            idx.build(&lab);
+            let mut fill = Vec::with_capacity(max_px + 1);
+            for l in 0..n {
+                proptest::prop_assert_eq!(
+                    idx.pinholes(&lab, &mask, l, max_px, &mut fill),
+                    pinholes_reference(&mask, &lab, l, max_px),
+                    "label {} of {}, four {}, max {}", l, n, four, max_px
+                );
+            }
+            let owner = |x: u32, y: u32| lab.runs().iter().find(|r| r.y == y && r.x0 <= x && x < r.x1).map(|r| r.label as usize);
+            for y in 0..h as u32 {
+                for x in 0..w as u32 {
+                    for l in 0..n {
+                        proptest::prop_assert_eq!(idx.contains(&lab, l, x, y), owner(x, y) == Some(l), "({}, {}) in {}", x, y, l);
+                    }
+                }
+            }
+            proptest::prop_assert!(!idx.contains(&lab, n + 3, 0, 0));
+        }
+    }
+
+    #[test]
+    fn a_ring_surrounds_its_centre_and_a_bar_does_not() {
+        #[rustfmt::skip]
+        let mask = Mask::from_vec(9, 6, vec![
+            0, 1, 1, 1, 1, 0, 0, 0, 0,
+            1, 1, 0, 0, 1, 1, 0, 0, 0,
+            1, 0, 0, 0, 0, 1, 0, 1, 1,
+            1, 1, 0, 0, 1, 1, 0, 0, 0,
+            0, 1, 1, 1, 1, 0, 0, 0, 0,
+            0, 0, 0, 0, 0, 0, 0, 0, 0,
+        ]).unwrap();
+        let mut lab = Labeler::new(9, 6);
+        lab.label(&mask).unwrap();
+        let mut idx = RunIndex::new(9, 6);
+        idx.build(&lab);
+        assert!(idx.surrounds(&lab, 0, 2, 2) && idx.surrounds(&lab, 0, 3, 2));
+        assert!(!idx.surrounds(&lab, 0, 1, 1), "its own pixel");
+        assert!(!idx.surrounds(&lab, 0, 6, 2), "outside, to its right");
+        assert!(!idx.surrounds(&lab, 1, 6, 2), "a bar surrounds nothing");
+        assert!(!idx.surrounds(&lab, 7, 2, 2), "an unknown label");
+    }
+
+    #[test]
+    fn a_pitted_ring_has_its_pinholes_counted_and_its_hole_not() {
+        // A 9×9 ring (a 3×3 hole) with a 1-pixel and a 2-pixel pinhole in its band.
+        let mut mask = Mask::new(11, 11);
+        for y in 1..10 {
+            for x in 1..10 {
+                let hole = (4..7).contains(&x) && (4..7).contains(&y);
+                mask.set(x, y, !hole);
+            }
+        }
+        mask.set(2, 2, false);
+        mask.set(7, 8, false);
+        mask.set(8, 8, false);
+        let mut lab = Labeler::new(11, 11);
+        lab.label(&mask).unwrap();
+        let mut idx = RunIndex::new(11, 11);
+        idx.build(&lab);
+        let mut fill = Vec::with_capacity(16);
+        assert_eq!(idx.euler(0), -2, "three holes");
+        assert_eq!(idx.pinholes(&lab, &mask, 0, 1, &mut fill), 1);
+        assert_eq!(idx.pinholes(&lab, &mask, 0, 2, &mut fill), 2);
+        assert_eq!(
+            idx.pinholes(&lab, &mask, 0, 8, &mut fill),
+            2,
+            "the 9-pixel hole is the ring's"
+        );
+        assert_eq!(idx.pinholes(&lab, &mask, 0, 9, &mut fill), 3);
+        assert_eq!(idx.pinholes(&lab, &mask, 0, 0, &mut fill), 0);
+        assert_eq!(idx.pinholes(&lab, &mask, 5, 4, &mut fill), 0, "an unknown label");
     }
 
     #[test]
