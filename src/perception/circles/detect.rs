@@ -790,7 +790,10 @@ mod tests {
             assert!(bare.detect(&im.view()).unwrap().is_empty(), "eight holes fail −3…0");
         }
         let im = pitted(&[(0, 0), (1, 0), (0, 1), (1, 1), (2, 0)]);
-        assert!(detector(w, h).detect(&im.view()).unwrap().is_empty(), "five-pixel holes");
+        assert!(
+            detector(w, h).detect(&im.view()).unwrap().is_empty(),
+            "five-pixel holes"
+        );
     }
 
     #[test]
