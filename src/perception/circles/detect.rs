@@ -384,10 +384,11 @@ impl CircleDetector {
             }
             // A mark's rim surrounds its centroid (in its hole): this drops most of the
             // textured ground's ring-like blobs before the costlier search for a partner.
+            if !(p.black_euler[0]..=p.black_euler[1]).contains(&e) {
+                continue;
+            }
             let (cx, cy) = c.centroid();
-            if (p.black_euler[0]..=p.black_euler[1]).contains(&e)
-                && self.index.surrounds(&self.labelers[BLACK], i, cx as u32, cy as u32)
-            {
+            if self.index.surrounds(&self.labelers[BLACK], i, cx as u32, cy as u32) {
                 self.black.push(i as u32);
             }
         }
@@ -400,13 +401,11 @@ impl CircleDetector {
         let comps = labeler.components();
         let halo = |outer: usize, inner: usize| {
             let (a, b) = (comps[outer].bbox, comps[inner].bbox);
-            let (cx, cy) = comps[outer].centroid();
-            outer != inner
-                && a[0] <= b[0]
-                && a[1] <= b[1]
-                && a[2] >= b[2]
-                && a[3] >= b[3]
-                && index.surrounds(labeler, inner, cx as u32, cy as u32)
+            let holds = outer != inner && a[0] <= b[0] && a[1] <= b[1] && a[2] >= b[2] && a[3] >= b[3];
+            holds && {
+                let (cx, cy) = comps[outer].centroid();
+                index.surrounds(labeler, inner, cx as u32, cy as u32)
+            }
         };
         const OUTER: u32 = 1 << 31; // a flag on the label (labels are fewer than 2³¹ pixels)
         for k in 0..self.black.len() {
