@@ -9,9 +9,10 @@
 //!
 //! **Pinholes.** A hole of a few pixels is sensor noise, not shape: a dark blob's pixels
 //! that noise lifts over the threshold. In shade, where the camera's gamma stretches dark
-//! noise, a printed black ring 100 px across shows a dozen of them (most of one pixel, a
-//! few of two to four). [`RunIndex::pinholes`] counts the holes of a component up to a
-//! size, so that a filter on the Euler number can ask about the holes of the shape.
+//! noise, a printed black ring shows a few of them, nearly all of one pixel (Axel's near
+//! marks: [`crate::perception::circles::CircleParams::for_image`]). [`RunIndex::pinholes`]
+//! counts the holes of a component up to a size, so that a filter on the Euler number can
+//! ask about the holes of the shape.
 //!
 //! All buffers are sized for the labeller's worst case when built, so indexing never
 //! allocates.

@@ -194,12 +194,13 @@ impl CircleParams {
     /// * black Euler number from −3 to 0 (at least one hole, a few from noise), or brought
     ///   there by filling holes of up to 4 px as pinholes. Sensor noise lifts single
     ///   pixels of a black print over the local threshold, and in shade, where the
-    ///   camera's gamma stretches dark noise, a mark's rim 100 px across shows about 15
-    ///   such holes (measured on rendered frames of Axel's marks at 1.0–1.2 m under the
-    ///   `axel-lighting` shadow: 87 % of one pixel, 12 % of two or three, 1 % of four or
-    ///   five), more than any fixed range allows: nearer than 1.4 m under that shadow the
-    ///   range alone lost a third of the marks. The smallest mark reported (minor
-    ///   semi-axis 4 px) has a hole of about 14 px, its white ring, so 4 px is noise;
+    ///   camera's gamma stretches dark noise, the rims of Axel's marks at 1.0–1.2 m under
+    ///   the `axel-lighting` shadow show 2.9 such holes each besides the ring, 93 % of
+    ///   one pixel and the rest of two or three, and 23 of 83 rims more than −3…0 allows:
+    ///   the range alone lost those marks (`tests/circles_render.rs`,
+    ///   `under_the_shadow_every_mark_is_found_once_pinholes_are_filled`). The smallest
+    ///   mark reported (minor semi-axis 4 px) has a hole of about 14 px, its white ring
+    ///   (0.88 R² by the mark's geometry), so 4 px is noise;
     /// * centroids within 0.2 of the radius; white/black area 0.25–4;
     /// * contrast ≥ 40 grey levels (rendered marks in lab light show 90–190);
     /// * fit RMS ≤ 0.35 px + 4 % of the minor semi-axis (a square's best ellipse is off by
@@ -382,8 +383,9 @@ impl CircleDetector {
                 );
                 e += pinholes as i32;
             }
-            // A mark's rim surrounds its centroid (in its hole): this drops most of the
-            // textured ground's ring-like blobs before the costlier search for a partner.
+            // A mark's rim surrounds its centroid (in its hole). The ground's ring-like
+            // blobs mostly do not, and dropping them halves the area the costlier partner
+            // search labels (on Axel's rendered 1024-px frames at 1.5 and 3 m).
             if !(p.black_euler[0]..=p.black_euler[1]).contains(&e) {
                 continue;
             }
