@@ -169,8 +169,8 @@ fn bench_pyramid(c: &mut Criterion, w: usize, h: usize) {
 
 fn bench_circles(c: &mut Criterion) {
     use marsupial::perception::circles::{
-        CircleDetector, CircleModel, CircleParams, CorrespondenceParams, MarkObservations, PoseBuffers, PoseParams,
-        RigCamera, correspond, mono_pose, stereo_pose,
+        CircleDetector, CircleModel, CircleParams, CorrespondenceParams, LensPlane, MarkObservations, PoseBuffers,
+        PoseParams, RigCamera, correspond, correspond_through, mono_pose, stereo_pose,
     };
     let (w, h) = (640, 480);
     let mut p = Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/axel.toml")).expect("profile");
@@ -213,23 +213,32 @@ fn bench_circles(c: &mut Criterion) {
         .collect();
     let mut det = CircleDetector::new(w, h, CircleParams::for_image(w));
     let params = CorrespondenceParams::default();
-    for f in &frames {
-        let marks = det.detect(&f.view()).expect("detect");
-        assert_eq!(marks.len(), 8, "bench frames must show all eight marks");
-        assert_eq!(correspond(&model, marks, &params).expect("fit").inliers, 8);
-    }
-    let marks = det.detect(&frames[0].view()).expect("detect").to_vec();
     let cams = [
         RigCamera::from_profile(&p, 0).expect("left"),
         RigCamera::from_profile(&p, 1).expect("right"),
     ];
+    // The robot labels through each camera's lens (`correspond_through`).
+    let mut lenses = [
+        LensPlane::new(cams[0].model.clone()),
+        LensPlane::new(cams[1].model.clone()),
+    ];
+    for (f, lens) in frames.iter().zip(&mut lenses) {
+        let marks = det.detect(&f.view()).expect("detect");
+        assert_eq!(marks.len(), 8, "bench frames must show all eight marks");
+        assert_eq!(
+            correspond_through(&model, marks, lens, &params).expect("fit").inliers,
+            8
+        );
+    }
+    let marks = det.detect(&frames[0].view()).expect("detect").to_vec();
     let pose_params = PoseParams::default();
     let mut buf = PoseBuffers::new();
     let obs: Vec<MarkObservations> = frames
         .iter()
-        .map(|f| {
+        .zip(&mut lenses)
+        .map(|(f, lens)| {
             let m = det.detect(&f.view()).expect("detect");
-            MarkObservations::from_fit(&correspond(&model, m, &params).expect("fit"), m)
+            MarkObservations::from_fit(&correspond_through(&model, m, lens, &params).expect("fit"), m)
         })
         .collect();
     let stereo = stereo_pose(&model, [&cams[0], &cams[1]], [&obs[0], &obs[1]], &pose_params, &mut buf).expect("pose");
@@ -285,6 +294,15 @@ fn bench_circles(c: &mut Criterion) {
     g.bench_function("correspond_eight_marks", |b| {
         b.iter(|| black_box(correspond(&model, black_box(&marks), &params).expect("fit").inliers))
     });
+    g.bench_function("correspond_eight_marks_through_lens", |b| {
+        b.iter(|| {
+            black_box(
+                correspond_through(&model, black_box(&marks), &mut lenses[0], &params)
+                    .expect("fit")
+                    .inliers,
+            )
+        })
+    });
     g.bench_function("pose_stereo", |b| {
         b.iter(|| {
             let p = stereo_pose(&model, [&cams[0], &cams[1]], [&obs[0], &obs[1]], &pose_params, &mut buf);
@@ -302,9 +320,9 @@ fn bench_circles(c: &mut Criterion) {
     });
     g.bench_function("detect_and_correspond_stereo_pair", |b| {
         b.iter(|| {
-            for f in &frames {
+            for (f, lens) in frames.iter().zip(&mut lenses) {
                 let m = det.detect(black_box(&f.view())).expect("detect");
-                black_box(correspond(&model, m, &params).expect("fit").inliers);
+                black_box(correspond_through(&model, m, lens, &params).expect("fit").inliers);
             }
         })
     });
@@ -313,7 +331,10 @@ fn bench_circles(c: &mut Criterion) {
         b.iter(|| {
             for (k, f) in frames.iter().enumerate() {
                 let m = det.detect(black_box(&f.view())).expect("detect");
-                seen[k] = MarkObservations::from_fit(&correspond(&model, m, &params).expect("fit"), m);
+                seen[k] = MarkObservations::from_fit(
+                    &correspond_through(&model, m, &mut lenses[k], &params).expect("fit"),
+                    m,
+                );
             }
             let p = stereo_pose(
                 &model,

@@ -164,7 +164,9 @@ fn axel_stands_outdoors_with_seven_metre_starts_inside_the_world() {
 /// at 20°.
 #[test]
 fn the_marks_are_detected_to_the_range_the_behavior_plans_within() {
-    use marsupial::perception::circles::{CircleDetector, CircleModel, CircleParams, CorrespondenceParams, correspond};
+    use marsupial::perception::circles::{
+        CircleDetector, CircleModel, CircleParams, CorrespondenceParams, LensPlane, RigCamera, correspond_through,
+    };
     let p = axel();
     let w = world::build(&p, &[], &[]).expect("axel world");
     let model = CircleModel::from_profile(&p).expect("model");
@@ -173,6 +175,10 @@ fn the_marks_are_detected_to_the_range_the_behavior_plans_within() {
         .iter()
         .map(|c| CircleDetector::new(c.width_px, c.height_px, CircleParams::for_image(c.width_px)))
         .collect();
+    // Labelled through each camera's lens, as the robot does.
+    let mut lenses: Vec<LensPlane> = (0..p.cameras.len())
+        .map(|c| LensPlane::new(RigCamera::from_profile(&p, c).expect("camera").model))
+        .collect();
     for alpha in [0.0, 20.0] {
         for d in [3.0, 4.0, 4.5, 5.0, 5.5, 6.0, 7.0] {
             let robot = common::axel::facing(d, alpha, 0.0);
@@ -180,7 +186,8 @@ fn the_marks_are_detected_to_the_range_the_behavior_plans_within() {
             for (cam, det) in dets.iter_mut().enumerate() {
                 let im = common::axel::render(&p, &w, cam, &robot, 7 + cam as u64);
                 let marks = det.detect(&im.view()).expect("detect");
-                labelled[cam] = correspond(&model, marks, &CorrespondenceParams::default()).map_or(0, |f| f.inliers);
+                labelled[cam] = correspond_through(&model, marks, &mut lenses[cam], &CorrespondenceParams::default())
+                    .map_or(0, |f| f.inliers);
             }
             eprintln!(
                 "{d} m, α {alpha}°: marks labelled left {}, right {}",

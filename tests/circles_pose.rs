@@ -19,8 +19,8 @@ use common::axel::{facing, render};
 use marsupial::geometry::Pose2;
 use marsupial::perception::camera_model::{CameraModel, Fisheye, MountAngles, Pinhole};
 use marsupial::perception::circles::{
-    CircleDetector, CircleModel, CircleParams, CorrespondenceParams, MarkObservations, PoseBuffers, PoseParams,
-    PoseSource, RigCamera, correspond, mono_pose, rigid_fit, stereo_pose,
+    CircleDetector, CircleModel, CircleParams, CorrespondenceParams, LensPlane, MarkObservations, PoseBuffers,
+    PoseParams, PoseSource, RigCamera, correspond_through, mono_pose, rigid_fit, stereo_pose,
 };
 use marsupial::sim::world;
 use nalgebra::{Matrix3, Rotation3, Vector3};
@@ -271,6 +271,11 @@ fn rendered_stereo_pose_beats_the_paper_and_mono_is_reported() {
         .map(|s| CircleDetector::new(s.width_px, s.height_px, CircleParams::for_image(s.width_px)))
         .collect();
     let mut buf = PoseBuffers::new();
+    // Labelled through each camera's lens, as the robot does.
+    let mut lenses = [
+        LensPlane::new(cams[0].model.clone()),
+        LensPlane::new(cams[1].model.clone()),
+    ];
     // (distance, α, turn); the paper's bound where it gives one.
     let distances = [1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0];
     let angles = [(0.0, 0.0), (20.0, 5.0), (-30.0, -8.0)];
@@ -286,7 +291,7 @@ fn rendered_stereo_pose_beats_the_paper_and_mono_is_reported() {
             for c in 0..2 {
                 let im = render(&p, &w, c, &robot, 300 + 10 * k as u64 + (d * 100.0) as u64);
                 let marks = dets[c].detect(&im.view()).expect("detect").to_vec();
-                if let Ok(fit) = correspond(&model, &marks, &CorrespondenceParams::default()) {
+                if let Ok(fit) = correspond_through(&model, &marks, &mut lenses[c], &CorrespondenceParams::default()) {
                     obs[c] = MarkObservations::from_fit(&fit, &marks);
                 }
             }

@@ -15,8 +15,8 @@ use marsupial::geometry::Pose2;
 use marsupial::perception::camera_model::CameraModel;
 use marsupial::perception::circles::RunIndex;
 use marsupial::perception::circles::{
-    CircleDetector, CircleModel, CircleParams, CorrespondenceParams, FixedThreshold, MarkRotation, Threshold,
-    correspond,
+    CircleDetector, CircleModel, CircleParams, CorrespondenceParams, FixedThreshold, LensPlane, MarkRotation,
+    Threshold, correspond_through,
 };
 use marsupial::perception::{Labeler, RgbImage};
 use marsupial::profile::Profile;
@@ -118,8 +118,9 @@ fn every_visible_mark_is_found_labelled_and_centred_from_several_poses() {
                 );
             }
             assert_eq!(marks.len(), visible, "{label}: {marks:?}");
-            // The correspondence labels each one.
-            let fit = correspond(&model, &marks, &CorrespondenceParams::default()).expect(&label);
+            // The correspondence labels each one, through the camera's lens as the robot does.
+            let mut lens = LensPlane::new(CameraModel::from_spec(spec));
+            let fit = correspond_through(&model, &marks, &mut lens, &CorrespondenceParams::default()).expect(&label);
             assert_eq!(fit.inliers, visible, "{label}");
             for (j, tr) in truth.iter().enumerate() {
                 let Some((c, _)) = tr else { continue };

@@ -486,9 +486,14 @@ fn simulated_lockstep_ticks(imperfect: bool) {
 
 #[test]
 fn circle_detection_and_correspondence_do_not_allocate() {
-    use marsupial::perception::circles::{CircleDetector, CircleModel, CircleParams, CorrespondenceParams, correspond};
+    use marsupial::perception::circles::{
+        CircleDetector, CircleModel, CircleParams, CorrespondenceParams, LensPlane, RigCamera, correspond,
+        correspond_through,
+    };
     let p = common::shipped_profile("axel");
     let model = CircleModel::from_profile(&p).unwrap();
+    // The robot labels through its fish-eye: the same frames through camera 0's lens.
+    let mut lens = LensPlane::new(RigCamera::from_profile(&p, 0).unwrap().model);
     let (w, h) = (640, 480);
     let frames: Vec<RgbImage> = [
         (300.0, [320.0, 240.0]),
@@ -504,6 +509,10 @@ fn circle_detection_and_correspondence_do_not_allocate() {
     for f in &frames {
         let marks = det.detect(&f.view()).unwrap();
         assert_eq!(correspond(&model, marks, &params).unwrap().inliers, 8); // warm-up
+        assert_eq!(
+            correspond_through(&model, marks, &mut lens, &params).unwrap().inliers,
+            8
+        );
     }
     reset();
     COUNTING.with(|c| c.set(true));
@@ -512,13 +521,15 @@ fn circle_detection_and_correspondence_do_not_allocate() {
         for f in &frames {
             let marks = det.detect(&f.view()).unwrap();
             fits += correspond(&model, marks, &params).is_ok() as usize;
+            fits += correspond_through(&model, marks, &mut lens, &params).is_ok() as usize;
         }
         let marks = det.detect(&empty.view()).unwrap();
         fits += correspond(&model, marks, &params).is_ok() as usize;
+        fits += correspond_through(&model, marks, &mut lens, &params).is_ok() as usize;
     }
     COUNTING.with(|c| c.set(false));
     assert_eq!(allocs(), 0, "allocations in steady state");
-    assert_eq!(fits, 15);
+    assert_eq!(fits, 30);
 }
 
 #[test]

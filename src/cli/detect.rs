@@ -9,9 +9,9 @@ use super::json_line;
 use crate::config::ConfigError;
 use crate::image_io::{ImageFileError, load_rgb, save_png};
 use crate::perception::circles::{
-    CircleDetector, CircleModel, CircleParams, CorrespondenceError, CorrespondenceParams, DetectedMark,
-    MarkObservations, ModelFit, ModulePose, PoseBuffers, PoseError, PoseParams, RigCamera, correspond, mono_pose,
-    stereo_pose,
+    CircleDetector, CircleModel, CircleParams, CorrespondenceError, CorrespondenceParams, DetectedMark, LensPlane,
+    MarkObservations, ModelFit, ModulePose, PoseBuffers, PoseError, PoseParams, RigCamera, correspond,
+    correspond_through, mono_pose, stereo_pose,
 };
 use crate::perception::overlay::{CirclesDrawing, paint_circles_overlay, paint_overlay};
 use crate::perception::{RgbImage, TwoBlockPercept, VisionError};
@@ -363,6 +363,8 @@ struct CirclesRun {
     detector: CircleDetector,
     model: CircleModel,
     cam: RigCamera,
+    /// The camera's lens, for labelling through its distortion.
+    lens: LensPlane,
     camera: usize,
     cam_size: (usize, usize),
     corr: CorrespondenceParams,
@@ -379,6 +381,7 @@ struct CirclesOutcome {
 impl CirclesRun {
     fn new(profile: &Profile, camera: usize) -> Result<Self, DetectError> {
         let spec = &profile.cameras[camera];
+        let cam = RigCamera::from_profile(profile, camera)?;
         Ok(Self {
             detector: CircleDetector::new(
                 spec.width_px,
@@ -386,7 +389,8 @@ impl CirclesRun {
                 CircleParams::from_profile(profile, spec.width_px),
             ),
             model: CircleModel::from_profile(profile)?,
-            cam: RigCamera::from_profile(profile, camera)?,
+            lens: LensPlane::new(cam.model.clone()),
+            cam,
             camera,
             cam_size: (spec.width_px, spec.height_px),
             corr: CorrespondenceParams::default(),
@@ -401,7 +405,12 @@ impl CirclesRun {
             self.detector = CircleDetector::new(im.width(), im.height(), params);
         }
         let marks = self.detector.detect(&im.view())?;
-        let fit = correspond(&self.model, marks, &self.corr);
+        // Through the lens when the image is the camera's; another size has no lens model.
+        let fit = if (im.width(), im.height()) == self.cam_size {
+            correspond_through(&self.model, marks, &mut self.lens, &self.corr)
+        } else {
+            correspond(&self.model, marks, &self.corr)
+        };
         let pose = fit.as_ref().ok().map(|f| {
             if (im.width(), im.height()) != self.cam_size {
                 return Err(format!(

@@ -216,6 +216,35 @@ impl CameraModel {
             CameraModel::Fisheye(m) => m.ray(u, v),
         }
     }
+
+    /// The distortion-free pin-hole that agrees with this model on its optical axis: a
+    /// pin-hole's own intrinsics without k1, k2; a fish-eye's on-axis focal length
+    /// (−a0 of its polynomial, since f(ρ) ≈ a0 near the centre) and its distortion
+    /// centre. Straight lines stay straight through it, so a homography holds between a
+    /// plane and this camera's image (what the circle correspondence fits); it is also
+    /// what a pose that ignores the distortion assumes.
+    pub fn ideal_pinhole(&self) -> Pinhole {
+        match self {
+            CameraModel::Pinhole(m) => Pinhole { k1: 0.0, k2: 0.0, ..*m },
+            CameraModel::Fisheye(m) => {
+                let f = -m.poly.first().copied().unwrap_or(-1.0);
+                Pinhole {
+                    fx: f,
+                    fy: f,
+                    cx: m.center[0],
+                    cy: m.center[1],
+                    k1: 0.0,
+                    k2: 0.0,
+                }
+            }
+        }
+    }
+
+    /// Whether the model has no distortion (a pin-hole with k1 = k2 = 0), so that its
+    /// image already is its [`CameraModel::ideal_pinhole`]'s.
+    pub fn is_ideal_pinhole(&self) -> bool {
+        matches!(self, CameraModel::Pinhole(m) if m.k1 == 0.0 && m.k2 == 0.0)
+    }
 }
 
 /// Where a camera looks on its body: the orientation part of a mounting, in degrees as a

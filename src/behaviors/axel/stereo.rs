@@ -5,8 +5,8 @@
 
 use crate::behaviors::BuildError;
 use crate::perception::circles::{
-    CircleDetector, CircleModel, CircleParams, CorrespondenceParams, MarkObservations, ModulePose, PoseBuffers,
-    PoseParams, RigCamera, correspond, module_pose,
+    CircleDetector, CircleModel, CircleParams, CorrespondenceParams, LensPlane, MarkObservations, ModulePose,
+    PoseBuffers, PoseParams, RigCamera, correspond_through, module_pose,
 };
 use crate::profile::Profile;
 use crate::schemas::Inputs;
@@ -16,6 +16,8 @@ pub(super) struct Perception {
     detectors: [CircleDetector; 2],
     model: CircleModel,
     cams: [RigCamera; 2],
+    /// Each camera's lens, for labelling through its distortion.
+    lenses: [LensPlane; 2],
     corr: CorrespondenceParams,
     params: PoseParams,
     buf: PoseBuffers,
@@ -35,10 +37,15 @@ impl Perception {
             CircleDetector::new(c.width_px, c.height_px, CircleParams::from_profile(profile, c.width_px))
         };
         let cam = |i: usize| RigCamera::from_profile(profile, i).map_err(|e| err(e.to_string()));
+        let cams = [cam(0)?, cam(1)?];
         Ok(Self {
             detectors: [detector(0), detector(1)],
             model: CircleModel::from_profile(profile).map_err(|e| err(e.to_string()))?,
-            cams: [cam(0)?, cam(1)?],
+            lenses: [
+                LensPlane::new(cams[0].model.clone()),
+                LensPlane::new(cams[1].model.clone()),
+            ],
+            cams,
             corr: CorrespondenceParams::default(),
             params: PoseParams::default(),
             buf: PoseBuffers::new(),
@@ -56,7 +63,7 @@ impl Perception {
             let Ok(marks) = self.detectors[i].detect(&frame.image) else {
                 continue;
             };
-            if let Ok(fit) = correspond(&self.model, marks, &self.corr) {
+            if let Ok(fit) = correspond_through(&self.model, marks, &mut self.lenses[i], &self.corr) {
                 *o = MarkObservations::from_fit(&fit, marks);
             }
         }

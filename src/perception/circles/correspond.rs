@@ -55,9 +55,9 @@ pub struct CorrespondenceParams {
     pub min_inliers: usize,
     /// Closeness gate, in projected mark radii (default 0.3: a well-measured centre is
     /// within a pixel, and a tight gate leaves a 5-mark fit little room to bend toward a
-    /// false mark). Centres
-    /// should be undistorted first when the lens distorts, since a homography does not
-    /// model distortion.
+    /// false mark). A homography does not model distortion: through a distorting lens,
+    /// label with [`super::correspond_through`], which moves the centres onto the lens's
+    /// ideal pin-hole image first.
     pub gate_radii: f64,
     /// Smallest gate, px (default 3: far marks are only a few pixels across).
     pub gate_min_px: f64,
@@ -169,6 +169,27 @@ impl ModelFit {
                 .and_then(|i| marks.get(i))
                 .map_or(self.projected[j], |m| m.centre),
         )
+    }
+}
+
+impl ModelFit {
+    /// Moves the fit from the plane it was labelled in into the camera's own pixels
+    /// (`to_image` maps a point across, `None` outside the lens's view): the reprojected
+    /// model, and the RMS recomputed between each inlier's detection in `marks` (image
+    /// pixels) and its mark's reprojection there. Used by
+    /// [`super::rectify::correspond_through`].
+    pub(super) fn map_to_image(&mut self, marks: &[DetectedMark], to_image: impl Fn([f64; 2]) -> Option<[f64; 2]>) {
+        for p in &mut self.projected[..self.len] {
+            *p = to_image(*p).unwrap_or([f64::NAN; 2]);
+        }
+        let mut ss = 0.0;
+        for j in 0..self.len {
+            if let Some(m) = self.detection_of(j).and_then(|i| marks.get(i)) {
+                let p = self.projected[j];
+                ss += (m.centre[0] - p[0]).powi(2) + (m.centre[1] - p[1]).powi(2);
+            }
+        }
+        self.rms_px = (ss / self.inliers.max(1) as f64).sqrt();
     }
 }
 
@@ -455,7 +476,7 @@ fn match_marks(h: &Homography, model: &CircleModel, marks: &[DetectedMark], para
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::perception::circles::MarkRotation;
     use MarkRotation::*;

@@ -12,6 +12,9 @@
 //!   labellings into at most 16 hypotheses, each verified by a homography
 //!   ([`Homography`], normalised DLT) and its reprojection; far points are occlusions or
 //!   false positives, and no fit from fewer than 5 marks is ever accepted;
+//!   [`correspond_through`] does it through a distorting lens, on the detections moved
+//!   onto the lens's ideal pin-hole image ([`LensPlane`]), where the face's marks obey a
+//!   homography;
 //! * [`module_pose`] turns the labelled marks ([`MarkObservations`]) into the module's
 //!   pose in the rover frame ([`ModulePose`]): midpoint triangulation of the marks both
 //!   cameras detected and a least-squares rigid (SVD) fit ([`stereo_pose`]), or, when
@@ -28,7 +31,7 @@ pub mod ellipse;
 pub mod homography;
 pub mod model;
 pub mod pose;
-
+pub mod rectify;
 pub mod threshold;
 
 pub use blobs::RunIndex;
@@ -41,4 +44,5 @@ pub use pose::{
     MarkObservations, ModulePose, PoseBuffers, PoseError, PoseParams, PoseSource, RigCamera, module_pose, mono_pose,
     rigid_fit, stereo_pose,
 };
+pub use rectify::{LensPlane, correspond_through};
 pub use threshold::{AdaptiveThreshold, FixedThreshold, Threshold, Thresholder, grey_from_rgb};
