@@ -202,3 +202,71 @@ fn the_marks_are_detected_to_the_range_the_behavior_plans_within() {
         }
     }
 }
+
+/// A false mark painted on the face among the real ones (`world::build_face`), the
+/// paper's hard case (seed 000 §V-D): the detector finds it where it is painted, the
+/// correspondence leaves it unlabelled beside 5 true marks and refuses 4 true marks with
+/// it, from both cameras and two poses.
+#[test]
+fn a_false_mark_painted_among_the_marks_is_drawn_and_never_labelled() {
+    use marsupial::perception::circles::{
+        CircleDetector, CircleModel, CircleParams, CorrespondenceError, CorrespondenceParams, LensPlane, RigCamera,
+        correspond_through,
+    };
+    use marsupial::profile::CirclePlacement;
+    let p = axel();
+    let model = CircleModel::from_profile(&p).expect("model");
+    // Among the marks, at least 3 radii from every one of them.
+    let false_mark = CirclePlacement {
+        y_m: 0.12,
+        z_m: 0.62,
+        rotation_deg: 90.0,
+    };
+    for (covered, labelled) in [(&[2usize, 3, 4][..], Some(5)), (&[0, 2, 3, 4][..], None)] {
+        let w = world::build_face(&p, &[], &[], covered, &[false_mark]).expect("axel world");
+        for (k, robot) in [
+            common::axel::facing(2.0, 0.0, 0.0),
+            common::axel::facing(2.5, 20.0, 3.0),
+        ]
+        .iter()
+        .enumerate()
+        {
+            for cam in 0..p.cameras.len() {
+                let spec = &p.cameras[cam];
+                let rig = RigCamera::from_profile(&p, cam).expect("camera");
+                let mut det =
+                    CircleDetector::new(spec.width_px, spec.height_px, CircleParams::for_image(spec.width_px));
+                let im = common::axel::render(&p, &w, cam, robot, 50 + k as u64);
+                let marks = det.detect(&im.view()).expect("detect").to_vec();
+                let label = format!("camera {cam}, pose {k}, covered {covered:?}");
+                assert_eq!(marks.len(), 8 - covered.len() + 1, "{label}: {marks:?}");
+                // The false mark is detected where it is painted.
+                let pose = camera_pose(robot, &spec.mount);
+                let q = Point3::new(0.0, false_mark.y_m, false_mark.z_m);
+                let px = rig
+                    .model
+                    .project(&(pose.rotation.transpose() * (q - pose.position)))
+                    .expect("in view");
+                assert!(
+                    marks
+                        .iter()
+                        .any(|m| (m.centre[0] - px[0]).hypot(m.centre[1] - px[1]) < 1.0),
+                    "{label}: nothing detected at {px:?}"
+                );
+                let mut lens = LensPlane::new(rig.model.clone());
+                let res = correspond_through(&model, &marks, &mut lens, &CorrespondenceParams::default());
+                match labelled {
+                    Some(n) => {
+                        let fit = res.unwrap_or_else(|e| panic!("{label}: {e}"));
+                        assert_eq!(fit.inliers, n, "{label}");
+                        assert_eq!((0..marks.len()).filter(|&i| !fit.is_inlier(i)).count(), 1, "{label}");
+                    }
+                    None => assert!(
+                        matches!(res, Err(CorrespondenceError::NoConsistentFit { .. })),
+                        "{label}: {res:?}"
+                    ),
+                }
+            }
+        }
+    }
+}

@@ -8,7 +8,7 @@ use super::dock::Cone;
 use super::obstacles::{Footprint, Obstacles};
 use super::scene::{CircleMark, Material, Prim, Scene, Shape, Tag, albedo, boxed};
 use crate::perception::RgbImage;
-use crate::profile::{CirclesSpec, NamedColor, Profile};
+use crate::profile::{CirclePlacement, CirclesSpec, NamedColor, Profile};
 use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
@@ -183,6 +183,26 @@ pub fn build_covering(
     backdrops: &[Arc<RgbImage>],
     covered: &[usize],
 ) -> Result<World, SimError> {
+    build_face(profile, clutter, backdrops, covered, &[])
+}
+
+/// [`build_covering`], with `painted` false marks painted on the module's face among the
+/// real ones: circle marks of the layout's size and pattern at those face positions
+/// (`y_m` across the face, `z_m` above the ground) and rotations, which the module's model
+/// does not have. It is the hard case for the correspondence (seed 000 §V-D: four true
+/// marks and one false one fit a homography exactly); a panel held in front of the face
+/// would be lost behind it (see [`build_covering`]). A profile without
+/// `[fiducial.circles]` ignores `painted`.
+///
+/// # Errors
+/// As [`build`].
+pub fn build_face(
+    profile: &Profile,
+    clutter: &[ClutterSpec],
+    backdrops: &[Arc<RgbImage>],
+    covered: &[usize],
+    painted: &[CirclePlacement],
+) -> Result<World, SimError> {
     let mut prims = Vec::new();
     let mut target_prims = Vec::new();
     let dock_spec = profile
@@ -356,7 +376,8 @@ pub fn build_covering(
             Tag::Body,
         ));
     } else if let Some(circles) = &profile.fiducial.circles {
-        build_central_module(circles, covered, &mut dock, &mut prims, &mut target_prims, body_grey);
+        let face = FaceMarks { covered, painted };
+        build_central_module(circles, face, &mut dock, &mut prims, &mut target_prims, body_grey);
     } else {
         return Err(SimError::Unsupported(format!(
             "the simulator builds two-block, pyramid and circle targets so far; profile `{}` has another fiducial",
@@ -430,9 +451,18 @@ pub fn build_covering(
 /// a `[dock.cone]` table the mouth sits on the ground. The body is 1 m deep and wide
 /// enough for the mouth and the marks; it is tall enough for the highest mark. The
 /// station's forward tilt acts in the contact model ([`Cone`]) but is not drawn.
+/// Which of the layout's marks the face shows, and what false marks it adds.
+#[derive(Clone, Copy)]
+struct FaceMarks<'a> {
+    /// Layout indices not painted.
+    covered: &'a [usize],
+    /// False marks painted besides the layout's.
+    painted: &'a [CirclePlacement],
+}
+
 fn build_central_module(
     circles: &CirclesSpec,
-    covered: &[usize],
+    face: FaceMarks<'_>,
     dock: &mut DockGeometry,
     prims: &mut Vec<Prim>,
     target_prims: &mut Vec<usize>,
@@ -460,8 +490,10 @@ fn build_central_module(
         .placements
         .iter()
         .enumerate()
-        .filter(|(i, _)| !covered.contains(i))
-        .map(|(_, p)| {
+        .filter(|(i, _)| !face.covered.contains(i))
+        .map(|(_, p)| p)
+        .chain(face.painted)
+        .map(|p| {
             CircleMark::new(
                 p.y_m as f32,
                 (p.z_m - face_zc) as f32,
