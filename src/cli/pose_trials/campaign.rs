@@ -50,19 +50,27 @@ pub struct OcclusionSpec {
     pub decoys: Vec<DecoySpec>,
 }
 
-/// One false mark: a circle mark of the module's pattern on a panel of the module's grey.
-/// Place it clear of the face in the image (beside the module): for the reason given at
-/// [`OcclusionSpec::hidden`], a patch overlapping the face would be drawn behind it.
+/// One false mark: a circle mark of the module's pattern, either on a panel of the
+/// module's grey standing near the module, or painted on the face among the real marks
+/// (`painted`). A panel must stand clear of the face in the image (beside the module):
+/// for the reason given at [`OcclusionSpec::hidden`], a panel overlapping the face would
+/// be drawn behind it. A painted one is drawn by the face itself
+/// ([`world::build_face`](crate::sim::world::build_face)), so it can sit among the marks:
+/// seed 000 §V-D's four true marks and one false one.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DecoySpec {
     /// Position of its centre in the module frame (x forward of the face, y, height), m.
+    /// A painted decoy lies on the face: x must be 0.
     pub at_m: [f64; 3],
     /// Its bar's rotation, degrees.
     pub rotation_deg: f64,
-    /// Side of its square panel, m (default 0.14).
+    /// Side of its square panel, m (default 0.14); unused when painted.
     #[serde(default = "decoy_side")]
     pub panel_m: f64,
+    /// Painted on the module's face instead of standing on a panel (default false).
+    #[serde(default)]
+    pub painted: bool,
 }
 
 fn zero_list() -> Vec<f64> {
@@ -158,6 +166,11 @@ impl Validate for PoseCampaign {
                 }
                 v.finite(&format!("occlusion.decoys[{i}].rotation_deg"), d.rotation_deg);
                 v.range(&format!("occlusion.decoys[{i}].panel_m"), d.panel_m, 0.01, 1.0);
+                v.require(
+                    !d.painted || d.at_m[0] == 0.0,
+                    &format!("occlusion.decoys[{i}].at_m[0]"),
+                    || format!("a painted decoy lies on the face (x = 0), got x = {}", d.at_m[0]),
+                );
             }
         }
         self.lighting.validate_at("lighting", v);
@@ -209,5 +222,34 @@ impl PoseCampaign {
             });
         }
         Ok(LoadedCampaign { campaign, profile })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A painted decoy off the face is refused with the field named; one on it is taken.
+    #[test]
+    fn a_painted_decoy_must_lie_on_the_face() {
+        let text = |x: f64| {
+            format!(
+                "name = \"t\"\nprofile = \"p.toml\"\n[pose]\ndistances_m = [2.0]\nalpha_deg = [0.0]\n\
+                 [occlusion]\nhidden = [0]\ndecoys = [ {{ at_m = [{x:?}, 0.1, 0.6], rotation_deg = 90.0, painted = true }} ]\n"
+            )
+        };
+        let file = Path::new("campaign.toml");
+        assert!(config::parse_str::<PoseCampaign>(&text(0.0), file).is_ok());
+        match config::parse_str::<PoseCampaign>(&text(0.1), file) {
+            Err(ConfigError::Invalid { problems, .. }) => {
+                assert_eq!(problems.len(), 1, "{problems:?}");
+                assert_eq!(problems[0].path, "occlusion.decoys[0].at_m[0]");
+                assert!(
+                    problems[0].message.contains("painted decoy lies on the face"),
+                    "{problems:?}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }

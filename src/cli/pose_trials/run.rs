@@ -7,11 +7,12 @@
 use super::score::{label, outcome, truth, unlabelled};
 use super::{CameraRun, Labelling, LoadedCampaign, PoseCampaign, PoseOutcome, PoseRun, RunSpec, rover_pose};
 use crate::perception::RgbImage;
-use crate::perception::camera_model::{CameraModel, Pinhole};
+use crate::perception::camera_model::CameraModel;
 use crate::perception::circles::{
-    CircleDetector, CircleModel, CircleParams, CorrespondenceParams, DetectedMark, MarkObservations, PoseBuffers,
-    PoseParams, RigCamera, mono_pose, stereo_pose,
+    CircleDetector, CircleModel, CircleParams, CorrespondenceParams, DetectedMark, LensPlane, MarkObservations,
+    PoseBuffers, PoseParams, RigCamera, mono_pose, stereo_pose,
 };
+use crate::profile::CirclePlacement;
 use crate::profile::Profile;
 use crate::sim::SimError;
 use crate::sim::camera::camera_pose;
@@ -35,6 +36,8 @@ pub(super) struct Context<'a> {
 /// A worker's buffers, reused from run to run.
 pub(super) struct Workspace {
     detectors: Vec<CircleDetector>,
+    /// Each camera's lens, which the labelling sees through as the robot's does.
+    lenses: Vec<LensPlane>,
     image: RgbImage,
     marks: Vec<DetectedMark>,
     buf: PoseBuffers,
@@ -72,6 +75,12 @@ impl Workspace {
                 .take(2)
                 .map(|c| CircleDetector::new(c.width_px, c.height_px, CircleParams::from_profile(p, c.width_px)))
                 .collect(),
+            lenses: p
+                .cameras
+                .iter()
+                .take(2)
+                .map(|c| LensPlane::new(CameraModel::from_spec(c)))
+                .collect(),
             image: RgbImage::default(),
             marks: Vec::new(),
             buf: PoseBuffers::new(),
@@ -79,22 +88,13 @@ impl Workspace {
     }
 }
 
-/// A pin-hole with a fish-eye's on-axis focal length and centre (what a pose that ignores
-/// the distortion assumes); a pin-hole camera stays as it is.
+/// The camera as a pose that ignores the distortion sees it: its ideal pin-hole
+/// ([`CameraModel::ideal_pinhole`], a fish-eye's on-axis focal length and centre).
 fn pinhole_of(cam: &RigCamera) -> RigCamera {
-    let mut out = cam.clone();
-    if let CameraModel::Fisheye(f) = &cam.model {
-        let fx = -f.poly.first().copied().unwrap_or(-1.0);
-        out.model = CameraModel::Pinhole(Pinhole {
-            fx,
-            fy: fx,
-            cx: f.center[0],
-            cy: f.center[1],
-            k1: 0.0,
-            k2: 0.0,
-        });
+    RigCamera {
+        model: CameraModel::Pinhole(cam.model.ideal_pinhole()),
+        ..cam.clone()
     }
-    out
 }
 
 /// The marks a run hides: `n` of the model's, drawn from the run's seed.
@@ -111,14 +111,23 @@ fn hidden_marks(n: usize, len: usize, seed: u64) -> Vec<usize> {
 
 impl Context<'_> {
     /// The world of a run: the module with its hidden marks covered, and the decoys when
-    /// the run places them.
+    /// the run places them (on panels, or painted on the face).
     fn world(&self, hidden: &[usize], decoy: bool) -> Result<world::World, SimError> {
         let mut clutter = Vec::new();
+        let mut painted = Vec::new();
         if let Some(o) = &self.campaign.occlusion
             && decoy
         {
             {
                 for d in &o.decoys {
+                    if d.painted {
+                        painted.push(CirclePlacement {
+                            y_m: d.at_m[1],
+                            z_m: d.at_m[2],
+                            rotation_deg: d.rotation_deg,
+                        });
+                        continue;
+                    }
                     clutter.push(ClutterSpec {
                         kind: ClutterKind::CircleMark,
                         x_m: d.at_m[0],
@@ -132,7 +141,7 @@ impl Context<'_> {
                 }
             }
         }
-        world::build_covering(self.profile, &clutter, &[], hidden)
+        world::build_face(self.profile, &clutter, &[], hidden, &painted)
     }
 
     /// Renders, detects, labels and poses one run and scores it against the truth.
@@ -205,7 +214,7 @@ impl Context<'_> {
                 .filter(|&j| !hidden.contains(&j) && whole(&self.model.centres()[j]))
                 .count();
             run.detected = ws.marks.len();
-            let (res, l) = label(&self.model, &ws.marks, &strict, &true_px);
+            let (res, l) = label(&self.model, &ws.marks, &mut ws.lenses[c], &strict, &true_px);
             run.labelling = l;
             match res {
                 Ok(fit) => {
@@ -224,7 +233,7 @@ impl Context<'_> {
                     run.mono_pinhole = unlabelled(&e);
                 }
             }
-            let (res, l) = label(&self.model, &ws.marks, &four, &true_px);
+            let (res, l) = label(&self.model, &ws.marks, &mut ws.lenses[c], &four, &true_px);
             run.labelling_four_point = l;
             run.mono_four_point = match res {
                 Ok(fit) => {

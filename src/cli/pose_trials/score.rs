@@ -6,7 +6,8 @@
 use super::{Labelling, PoseOutcome};
 use crate::geometry::Pose2;
 use crate::perception::circles::{
-    CircleModel, CorrespondenceError, CorrespondenceParams, DetectedMark, ModelFit, ModulePose, PoseError, correspond,
+    CircleModel, CorrespondenceError, CorrespondenceParams, DetectedMark, LensPlane, ModelFit, ModulePose, PoseError,
+    correspond_through,
 };
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
@@ -74,14 +75,16 @@ pub(super) fn unlabelled(e: &CorrespondenceError) -> PoseOutcome {
     }
 }
 
-/// Labels `marks` with `params` and checks each label against the true image of its mark.
+/// Labels `marks` with `params` through the camera's `lens`, as the robot does, and checks
+/// each label against the true image of its mark.
 pub(super) fn label(
     model: &CircleModel,
     marks: &[DetectedMark],
+    lens: &mut LensPlane,
     params: &CorrespondenceParams,
     true_px: &[Option<[f64; 2]>],
 ) -> (Result<ModelFit, CorrespondenceError>, Labelling) {
-    let res = correspond(model, marks, params);
+    let res = correspond_through(model, marks, lens, params);
     let l = match &res {
         Ok(fit) => Labelling {
             found: true,
