@@ -193,6 +193,41 @@ fn several_problems_are_reported_together() {
     );
 }
 
+/// `behavior.two_arc.max_arc_turn_deg` is optional (absent in the shipped profile: no
+/// cap) and, when given, must be a finite number in (0, 180]; a bad one is reported by
+/// its field path and line.
+#[test]
+fn the_arc_turn_cap_is_optional_and_checked() {
+    let src = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/axel.toml")).unwrap();
+    let gains = |p: &Profile| p.behavior.two_arc.expect("two-arc gains");
+    let shipped = Profile::parse(&src, Path::new("axel.toml")).expect("the shipped profile");
+    assert_eq!(gains(&shipped).max_arc_turn_deg, None);
+    let with = |cap: &str| {
+        src.replace(
+            "arc_speed_mps = 0.08",
+            &format!("arc_speed_mps = 0.08\nmax_arc_turn_deg = {cap}"),
+        )
+    };
+    assert!(with("1").len() > src.len(), "the profile's arc_speed_mps line moved");
+    let capped = Profile::parse(&with("30.0"), Path::new("axel.toml")).expect("a 30° cap");
+    assert_eq!(gains(&capped).max_arc_turn_deg, Some(30.0));
+    let line = src.lines().position(|l| l.starts_with("arc_speed_mps")).unwrap() + 2;
+    for bad in ["0.0", "-5.0", "180.5", "nan", "inf"] {
+        let err = Profile::parse(&with(bad), Path::new("axel.toml")).expect_err(bad);
+        let p = err
+            .problems()
+            .iter()
+            .find(|p| p.path == "behavior.two_arc.max_arc_turn_deg")
+            .unwrap_or_else(|| panic!("{bad}: {:?}", err.problems()));
+        assert!(
+            p.message.contains("expected a number in (0, 180]"),
+            "{bad}: {}",
+            p.message
+        );
+        assert_eq!(p.line, Some(line), "{bad}");
+    }
+}
+
 /// The shipped profiles, sorted by name.
 fn shipped_profiles() -> Vec<std::path::PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles");

@@ -186,6 +186,13 @@ pub struct PlanParams {
     pub allow_reverse: bool,
     /// Spacing of the view check along the arcs, m.
     pub check_step_m: f64,
+    /// Largest heading change either arc may make, rad (`f64::INFINITY`: no cap). The
+    /// reel pays out at a constant rate along an arc (the paper's linear approximation
+    /// of the tether's length), and that approximation holds only for small turns: the
+    /// paper found it sufficient below 30° (seed 000 §V-F). A cap makes plans with a
+    /// sharper arc infeasible, so the approximation's error can be bounded by the plan
+    /// rather than by the turn weight alone (the tether ablation).
+    pub max_arc_turn: f64,
 }
 
 impl Default for PlanParams {
@@ -199,15 +206,25 @@ impl Default for PlanParams {
             headings: 720,
             allow_reverse: true,
             check_step_m: 0.05,
+            max_arc_turn: f64::INFINITY,
         }
+    }
+}
+
+impl PlanParams {
+    /// True when an arc turning by `turn` rad is within [`PlanParams::max_arc_turn`]
+    /// (the schemas' single-arc fallbacks check their arcs by it too).
+    pub fn turn_within_cap(&self, turn: f64) -> bool {
+        turn.abs() <= self.max_arc_turn + 1e-9
     }
 }
 
 /// Why no manoeuvre was planned.
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
 pub enum PlanError {
-    /// A pose or parameter is not finite, or `headings` is 0.
-    #[error("the start, goal or planner parameters are not finite")]
+    /// A pose or parameter is not finite, `headings` is 0, or the turn cap is not
+    /// positive.
+    #[error("the start, goal or planner parameters are not finite (or the turn cap is not positive)")]
     NonFinite,
     /// No two-arc manoeuvre within the curvature limit keeps the module in view.
     #[error("no two-arc manoeuvre within the turn limit keeps the module in view")]
@@ -289,8 +306,9 @@ fn through(from: &Pose2, goal: &Pose2, phi: f64) -> Option<TwoArc> {
 }
 
 /// The two-arc manoeuvre from `from` to `goal` (module frame) minimising distance plus
-/// weighted turning among those within the curvature limit (and forward-only unless
-/// reverse is allowed) that keep the module in view ([`keeps_in_view`]).
+/// weighted turning among those within the curvature limit and the per-arc turn cap
+/// ([`PlanParams::max_arc_turn`]), forward-only unless reverse is allowed, that keep the
+/// module in view ([`keeps_in_view`]).
 ///
 /// # Errors
 /// [`PlanError::NonFinite`] for non-finite input, [`PlanError::Infeasible`] when no
@@ -303,16 +321,21 @@ pub fn plan(from: &Pose2, goal: &Pose2, params: &PlanParams) -> Result<TwoArc, P
         && params.fov_half_angle.is_finite()
         && params.view_margin_rad.is_finite()
         && !params.max_range_m.is_nan()
-        && params.check_step_m.is_finite();
+        && params.check_step_m.is_finite()
+        && params.max_arc_turn > 0.0;
     if !finite || params.headings == 0 {
         return Err(PlanError::NonFinite);
     }
     let kmax = 1.0 / params.min_radius_m.max(1e-6);
     // A candidate's cost, before the view check (`None`: no such manoeuvre, or beyond
-    // the curvature limit, or reversing when that is not allowed).
+    // the curvature limit or the turn cap, or reversing when that is not allowed).
     let candidate = |phi: f64| -> Option<(f64, TwoArc)> {
         let cand = through(from, goal, phi)?;
-        if cand.arcs.iter().any(|a| a.curvature.abs() > kmax + 1e-9) {
+        if cand
+            .arcs
+            .iter()
+            .any(|a| a.curvature.abs() > kmax + 1e-9 || !params.turn_within_cap(a.turn()))
+        {
             return None;
         }
         if !params.allow_reverse && cand.arcs.iter().any(|a| a.length < 0.0) {
@@ -551,6 +574,61 @@ mod tests {
         assert!(keeps_in_view(&back, &edge, &params));
     }
 
+    #[test]
+    fn the_turn_cap_refuses_sharper_arcs() {
+        // A quarter turn: two arcs within a 30° cap change the heading by at most 60°, so
+        // the goal is reachable without the cap and infeasible under it.
+        let from = Pose2::new(0.0, 0.0, 0.0);
+        let goal = Pose2::new(2.0, 2.0, PI / 2.0);
+        let open = PlanParams {
+            fov_half_angle: PI,
+            ..PlanParams::default()
+        };
+        let p = plan(&from, &goal, &open).expect("a plan without the cap");
+        assert!(close(&p.end(&from), &goal), "{p:?}");
+        assert!(p.arcs.iter().any(|a| a.turn().abs() > 30f64.to_radians()), "{p:?}");
+        let capped = PlanParams {
+            max_arc_turn: 30f64.to_radians(),
+            ..open
+        };
+        assert_eq!(plan(&from, &goal, &capped), Err(PlanError::Infeasible));
+        // A 50° change, split by the cap: each arc within 30°, the goal reached.
+        let made = TwoArc {
+            arcs: [
+                Arc {
+                    curvature: 0.5,
+                    length: 25f64.to_radians() / 0.5,
+                },
+                Arc {
+                    curvature: 0.4,
+                    length: 25f64.to_radians() / 0.4,
+                },
+            ],
+        };
+        let goal = made.end(&from);
+        let p = plan(&from, &goal, &capped).expect("a plan within the cap");
+        assert!(close(&p.end(&from), &goal), "{p:?}");
+        assert!(
+            p.arcs.iter().all(|a| a.turn().abs() <= 30f64.to_radians() + 1e-9),
+            "{p:?}"
+        );
+        // The uncapped optimum of this goal turns one arc by more than 30° (a single arc
+        // of 50°), so the cap changed the plan rather than agreeing with it.
+        let free = plan(&from, &goal, &open).expect("a plan");
+        assert!(
+            free.arcs.iter().any(|a| a.turn().abs() > 30f64.to_radians()),
+            "{free:?}"
+        );
+        // A cap that is not positive, or NaN, is refused as a parameter.
+        for bad in [0.0, -1.0, f64::NAN] {
+            let params = PlanParams {
+                max_arc_turn: bad,
+                ..open
+            };
+            assert_eq!(plan(&from, &goal, &params), Err(PlanError::NonFinite));
+        }
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(64))]
 
@@ -577,6 +655,34 @@ mod tests {
             }
             let cost = |t: &TwoArc| t.distance() + params.turn_weight_m_per_rad * t.turning();
             prop_assert!(cost(&p) <= 1.05 * cost(&made) + 0.1, "{} > {}", cost(&p), cost(&made));
+        }
+
+        /// With a 30° cap every arc of every plan turns by at most 30°; goals made by two
+        /// arcs of at most 25° each are still reached (the cap removes only sharper arcs).
+        #[test]
+        fn capped_plans_keep_every_arc_within_the_cap(
+            x in -3.0f64..3.0, y in -3.0f64..3.0, th in -PI..PI,
+            k1 in -1.9f64..1.9, s1 in -3.0f64..3.0, k2 in -1.9f64..1.9, s2 in -3.0f64..3.0,
+        ) {
+            let from = Pose2::new(x, y, th);
+            let made = TwoArc { arcs: [Arc { curvature: k1, length: s1 }, Arc { curvature: k2, length: s2 }] };
+            prop_assume!((k1 * s1).abs() < 3.0 && (k2 * s2).abs() < 3.0);
+            let goal = made.end(&from);
+            let cap = 30f64.to_radians();
+            let params = PlanParams { fov_half_angle: PI, max_arc_turn: cap, ..PlanParams::default() };
+            let within = made.arcs.iter().all(|a| a.turn().abs() <= 25f64.to_radians());
+            match plan(&from, &goal, &params) {
+                Ok(p) => {
+                    prop_assert!(close(&p.end(&from), &goal), "{p:?} ends at {:?}", p.end(&from));
+                    for arc in &p.arcs {
+                        prop_assert!(arc.turn().abs() <= cap + 1e-9, "{p:?}");
+                    }
+                }
+                Err(e) => {
+                    prop_assert_eq!(e, PlanError::Infeasible);
+                    prop_assert!(!within, "{from:?} → {goal:?} made by {made:?} within 25°");
+                }
+            }
         }
     }
 }

@@ -208,6 +208,12 @@ pub struct TwoArcGains {
     pub reel_in_m: f64,
     /// Speed along arcs, m/s.
     pub arc_speed_mps: f64,
+    /// Largest heading change of any one planned arc, degrees; absent: no cap. The reel
+    /// pays out at a constant rate along each arc, the paper's linear approximation of
+    /// the tether's length, which it found sufficient below 30° (seed 000 §V-F); a cap
+    /// keeps every arc in that range (`axel-arc-cap` measures it against none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_arc_turn_deg: Option<f64>,
 }
 
 /// The `[behavior]` table.
@@ -410,6 +416,13 @@ pub(crate) fn validate_behavior(b: &BehaviorSpec, v: &mut Validator<'_>) {
                 );
                 v.positive("behavior.two_arc.reel_in_m", g.reel_in_m);
                 v.positive("behavior.two_arc.arc_speed_mps", g.arc_speed_mps);
+                if let Some(cap) = g.max_arc_turn_deg {
+                    v.require(
+                        cap.is_finite() && cap > 0.0 && cap <= 180.0,
+                        "behavior.two_arc.max_arc_turn_deg",
+                        || format!("expected a number in (0, 180], got {cap}"),
+                    );
+                }
             }
         },
         ApproachKind::None => {}

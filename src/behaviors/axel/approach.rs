@@ -62,8 +62,11 @@ pub(super) fn one_step(arcs: &[Arc; 2], step: f64) -> Arc {
 }
 
 /// The single arc from `pose` through the axis point (`x`, 0), cut at `step` m: `None`
-/// when the point is not ahead.
-fn toward(pose: &Pose2, x: f64, step: f64) -> Option<Arc> {
+/// when the point is not ahead, or when the whole arc to it turns by more than the
+/// planner's per-arc cap (`params`): the fallback obeys the cap the two-arc plans obey,
+/// judged like them on the whole arc rather than the step cut from it, so a capped
+/// campaign never drives an arc planned sharper than the cap.
+fn toward(pose: &Pose2, x: f64, step: f64, params: &PlanParams) -> Option<Arc> {
     let (lx, ly) = pose.to_local(x, 0.0);
     if lx <= 0.0 {
         return None;
@@ -71,6 +74,9 @@ fn toward(pose: &Pose2, x: f64, step: f64) -> Option<Arc> {
     let d2 = lx * lx + ly * ly;
     let curvature = 2.0 * ly / d2;
     let turn = 2.0 * ly.atan2(lx);
+    if !params.turn_within_cap(turn) {
+        return None;
+    }
     let length = if curvature.abs() < 1e-9 {
         d2.sqrt()
     } else {
@@ -89,7 +95,9 @@ fn toward(pose: &Pose2, x: f64, step: f64) -> Option<Arc> {
 /// else a straight step, at most `step` m and no longer than keeps the module in view
 /// (`params`); with no room even for 5 cm, face the module. Holding the bearing at B
 /// sweeps α by tan B · ln(r₀/r₁) (a log spiral), so the rover reaches the axis's
-/// neighbourhood at a radius from which an S to the axis keeps the view.
+/// neighbourhood at a radius from which an S to the axis keeps the view. Its straights
+/// turn by nothing and its turns are pivots in place, not arcs, so a per-arc turn cap
+/// ([`PlanParams::max_arc_turn`]) never binds it.
 pub(super) fn spiral(pose: &Pose2, spiral: f64, step: f64, params: &PlanParams) -> Decision {
     let polar = Polar::from_pose(pose);
     let want = -polar.alpha.signum() * spiral.min(params.fov_half_angle - params.view_margin_rad);
@@ -170,9 +178,9 @@ impl Behavior for Approach {
                     },
                     // No two-arc plan keeps the module in view (square to the axis far to
                     // the side, the S would turn it out): one arc toward the entry point,
-                    // whatever the heading it ends in, if that keeps it; otherwise face the
-                    // module and look again.
-                    None => match toward(&s.pose, entry, p.step_m) {
+                    // whatever the heading it ends in, if that keeps it and turns within the
+                    // cap; otherwise face the module and look again.
+                    None => match toward(&s.pose, entry, p.step_m, &params) {
                         Some(arc)
                             if keeps_in_view(
                                 &TwoArc {
@@ -190,5 +198,31 @@ impl Behavior for Approach {
             },
             |_, _| None,
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_single_arc_fallback_obeys_the_turn_cap() {
+        // Heading −y, 1 m off the axis at 4 m: the entry (2.5 m on the axis) lies 1 m
+        // ahead and 1.5 m to the right, and the arc through it turns by
+        // 2·atan2(1.5, 1) ≈ 113°, beyond a 30° cap.
+        let pose = Pose2::new(4.0, 1.0, -PI / 2.0);
+        let open = PlanParams::default();
+        let arc = toward(&pose, 2.5, 1.5, &open).expect("the point is ahead");
+        assert!((arc.length - 1.5).abs() < 1e-12 && arc.curvature < 0.0, "{arc:?}");
+        let capped = PlanParams {
+            max_arc_turn: 30f64.to_radians(),
+            ..open
+        };
+        assert_eq!(toward(&pose, 2.5, 1.5, &capped), None);
+        // 2 m off the axis at 3 m, the same heading: the entry lies 2 m ahead and 0.5 m
+        // to the right, a turn of 2·atan2(0.5, 2) ≈ 28°, within the cap.
+        let near = Pose2::new(3.0, 2.0, -PI / 2.0);
+        assert_eq!(toward(&near, 2.5, 1.5, &capped), toward(&near, 2.5, 1.5, &open));
+        assert!(toward(&near, 2.5, 1.5, &capped).is_some());
     }
 }

@@ -128,7 +128,8 @@ pub struct Geometry {
     pub regions: Regions,
     /// The tether's anchor and the arm (`[tether]`).
     pub tether: TetherGeometry,
-    /// The planner's limits; the field of view is the cameras'.
+    /// The planner's limits; the field of view is the cameras', the per-arc turn cap
+    /// `behavior.two_arc.max_arc_turn_deg` (none when absent).
     pub plan: PlanParams,
     /// Speed along arcs, m/s (`behavior.two_arc.arc_speed_mps`).
     pub arc_speed: f64,
@@ -176,6 +177,7 @@ impl Geometry {
             tether: TetherGeometry::new(tether.anchor_depth_m, tether.arm_m),
             plan: PlanParams {
                 fov_half_angle,
+                max_arc_turn: gains.max_arc_turn_deg.map_or(f64::INFINITY, f64::to_radians),
                 ..PlanParams::default()
             },
             arc_speed: gains.arc_speed_mps,
