@@ -165,34 +165,22 @@ pub(super) fn paint(c: NamedColor) -> [f32; 3] {
 /// # Errors
 /// [`SimError::Unsupported`] for a fiducial kind the simulator cannot build yet.
 pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbImage>]) -> Result<World, SimError> {
-    build_covering(profile, clutter, backdrops, &[])
+    build_face(profile, clutter, backdrops, &[], &[])
 }
 
-/// [`build`], with the circle marks `covered` (indices into `[fiducial.circles]
-/// .placements`) covered flush with a patch of the face's paint: the module keeps its
-/// size and the other marks, and those are not painted (`marsupial pose-trials`'
-/// occlusion campaign hides marks this way; a panel held in front of a mark would be
-/// drawn behind the face, since the renderer orders primitives by their centres'
-/// distance).
+/// [`build`], with the module's face edited for `marsupial pose-trials`' occlusion
+/// campaigns (ignored by a profile without `[fiducial.circles]`):
+/// * the circle marks `covered` (indices into `[fiducial.circles].placements`) are covered
+///   flush with a patch of the face's paint: the module keeps its size and the other
+///   marks, and those are not painted;
+/// * `painted` false marks are painted on the face among the real ones: circle marks of
+///   the layout's size and pattern at those face positions (`y_m` across the face, `z_m`
+///   above the ground) and rotations, which the module's model does not have. It is the
+///   hard case for the correspondence (seed 000 §V-D: four true marks and one false one
+///   fit a homography exactly).
 ///
-/// # Errors
-/// As [`build`].
-pub fn build_covering(
-    profile: &Profile,
-    clutter: &[ClutterSpec],
-    backdrops: &[Arc<RgbImage>],
-    covered: &[usize],
-) -> Result<World, SimError> {
-    build_face(profile, clutter, backdrops, covered, &[])
-}
-
-/// [`build_covering`], with `painted` false marks painted on the module's face among the
-/// real ones: circle marks of the layout's size and pattern at those face positions
-/// (`y_m` across the face, `z_m` above the ground) and rotations, which the module's model
-/// does not have. It is the hard case for the correspondence (seed 000 §V-D: four true
-/// marks and one false one fit a homography exactly); a panel held in front of the face
-/// would be lost behind it (see [`build_covering`]). A profile without
-/// `[fiducial.circles]` ignores `painted`.
+/// Both are painted by the face because a panel held in front of it would be drawn
+/// behind it: the renderer orders primitives by their centres' distance.
 ///
 /// # Errors
 /// As [`build`].

@@ -39,7 +39,7 @@ pub struct PoseGrid {
 pub struct OcclusionSpec {
     /// How many marks each run hides (an axis): which ones is drawn per run. A hidden
     /// mark is covered flush with a patch of the face's grey
-    /// ([`world::build_covering`](crate::sim::world::build_covering)). A panel held in
+    /// ([`world::build_face`](crate::sim::world::build_face)). A panel held in
     /// front of it would be more physical, but the renderer draws front to back by each
     /// primitive's centre distance, so a small panel before the large face is lost
     /// wherever its centre lies farther from the camera than the face's.

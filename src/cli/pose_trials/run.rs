@@ -115,30 +115,28 @@ impl Context<'_> {
     fn world(&self, hidden: &[usize], decoy: bool) -> Result<world::World, SimError> {
         let mut clutter = Vec::new();
         let mut painted = Vec::new();
-        if let Some(o) = &self.campaign.occlusion
-            && decoy
-        {
-            {
-                for d in &o.decoys {
-                    if d.painted {
-                        painted.push(CirclePlacement {
-                            y_m: d.at_m[1],
-                            z_m: d.at_m[2],
-                            rotation_deg: d.rotation_deg,
-                        });
-                        continue;
-                    }
-                    clutter.push(ClutterSpec {
-                        kind: ClutterKind::CircleMark,
-                        x_m: d.at_m[0],
-                        y_m: d.at_m[1],
-                        z_m: d.at_m[2],
-                        size_m: vec![d.panel_m, d.panel_m],
-                        color: None,
-                        facing_deg: 0.0,
-                        mark_rotation_deg: d.rotation_deg,
-                    });
-                }
+        let decoys = match &self.campaign.occlusion {
+            Some(o) if decoy => o.decoys.as_slice(),
+            _ => &[],
+        };
+        for d in decoys {
+            if d.painted {
+                painted.push(CirclePlacement {
+                    y_m: d.at_m[1],
+                    z_m: d.at_m[2],
+                    rotation_deg: d.rotation_deg,
+                });
+            } else {
+                clutter.push(ClutterSpec {
+                    kind: ClutterKind::CircleMark,
+                    x_m: d.at_m[0],
+                    y_m: d.at_m[1],
+                    z_m: d.at_m[2],
+                    size_m: vec![d.panel_m, d.panel_m],
+                    color: None,
+                    facing_deg: 0.0,
+                    mark_rotation_deg: d.rotation_deg,
+                });
             }
         }
         world::build_face(self.profile, &clutter, &[], hidden, &painted)

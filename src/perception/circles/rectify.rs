@@ -7,8 +7,8 @@
 //! the view, more than the closeness gate (0.3 of a mark's projected radius). With 6 or
 //! more marks the trimmed refit absorbs that, but with exactly 5 (3 covered) the fit has
 //! 2 redundant degrees of freedom, the bend pushes one mark out of its gate, and the
-//! frame is refused: 10 of the 36 five-mark frames of `axel-occlusion` were, every one a
-//! labelling that the same marks give without the distortion.
+//! frame is refused: 10 of the 36 five-mark frames of `axel-occlusion` were, and all 36
+//! are labelled through the lens (README, "axel-occlusion").
 //!
 //! [`LensPlane`] maps each detection's centre through the camera's model to its ray and
 //! back through the model's distortion-free pin-hole ([`CameraModel::ideal_pinhole`]),
@@ -48,11 +48,6 @@ impl LensPlane {
             camera,
             marks: Vec::with_capacity(MAX_DETECTIONS),
         }
-    }
-
-    /// The camera whose distortion this plane removes.
-    pub fn camera(&self) -> &CameraModel {
-        &self.camera
     }
 
     /// Image pixel → ideal pin-hole pixel, or `None` for a ray the pin-hole cannot show
