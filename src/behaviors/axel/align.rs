@@ -6,7 +6,11 @@
 //! checks the alignment: the heading within `behavior.two_arc.heading_tolerance_deg`
 //! (±5°, §V-B) and the gate of `[success]` (the tip's lateral offset and the arm's angle
 //! to the cone's axis); aligned, it commits to mating (event `aligned`, the pose kept in
-//! [`Memory::commit`]). With no plan farther out than `spiral_beyond_m` beyond the look
+//! [`Memory::commit`]). A plan is finished before it is judged: one step drives one arc,
+//! and a plan whose first arc runs nearly straight to the look pose leaves its turn to a
+//! short second arc, so the rover can stand inside the arrival circle with the turn still
+//! to make. Misaligned there, it plans again from where it stands and drives that (at most
+//! `finish_steps` times per arrival) before it reverses. With no plan farther out than `spiral_beyond_m` beyond the look
 //! pose it spirals in toward the axis (the approach's spiral). Misaligned at the look
 //! pose, past it (also when only an untrusted pose says so: nearer than the look pose one
 //! camera loses the marks), or with no plan within the turn limit closer in, it reverses `reverse_m` (paying the tether out) and retries; after
@@ -53,6 +57,12 @@ pub struct AlignParams {
     pub spiral_beyond_m: f64,
     /// The module's bearing the spiral holds, degrees.
     pub spiral_deg: f64,
+    /// Misaligned inside the arrival circle, plan again and drive at most this many steps
+    /// before reversing (0: reverse at once). Replayed: axel-field run 3 and
+    /// axel-lighting run 5 stood 5–6 cm from the look pose, 5–8° off, with the plan's
+    /// turning arc not yet driven, and reversed three times straight back (keeping the
+    /// error) until the retries ran out.
+    pub finish_steps: u32,
 }
 
 impl Default for AlignParams {
@@ -69,6 +79,7 @@ impl Default for AlignParams {
             view: ViewLimits::default(),
             spiral_beyond_m: 0.5,
             spiral_deg: 30.0,
+            finish_steps: 2,
         }
     }
 }
@@ -79,6 +90,9 @@ pub struct Align {
     mem: Blackboard<Memory>,
     params: AlignParams,
     cycle: Cycle,
+    /// Steps driven to finish a plan inside the arrival circle since the rover last
+    /// arrived there.
+    finishing: u32,
 }
 
 impl Align {
@@ -89,20 +103,37 @@ impl Align {
             mem,
             params,
             cycle: Cycle::new(params.cycle, params.trust),
+            finishing: 0,
         }
     }
 }
 
 /// Whether the rover at module-frame `pose` may commit to mating: its heading within
-/// `heading_tolerance` of the axis, and the arm's tip within `gate_lateral` of the axis
-/// with the arm within `gate_heading` of it.
+/// `heading_tolerance` of the axis, the arm within `gate_heading` of it, and the arm's
+/// tip within `gate_lateral` of the axis **where it will meet the mouth**: mating drives
+/// blind and straight, so the tip's offset is carried along the heading to the mouth's
+/// plane (x = 0). Judged at the look pose alone, a tip 4 cm aside and 5° off (both
+/// within) meets the mouth 9 cm aside, outside the cone's capture: axel-field run 31
+/// committed so and stalled at the cone (`stuck_contact`).
 pub fn aligned(pose: &Pose2, arm: f64, heading_tolerance: f64, gate_lateral: f64, gate_heading: f64) -> bool {
     let h = wrap_angle(pose.theta - PI).abs();
-    let tip = pose.to_world(arm, 0.0);
-    h <= heading_tolerance && h <= gate_heading && tip.1.abs() <= gate_lateral
+    h <= heading_tolerance && h <= gate_heading && tip_at_mouth(pose, arm).abs() <= gate_lateral
 }
 
-fn decide(m: &mut Memory, p: &AlignParams, s: Sighting) -> Decision {
+/// The arm's tip's lateral offset from the axis (module frame y) once a straight drive
+/// along `pose`'s heading brings it to the mouth's plane; the tip's own offset when it is
+/// already there or the rover does not face the module.
+fn tip_at_mouth(pose: &Pose2, arm: f64) -> f64 {
+    let (tx, ty) = pose.to_world(arm, 0.0);
+    let (c, s) = (pose.theta.cos(), pose.theta.sin());
+    if tx <= 0.0 || c >= -1e-6 {
+        return ty;
+    }
+    // Along (c, s) until x = 0: t = tx / −c.
+    ty + tx / -c * s
+}
+
+fn decide(m: &mut Memory, p: &AlignParams, finishing: &mut u32, s: Sighting) -> Decision {
     let g = m.geometry;
     let polar = Polar::from_pose(&s.pose);
     if polar.r > g.regions.alignment_radius + p.far_margin_m {
@@ -124,10 +155,19 @@ fn decide(m: &mut Memory, p: &AlignParams, s: Sighting) -> Decision {
         return Decision::Event("aligned");
     }
     let params = p.view.plan_params(&g.plan);
-    let planned = if at_look || past {
-        None
+    // Inside the arrival circle a plan is driven only to finish a turn (bounded); outside
+    // it, the count starts over.
+    let may_plan = if at_look {
+        *finishing += 1;
+        *finishing <= p.finish_steps
     } else {
+        *finishing = 0;
+        !past
+    };
+    let planned = if may_plan {
         plan(&s.pose, &look, &params).ok()
+    } else {
+        None
     };
     match planned {
         Some(pl) => Decision::Arc {
@@ -188,16 +228,18 @@ impl Behavior for Align {
 
     fn enter(&mut self, inputs: &Inputs<'_>) {
         self.cycle.begin(inputs.now);
+        self.finishing = 0;
     }
 
     fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
         let mut m = self.mem.lock();
         let p = self.params;
+        let finishing = &mut self.finishing;
         Some(self.cycle.tick_seeing(
             &mut m,
             "align",
             p.lost_looks,
-            |m, s| decide(m, &p, s),
+            |m, s| decide(m, &p, finishing, s),
             |m, s| past_unseen(m, &p, s),
         ))
     }
@@ -222,6 +264,77 @@ mod tests {
         // 3° off, axle 4 cm aside, tip pointing back at the axis: within.
         let converging = Pose2::new(1.05, 0.04, PI + 3f64.to_radians());
         assert!(aligned(&converging, arm, d5, 0.05, d5));
+        // axel-field run 31's commitment: 0.4 cm aside, 5.0° off, the tip 4.4 cm aside
+        // and heading away from the axis: it would meet the mouth 9 cm aside.
+        let diverging = Pose2::new(1.12, 0.0037, PI + 4.99f64.to_radians());
+        assert!(!aligned(&diverging, arm, d5, 0.05, d5));
+        assert!((tip_at_mouth(&diverging, arm) + 0.094).abs() < 0.003);
+        // The same offsets mirrored, converging: the tip meets the mouth on the axis.
+        let mirrored = Pose2::new(1.12, 0.094, PI + 4.99f64.to_radians());
+        assert!(aligned(&mirrored, arm, d5, 0.05, d5));
+    }
+
+    fn axel_memory() -> Memory {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/profiles/axel.toml");
+        let profile = crate::profile::Profile::load(std::path::Path::new(path)).expect("axel profile");
+        Memory::from_profile(&profile).expect("memory")
+    }
+
+    fn stereo(pose: Pose2) -> Sighting {
+        Sighting {
+            t: 0.0,
+            pose,
+            source: crate::perception::circles::PoseSource::Stereo,
+            marks: 8,
+            reprojection_px: 0.03,
+            residual_m: 0.001,
+        }
+    }
+
+    #[test]
+    fn a_turn_left_undone_inside_the_arrival_circle_is_finished_before_reversing() {
+        // axel-field run 3: 5–6 cm short of the look pose on the axis, 7° off.
+        let mut m = axel_memory();
+        let p = AlignParams::default();
+        let look_x = m.geometry.tether.arm + p.look_m;
+        for (dx, dy, deg) in [(0.055, 0.003, 7.0), (0.05, -0.004, -6.0), (0.06, 0.0, 8.0)] {
+            let start = Pose2::new(look_x + dx, dy, PI + f64::to_radians(deg));
+            assert!(!aligned(
+                &start,
+                m.geometry.tether.arm,
+                m.geometry.heading_tolerance,
+                m.geometry.gate_lateral,
+                m.geometry.gate_heading
+            ));
+            let mut finishing = 0;
+            let mut pose = start;
+            // Driving what it plans (exactly, as if no slip) brings it into the gate
+            // within the budget, with no retry spent.
+            let mut committed = false;
+            for _ in 0..=p.finish_steps {
+                match decide(&mut m, &p, &mut finishing, stereo(pose)) {
+                    Decision::Arc { arc, from } => pose = arc.end(&from),
+                    Decision::Event("aligned") => {
+                        committed = true;
+                        break;
+                    }
+                    d => panic!("{start:?}: expected a finishing arc, got {d:?}"),
+                }
+            }
+            assert!(committed, "{start:?} ended at {pose:?}");
+            assert_eq!(m.retries, 0);
+        }
+        // With the budget spent, a misaligned arrival reverses and spends a retry.
+        let start = Pose2::new(look_x + 0.05, 0.0, PI + 7f64.to_radians());
+        let mut finishing = p.finish_steps;
+        match decide(&mut m, &p, &mut finishing, stereo(start)) {
+            Decision::Arc { arc, .. } => assert_eq!((arc.curvature, arc.length), (0.0, -p.reverse_m)),
+            d => panic!("expected a reverse, got {d:?}"),
+        }
+        assert_eq!(m.retries, 1);
+        // Leaving the arrival circle starts the count over.
+        let _ = decide(&mut m, &p, &mut finishing, stereo(Pose2::new(look_x + 0.4, 0.0, PI)));
+        assert_eq!(finishing, 0);
     }
 
     #[test]
