@@ -29,6 +29,7 @@ use super::record::RecordOptions;
 use super::robot::SimDevices;
 pub use super::run::{Recording, run_one};
 use super::scenario::{Loaded, RunSpec};
+use super::tether::TetherTally;
 use super::world::{self, World};
 use crate::behaviors::BuildError;
 use crate::perception::RgbImage;
@@ -95,6 +96,10 @@ pub struct RunRecord {
     /// Alignment manoeuvres started (RAPOSA's region-II iterations).
     #[serde(default)]
     pub manoeuvres: u32,
+    /// The tether's largest slack, tension and reel current over the docking, from the
+    /// simulator's truth (robots with a tether; absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tether: Option<TetherTally>,
     /// The run's lighting draw, when its lighting is a `[lighting_random.NAME]`
     /// distribution (absent otherwise).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -14,7 +14,7 @@ use super::lighting::{LightState, LightingRun, ShadowBand};
 use super::motion::Motion;
 use super::render::{CameraMotion, Renderer, SensorParams};
 use super::rng::Rng;
-use super::tether::Tether;
+use super::tether::{Tether, TetherTally};
 use super::world::World;
 use crate::geometry::Pose2;
 use crate::kinematics::Odometry;
@@ -117,6 +117,8 @@ pub struct Sim {
     /// The dock has let go ([`Sim::release`]): contact with the dock's socket does not
     /// hold or judge the robot until it is clear of the dock.
     releasing: bool,
+    /// The tether's extremes this mission ([`Sim::tether_tally`]).
+    tally: TetherTally,
 }
 
 /// Ticks of pose history kept for `camera_late` frames.
@@ -204,6 +206,7 @@ impl Sim {
             past: VecDeque::with_capacity(PAST_CAPACITY),
             mission_start: 0.0,
             releasing: false,
+            tally: TetherTally::default(),
         }
     }
 
@@ -350,6 +353,7 @@ impl Sim {
         self.past.clear();
         self.mission_start = 0.0;
         self.releasing = false;
+        self.tally = TetherTally::default();
         let last = self.motion.encoders();
         self.encoder_ref = (last.left, last.right);
         if let Some(t) = &mut self.tether {
@@ -372,6 +376,7 @@ impl Sim {
         self.safe_stops = 0;
         self.stale_motion_ticks = 0;
         self.docked = false;
+        self.tally = TetherTally::default();
     }
 
     /// Time since the current mission began, s ([`Sim::place`] or [`Sim::begin_leg`]).
@@ -548,6 +553,12 @@ impl Sim {
         self.tether.map(|t| t.reading())
     }
 
+    /// The tether's largest slack, tension and reel current since the mission began
+    /// (`None` without a tether).
+    pub fn tether_tally(&self) -> Option<TetherTally> {
+        self.tether.map(|_| self.tally)
+    }
+
     /// Queues a drive command on the motors (counting command changes).
     pub fn command_drive(&mut self, drive: DriveCommand) {
         if drive != self.last_drive && !(drive.is_stop() && self.last_drive.is_stop()) {
@@ -622,6 +633,7 @@ impl Sim {
                 } else {
                     to = pulled;
                 }
+                self.tally.observe(t, &to, self.t + dt - self.mission_start);
             }
             if let Some(obstacle) = self.world.obstacles.entered(&from, &to, length, width) {
                 self.motion.halt();

@@ -484,6 +484,7 @@ pub(super) fn record(spec: &RunSpec, sim: &Sim, end: PhaseEnd, imprinted: Option
         safe_stops: sim.safe_stops,
         imprinted,
         manoeuvres,
+        tether: sim.tether_tally(),
         track: sim
             .track
             .iter()

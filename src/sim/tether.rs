@@ -19,6 +19,7 @@
 
 use crate::geometry::{Pose2, wrap_angle};
 use crate::schemas::{TetherCommand, TetherReading};
+use serde::{Deserialize, Serialize};
 
 /// Tether stiffness, N per metre stretched (our estimate).
 const STIFFNESS_N_PER_M: f64 = 500.0;
@@ -114,6 +115,12 @@ impl Tether {
     /// reports it).
     pub fn tension(&self) -> f64 {
         self.tension
+    }
+
+    /// Tether paid out beyond the straight line from its attachment to the anchor with
+    /// the robot at `pose`, m: what lies slack on the ground (0 when taut).
+    pub fn slack(&self, pose: &Pose2) -> f64 {
+        (self.length - self.distance(pose)).max(0.0)
     }
 
     /// True when a leading arm's taut tether, on its way from the tip to the anchor, runs
@@ -250,6 +257,36 @@ fn segment_hits_box(a: (f64, f64), b: (f64, f64), hx: f64, hy: f64) -> bool {
     true
 }
 
+/// The tether's extremes over one mission, from the simulator's truth (a run's record:
+/// `runs.jsonl`'s `tether`). The behavior never sees them: it reads the reel's length
+/// and current alone.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct TetherTally {
+    /// Largest slack, m ([`Tether::slack`]): whether reeling by the change of length kept
+    /// the tether off the ground.
+    pub max_slack_m: f64,
+    /// When the slack was largest, s from the mission's start (0 with none): where to
+    /// look in a replay.
+    pub max_slack_at_s: f64,
+    /// Highest tension, N.
+    pub peak_tension_n: f64,
+    /// Highest reel motor current the sensor read, A (the stall guard's input).
+    pub peak_current_a: f64,
+}
+
+impl TetherTally {
+    /// Takes in the tether's state with the robot at `pose`, `t` s into the mission.
+    pub fn observe(&mut self, tether: &Tether, pose: &Pose2, t: f64) {
+        let slack = tether.slack(pose);
+        if slack > self.max_slack_m {
+            self.max_slack_m = slack;
+            self.max_slack_at_s = t;
+        }
+        self.peak_tension_n = self.peak_tension_n.max(tether.tension());
+        self.peak_current_a = self.peak_current_a.max(tether.reading().motor_current_a);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -376,5 +413,39 @@ mod tests {
         }
         let i = t.reading().motor_current_a;
         assert!((i - STALL_CURRENT_A).abs() < 1e-6, "{i}");
+    }
+
+    #[test]
+    fn the_tally_keeps_the_largest_slack_tension_and_current() {
+        let mut t = Tether::with_arm((-0.25, 0.0), 0.0, 50.0, 0.05, 0.5);
+        let far = Pose2::new(2.0, 0.0, std::f64::consts::PI);
+        t.length = t.distance(&far);
+        let mut tally = TetherTally::default();
+        tally.observe(&t, &far, 0.0);
+        assert_eq!(tally, TetherTally::default(), "taut and idle: nothing to tally");
+        // Driven 0.3 m in without reeling: 0.3 m lies slack.
+        let near = Pose2::new(1.7, 0.0, std::f64::consts::PI);
+        t.step(0.02, &near, None);
+        tally.observe(&t, &near, 1.0);
+        assert!((tally.max_slack_m - 0.3).abs() < 1e-9, "{tally:?}");
+        // Wheels locked, reeling: the slack is taken up, then the reel pulls to its stall.
+        for _ in 0..1000 {
+            t.step(
+                0.02,
+                &near,
+                Some(TetherCommand {
+                    reel_rate: 0.05,
+                    free_wheel: false,
+                }),
+            );
+            tally.observe(&t, &near, 2.0);
+        }
+        assert!(
+            (tally.max_slack_m - 0.3).abs() < 1e-9,
+            "the largest slack is kept: {tally:?}"
+        );
+        assert!((tally.peak_current_a - STALL_CURRENT_A).abs() < 1e-6, "{tally:?}");
+        assert!(tally.peak_tension_n > 0.0);
+        assert_eq!(t.slack(&near), 0.0);
     }
 }
