@@ -10,7 +10,9 @@
 //!
 //! As in the paper, the reel follows each arc by the change of length between its ends,
 //! at a constant rate over the arc's duration (the linear approximation the paper found
-//! sufficient for turns under about 30°, §V-F); [`TetherGeometry::length_at`] gives the
+//! sufficient for turns under about 30°, §V-F). Ours also closes the loop on the reel's
+//! own length reading at the arc's start ([`TetherGeometry::pay_out_along`]), so slack
+//! from slip or a turn in place does not accumulate from step to step; [`TetherGeometry::length_at`] gives the
 //! instantaneous length for finer control. Polar coordinates here are about the anchor,
 //! not the mouth: the tether pulls toward the anchor.
 
@@ -80,15 +82,27 @@ impl TetherGeometry {
             .fold(0.0, f64::max)
     }
 
-    /// The reel rate (m/s, positive reels in) that follows `arc` from `from` driven at
-    /// `speed` m/s: the change of length over the arc's duration, the paper's linear
-    /// approximation. 0 for an arc of no length or a non-positive speed.
-    pub fn reel_rate(&self, from: &Pose2, arc: &Arc, speed: f64) -> f64 {
+    /// The tether to pay out over `arc` from `from`, m (negative: reel in), so that it
+    /// ends the arc just taut: the exposed length at the arc's end less what the reel
+    /// has paid out at its start (`paid_out`, the reel's own length reading). That is
+    /// the change of length along the arc plus whatever the reading differs from the
+    /// exposed length at the start: slack left by wheel slip on the last arc or by a
+    /// turn in place is taken up, a stretched tether eased. Without a reading, the change
+    /// along the arc alone (the paper's open-loop reel).
+    pub fn pay_out_along(&self, paid_out: Option<f64>, from: &Pose2, arc: &Arc) -> f64 {
+        let start = paid_out.unwrap_or_else(|| self.length_at(from));
+        self.length_at(&arc.end(from)) - start
+    }
+
+    /// The reel rate (m/s, positive reels in) over `arc` from `from` driven at `speed`
+    /// m/s: [`TetherGeometry::pay_out_along`] spread evenly over the arc's duration, the
+    /// paper's linear approximation. 0 for an arc of no length or a non-positive speed.
+    pub fn reel_rate(&self, paid_out: Option<f64>, from: &Pose2, arc: &Arc, speed: f64) -> f64 {
         if arc.length.abs() < 1e-9 || speed <= 0.0 {
             return 0.0;
         }
         let duration = arc.length.abs() / speed;
-        -self.change_along(from, arc) / duration
+        -self.pay_out_along(paid_out, from, arc) / duration
     }
 }
 
@@ -114,13 +128,22 @@ mod tests {
             length: 1.0,
         };
         assert!((g.change_along(&p, &arc) + 1.0).abs() < 1e-12);
-        assert!((g.reel_rate(&p, &arc, 0.08) - 0.08).abs() < 1e-12);
+        assert!((g.reel_rate(None, &p, &arc, 0.08) - 0.08).abs() < 1e-12);
         // Reversing pays out.
         let back = Arc {
             curvature: 0.0,
             length: -0.5,
         };
-        assert!((g.reel_rate(&p, &back, 0.08) + 0.08).abs() < 1e-12);
+        assert!((g.reel_rate(None, &p, &back, 0.08) + 0.08).abs() < 1e-12);
+        // With the reel's reading: 10 cm of slack at the start is taken up over the arc
+        // as well (1.1 m reeled in over 12.5 s), and a tether read 10 cm short of the
+        // exposed length (stretched) is eased (0.9 m).
+        let l = g.length_at(&p);
+        assert!((g.pay_out_along(Some(l + 0.1), &p, &arc) + 1.1).abs() < 1e-12);
+        assert!((g.reel_rate(Some(l + 0.1), &p, &arc, 0.08) - 1.1 / 12.5).abs() < 1e-12);
+        assert!((g.pay_out_along(Some(l - 0.1), &p, &arc) + 0.9).abs() < 1e-12);
+        // A reading equal to the exposed length changes nothing.
+        assert!((g.reel_rate(Some(l), &p, &back, 0.08) + 0.08).abs() < 1e-12);
     }
 
     /// The linear approximation's error against the arc's turn, over 4 000 arcs from the

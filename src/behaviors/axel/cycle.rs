@@ -1,7 +1,7 @@
 //! The sense-plan-act cycle Axel's sensing schemas share (seed 000 §II, §V-B: "stop,
 //! take images, plan, take one step"): settle stopped, look until a trusted pose arrives
 //! (or give up looking), let the schema decide, then execute ONE motion by odometry (an
-//! arc, reeling by the tether's change of length along it, or a turn in place) and start
+//! arc, reeling to the tether's exposed length at its end, or a turn in place) and start
 //! over. A rover that kept moving while it looked would plan on frames blurred by its own
 //! motion and a pose already out of date by the time it plans; the paper stopped, and so
 //! do we.
@@ -277,8 +277,9 @@ impl Cycle {
     }
 
     /// Starts driving `arc` from module-frame `from`: at the arc speed, slower where the
-    /// turn-rate limit needs it or where the reel could not keep up with the tether's
-    /// change of length, reeling at the rate that follows that change over the arc.
+    /// turn-rate limit needs it or where the reel could not keep up, reeling at the rate
+    /// that brings the reel's paid-out length to the exposed length at the arc's end
+    /// ([`crate::kinematics::tether_length::TetherGeometry::pay_out_along`]).
     fn begin_arc(&mut self, m: &mut Memory, arc: Arc, from: &Pose2, phase: &'static str) -> Step {
         let g = &m.geometry;
         let mut speed = if arc.curvature.abs() > 1e-9 {
@@ -286,15 +287,17 @@ impl Cycle {
         } else {
             g.arc_speed
         };
-        // The tether changes by |ΔL| over |s|: at `speed` the reel must turn at
-        // speed·|ΔL|/|s|, no faster than it can.
-        let per_m = g.tether.change_along(from, &arc).abs() / arc.length.abs().max(1e-9);
+        // The reel pays out |ΔL| over |s| (the change along the arc, and the slack its
+        // reading shows now): at `speed` it must turn at speed·|ΔL|/|s|, no faster than
+        // it can.
+        let paid_out = m.reel.map(|r| r.length);
+        let per_m = g.tether.pay_out_along(paid_out, from, &arc).abs() / arc.length.abs().max(1e-9);
         if per_m * speed > g.max_reel_rate {
             speed = g.max_reel_rate / per_m;
         }
         let v = speed * arc.length.signum();
         let twist = Twist::new(v, v * arc.curvature);
-        let reel = g.tether.reel_rate(from, &arc, speed);
+        let reel = g.tether.reel_rate(paid_out, from, &arc, speed);
         m.arcs += 1;
         self.state = State::Arc {
             twist,

@@ -1,7 +1,7 @@
 //! `axel.mate`: the mating (seed 000 §II, §IV). Committed at the look pose
 //! ([`Memory::commit`]), the markers now too close to identify, the rover drives blind
 //! by odometry straight in until its arm's tip is `standoff_m` from the cone's mouth,
-//! reeling in by the tether's change of length; then it puts its wheels in free rotation
+//! reeling in to the exposed length at its end (by the reel's reading); then it puts its wheels in free rotation
 //! and reels in until the reel's paid-out length is `behavior.two_arc.reel_in_m` short
 //! of the exposed length at the mouth (about 25 cm into the module, §II), the tether
 //! pulling the arm into the cone. The reel's own length reading decides, so slack left
@@ -83,7 +83,9 @@ impl Behavior for Mate {
         self.phase = Phase::Close {
             left,
             last: m.odo,
-            reel: g.tether.reel_rate(&at, &arc, self.params.speed_mps),
+            reel: g
+                .tether
+                .reel_rate(m.reel.map(|r| r.length), &at, &arc, self.params.speed_mps),
         };
     }
 
