@@ -40,12 +40,21 @@ fn docks_from_three_starts() {
     let (records, _) = campaign::run_campaign(&p, &agent_for, &Default::default()).unwrap();
     for (r, start) in records.iter().zip(starts) {
         eprintln!(
-            "start {start:?}: {} after {:.1} s, {} arcs, {:.2} m driven",
-            r.outcome, r.time_s, r.manoeuvres, r.path_m
+            "start {start:?}: {} after {:.1} s, {} arcs, {:.2} m driven, tether {:?}",
+            r.outcome, r.time_s, r.manoeuvres, r.path_m, r.tether
         );
     }
     for (r, start) in records.iter().zip(starts) {
         assert!(r.success, "start {start:?}: {} after {:.1} s", r.outcome, r.time_s);
         assert!(r.manoeuvres >= 1, "start {start:?} docked without an arc step");
+        // The reel follows every arc closed on its own reading, and takes up by its
+        // current what a turn in place or a slipping arc left: the slack never builds up
+        // (axel-field's campaign: at most 0.15 m, one reversing step's slip; the
+        // open-loop reel left up to 0.40 m there, and without the take-up the second
+        // start here left 0.30 m from its search turns), and the reel never reaches the
+        // stall guard's current.
+        let t = r.tether.expect("Axel's record has the tether's figures");
+        assert!(t.max_slack_m < 0.2, "start {start:?}: {t:?}");
+        assert!(t.peak_current_a < 1.8, "start {start:?}: {t:?}");
     }
 }

@@ -2,7 +2,8 @@
 //! take images, plan, take one step"): settle stopped, look until a trusted pose arrives
 //! (or give up looking), let the schema decide, then execute ONE motion by odometry (an
 //! arc, reeling to the tether's exposed length at its end, or a turn in place) and start
-//! over. A rover that kept moving while it looked would plan on frames blurred by its own
+//! over. Standing or turning in place, the reel takes up slack until its current says the
+//! tether is taut ([`Memory::take_up`]). A rover that kept moving while it looked would plan on frames blurred by its own
 //! motion and a pose already out of date by the time it plans; the paper stopped, and so
 //! do we.
 
@@ -161,7 +162,7 @@ impl Cycle {
                             left: angle.abs(),
                             last: m.odo.theta,
                         };
-                        m.drive(DriveCommand::Turn { omega }, 0.0, phase)
+                        m.drive(DriveCommand::Turn { omega }, m.take_up(), phase)
                     }
                     Decision::Reel(length) => self.begin_reel(m, length, phase),
                     Decision::Event(e) => {
@@ -201,7 +202,7 @@ impl Cycle {
                     left,
                     last: m.odo.theta,
                 };
-                m.drive(DriveCommand::Turn { omega }, 0.0, phase)
+                m.drive(DriveCommand::Turn { omega }, m.take_up(), phase)
             }
             State::Reel { until, deadline } => {
                 if now >= deadline || m.reel.is_none_or(|r| r.length <= until) {

@@ -25,6 +25,13 @@ use serde::Deserialize;
 /// the 0.5–1.0 A the paper's reel drew in vision-guided docking (seed 000 §V-C).
 pub const TAUT_CURRENT_A: f64 = 1.0;
 
+/// The reel's current below which a standing rover's tether counts as slack, A: a
+/// winding reel draws about 0.4 A with no load, so this is a pull of a few newtons.
+/// Lower than [`TAUT_CURRENT_A`] because the take-up ([`Memory::take_up`]) winds at the
+/// reel's top rate and reads the current once a tick: a tick's overshoot then stays
+/// within the 0.5–1.0 A the paper's reel drew (seed 000 §V-C).
+pub const SLACK_CURRENT_A: f64 = 0.7;
+
 /// One pose measurement: where the rover is in the module frame, and how good it is.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sighting {
@@ -263,16 +270,29 @@ impl Memory {
         })
     }
 
-    /// A stopped base, the reel held (neither slack nor pulling), feedback `phase`.
+    /// A stopped base with its wheels braked, the reel taking up slack
+    /// ([`Memory::take_up`]), feedback `phase`.
     pub fn hold(&self, phase: &'static str) -> Step {
         let out = MotorOutput::stop().with_aux(crate::schemas::Auxiliary {
             tether: Some(TetherCommand {
-                reel_rate: 0.0,
+                reel_rate: self.take_up(),
                 free_wheel: false,
             }),
             ..Default::default()
         });
         Step::running(out, self.feedback(phase))
+    }
+
+    /// The reel rate that takes up slack while the base stands or turns in place, m/s:
+    /// the top rate while the reel's current says the tether is slack
+    /// ([`SLACK_CURRENT_A`]), then none. A turn in place swings the arm's tip about the
+    /// axle, and an arc that slipped ends short of where the reel paid out for; with no
+    /// tension sensor and no pose during a search, the current is what tells slack from
+    /// taut (a slack tether loads the reel with its idle current alone). The braked wheels
+    /// hold the rover against the pull.
+    pub fn take_up(&self) -> f64 {
+        let taut = self.reel.is_none_or(|r| r.motor_current_a >= SLACK_CURRENT_A);
+        if taut { 0.0 } else { self.geometry.max_reel_rate }
     }
 
     /// Driving `drive` while reeling at `reel_rate` (m/s, positive in), wheels driven.
@@ -374,6 +394,35 @@ impl SharedMemory for Memory {
 mod tests {
     use super::*;
     use std::f64::consts::PI;
+
+    #[test]
+    fn the_reel_takes_up_slack_until_its_current_says_taut() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/profiles/axel.toml");
+        let profile = Profile::load(std::path::Path::new(path)).expect("axel profile");
+        let mut m = Memory::from_profile(&profile).expect("memory");
+        // No reading: nothing to judge slack by, the reel holds.
+        assert_eq!(m.take_up(), 0.0);
+        // Winding a slack tether: the idle current alone, wind at the top rate.
+        m.reel = Some(TetherReading {
+            length: 3.0,
+            motor_current_a: 0.4,
+        });
+        assert_eq!(m.take_up(), m.geometry.max_reel_rate);
+        // Taut: a few newtons on top of the idle current, stop.
+        m.reel = Some(TetherReading {
+            length: 3.0,
+            motor_current_a: SLACK_CURRENT_A,
+        });
+        assert_eq!(m.take_up(), 0.0);
+        // A stopped rover holds the reel at the take-up's rate.
+        m.reel = Some(TetherReading {
+            length: 3.0,
+            motor_current_a: 0.0,
+        });
+        let step = m.hold("test");
+        let reel = step.output.aux.tether.expect("a reel command").reel_rate;
+        assert_eq!(reel, m.geometry.max_reel_rate);
+    }
 
     #[test]
     fn dead_reckoning_carries_the_odometry_motion_into_the_module_frame() {
