@@ -12,8 +12,8 @@
 //! at a constant rate over the arc's duration (the linear approximation the paper found
 //! sufficient for turns under about 30°, §V-F). Ours also closes the loop on the reel's
 //! own length reading at the arc's start ([`TetherGeometry::pay_out_along`]), so slack
-//! from slip or a turn in place does not accumulate from step to step; [`TetherGeometry::length_at`] gives the
-//! instantaneous length for finer control. Polar coordinates here are about the anchor,
+//! from slip or a turn in place does not accumulate from step to step;
+//! [`TetherGeometry::length_at`] gives the instantaneous length for finer control. Polar coordinates here are about the anchor,
 //! not the mouth: the tether pulls toward the anchor.
 
 use super::two_arc::Arc;
@@ -90,8 +90,10 @@ impl TetherGeometry {
     /// turn in place is taken up, a stretched tether eased. Without a reading, the change
     /// along the arc alone (the paper's open-loop reel).
     pub fn pay_out_along(&self, paid_out: Option<f64>, from: &Pose2, arc: &Arc) -> f64 {
-        let start = paid_out.unwrap_or_else(|| self.length_at(from));
-        self.length_at(&arc.end(from)) - start
+        match paid_out {
+            Some(l) => self.length_at(&arc.end(from)) - l,
+            None => self.change_along(from, arc),
+        }
     }
 
     /// The reel rate (m/s, positive reels in) over `arc` from `from` driven at `speed`

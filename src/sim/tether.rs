@@ -262,8 +262,8 @@ fn segment_hits_box(a: (f64, f64), b: (f64, f64), hx: f64, hy: f64) -> bool {
 /// and current alone.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct TetherTally {
-    /// Largest slack, m ([`Tether::slack`]): whether reeling by the change of length kept
-    /// the tether off the ground.
+    /// Largest slack, m ([`Tether::slack`]): whether the reel kept the tether off the
+    /// ground.
     pub max_slack_m: f64,
     /// When the slack was largest, s from the mission's start (0 with none): where to
     /// look in a replay.

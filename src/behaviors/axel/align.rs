@@ -9,9 +9,10 @@
 //! [`Memory::commit`]). A plan is finished before it is judged: one step drives one arc,
 //! and a plan whose first arc runs nearly straight to the look pose leaves its turn to a
 //! short second arc, so the rover can stand inside the arrival circle with the turn still
-//! to make. Misaligned there, it plans again from where it stands and drives that (at most
-//! `finish_steps` times per arrival) before it reverses. With no plan farther out than `spiral_beyond_m` beyond the look
-//! pose it spirals in toward the axis (the approach's spiral). Misaligned at the look
+//! to make. Misaligned there, it plans again from where it stands and drives that (at
+//! most `finish_steps` times per arrival) before it reverses. With no plan farther out
+//! than `spiral_beyond_m` beyond the look pose it spirals in toward the axis (the
+//! approach's spiral). Misaligned at the look
 //! pose, past it (also when only an untrusted pose says so: nearer than the look pose one
 //! camera loses the marks), or with no plan within the turn limit closer in, it reverses `reverse_m` (paying the tether out) and retries; after
 //! `behavior.max_retries` realignments (our choice: the paper had no limit and saw one
@@ -274,12 +275,6 @@ mod tests {
         assert!(aligned(&mirrored, arm, d5, 0.05, d5));
     }
 
-    fn axel_memory() -> Memory {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/profiles/axel.toml");
-        let profile = crate::profile::Profile::load(std::path::Path::new(path)).expect("axel profile");
-        Memory::from_profile(&profile).expect("memory")
-    }
-
     fn stereo(pose: Pose2) -> Sighting {
         Sighting {
             t: 0.0,
@@ -294,7 +289,7 @@ mod tests {
     #[test]
     fn a_turn_left_undone_inside_the_arrival_circle_is_finished_before_reversing() {
         // axel-field run 3: 5–6 cm short of the look pose on the axis, 7° off.
-        let mut m = axel_memory();
+        let mut m = Memory::shipped_axel();
         let p = AlignParams::default();
         let look_x = m.geometry.tether.arm + p.look_m;
         for (dx, dy, deg) in [(0.055, 0.003, 7.0), (0.05, -0.004, -6.0), (0.06, 0.0, 8.0)] {
@@ -339,9 +334,7 @@ mod tests {
 
     #[test]
     fn an_untrusted_pose_past_the_look_pose_reverses_and_counts_a_retry() {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/profiles/axel.toml");
-        let profile = crate::profile::Profile::load(std::path::Path::new(path)).expect("axel profile");
-        let mut m = Memory::from_profile(&profile).expect("memory");
+        let mut m = Memory::shipped_axel();
         let p = AlignParams::default();
         let look_x = m.geometry.tether.arm + p.look_m;
         let sighting = |x: f64| Sighting {

@@ -3,9 +3,9 @@
 //! (or give up looking), let the schema decide, then execute ONE motion by odometry (an
 //! arc, reeling to the tether's exposed length at its end, or a turn in place) and start
 //! over. Standing or turning in place, the reel takes up slack until its current says the
-//! tether is taut ([`Memory::take_up`]). A rover that kept moving while it looked would plan on frames blurred by its own
-//! motion and a pose already out of date by the time it plans; the paper stopped, and so
-//! do we.
+//! tether is taut ([`Memory::take_up`]). A rover that kept moving while it looked would
+//! plan on frames blurred by its own motion and a pose already out of date by the time
+//! it plans; the paper stopped, and so do we.
 
 use super::memory::{Memory, Sighting, Trust};
 use crate::geometry::{Pose2, Twist, wrap_angle};

@@ -291,8 +291,21 @@ impl Memory {
     /// taut (a slack tether loads the reel with its idle current alone). The braked wheels
     /// hold the rover against the pull.
     pub fn take_up(&self) -> f64 {
-        let taut = self.reel.is_none_or(|r| r.motor_current_a >= SLACK_CURRENT_A);
-        if taut { 0.0 } else { self.geometry.max_reel_rate }
+        if self.reel.is_none() {
+            return 0.0;
+        }
+        self.wind_below(self.geometry.max_reel_rate, SLACK_CURRENT_A)
+    }
+
+    /// The current-limited reel, the one rule both [`Memory::drive`] and
+    /// [`Memory::take_up`] apply: `rate` (m/s, positive in), but no winding in once the
+    /// reel's current reaches `limit_a` (paying out is never held back).
+    fn wind_below(&self, rate: f64, limit_a: f64) -> f64 {
+        if self.reel.is_some_and(|r| r.motor_current_a >= limit_a) {
+            rate.min(0.0)
+        } else {
+            rate
+        }
     }
 
     /// Driving `drive` while reeling at `reel_rate` (m/s, positive in), wheels driven.
@@ -300,8 +313,7 @@ impl Memory {
     /// shortens less than planned, so while the reel's current says the tether is taut
     /// ([`TAUT_CURRENT_A`]) it does not reel in (a current-limited reel: no tension sensor).
     pub fn drive(&self, drive: DriveCommand, reel_rate: f64, phase: &'static str) -> Step {
-        let taut = self.reel.is_some_and(|r| r.motor_current_a >= TAUT_CURRENT_A);
-        let rate = if taut { reel_rate.min(0.0) } else { reel_rate };
+        let rate = self.wind_below(reel_rate, TAUT_CURRENT_A);
         let out = MotorOutput::drive(drive).with_aux(crate::schemas::Auxiliary {
             tether: Some(TetherCommand {
                 reel_rate: rate.clamp(-self.geometry.max_reel_rate, self.geometry.max_reel_rate),
@@ -391,15 +403,23 @@ impl SharedMemory for Memory {
 }
 
 #[cfg(test)]
+impl Memory {
+    /// The memory of the shipped `profiles/axel.toml` (the schemas' unit tests).
+    pub(super) fn shipped_axel() -> Self {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/profiles/axel.toml");
+        let profile = Profile::load(std::path::Path::new(path)).expect("axel profile");
+        Self::from_profile(&profile).expect("memory")
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use std::f64::consts::PI;
 
     #[test]
     fn the_reel_takes_up_slack_until_its_current_says_taut() {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/profiles/axel.toml");
-        let profile = Profile::load(std::path::Path::new(path)).expect("axel profile");
-        let mut m = Memory::from_profile(&profile).expect("memory");
+        let mut m = Memory::shipped_axel();
         // No reading: nothing to judge slack by, the reel holds.
         assert_eq!(m.take_up(), 0.0);
         // Winding a slack tether: the idle current alone, wind at the top rate.
