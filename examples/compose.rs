@@ -69,7 +69,6 @@ kind = "bumper"                # this crate's kind, registered in main()
 params = { segments = 4 }
 
 [behavior]
-approach = "none"
 max_retries = 0
 search_timeout_s = 20.0
 phase_timeout_s = 30.0

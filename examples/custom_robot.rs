@@ -51,7 +51,6 @@ description = "A differential-drive toy that docks at a red beacon"
     include_str!("common/toy_robot.toml"),
     r#"
 [behavior]
-approach = "none"
 max_retries = 0
 search_timeout_s = 20.0
 phase_timeout_s = 20.0

@@ -82,7 +82,7 @@ enum Command {
     /// the coefficients and residuals; `--write` puts them into the profile.
     CalibrateSteering(marsupial::cli::calibrate_steering::CalibrateSteeringOptions),
     /// Run a profile's fiducial detection on image files: the two-block schema for a
-    /// [fiducial.two_block] profile, circle marks for a [fiducial.circles] one.
+    /// `two_block` fiducial profile, circle marks for a `circles` fiducial one.
     ///
     /// The images are processed in order as a stream, so adaptation carries from one to
     /// the next (and the fallback timeouts run on `--interval` seconds per image). With

@@ -41,11 +41,11 @@ fn bujold_avoid_is_bujold_but_for_the_listed_keys() {
         assert!(take(&mut avoid, key).is_some(), "bujold-avoid.toml lacks {key}");
     }
     // The field's gains are bujold-potential's, so the field alone is a tested approach.
-    let field = take(&mut avoid, "behavior.potential_field").expect("a potential_field table");
+    let field = take(&mut avoid, "robot.potential_field").expect("a potential_field table");
     let mut potential = read_table("scenarios/bujold-potential.toml");
     assert_eq!(
         Some(field),
-        take(&mut potential, "profile_patch.behavior.potential_field"),
+        take(&mut potential, "profile_patch.robot.potential_field"),
         "bujold-avoid's field gains drifted from scenarios/bujold-potential.toml"
     );
     // One new state, approach_near, after approach; the rest of the machine is Bujold's.

@@ -28,7 +28,11 @@ fn level(im: &RgbImage, px: [f64; 2]) -> u8 {
 #[test]
 fn both_cameras_see_every_circle_where_their_models_project_it() {
     let p = axel();
-    let circles = p.fiducial.circles.clone().expect("axel has circles");
+    let circles = p
+        .fiducial
+        .get::<marsupial::profile::CirclesSpec>()
+        .cloned()
+        .expect("axel has circles");
     let w = world::build(&p, &[], &[]).expect("axel world");
     assert_eq!(w.target_prims.len(), 1, "the marked face is the target");
     let radius = circles.diameter_m / 2.0;
@@ -113,7 +117,7 @@ fn the_module_body_blocks_starts_and_the_cone_is_its_dock() {
     assert!(dock.body_half_width >= dock.entrance_half, "the mouth fits the face");
     let widest = p
         .fiducial
-        .circles
+        .get::<marsupial::profile::CirclesSpec>()
         .unwrap()
         .placements
         .iter()

@@ -198,9 +198,10 @@ fn docks_from_starts_across_the_approach_zone() {
 #[test]
 fn potential_field_approach_docks_from_the_wings() {
     let c = run_shipped("scenarios/bujold-potential.toml", |loaded| {
+        let robot = marsupial::behaviors::catalog::tuning::<marsupial::behaviors::bujold::Bujold>(&loaded.profile);
         assert_eq!(
-            loaded.profile.behavior.approach,
-            marsupial::profile::ApproachKind::PotentialField
+            robot.unwrap().approach,
+            marsupial::behaviors::bujold::tuning::Approach::PotentialField
         );
         loaded.scenario.starts.select = Some(vec![1, 4, 7, 12, 14, 16]);
     });

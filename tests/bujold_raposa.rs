@@ -110,10 +110,11 @@ fn pair(h: u32, left_share: f64, offset: f64) -> TwoBlockPercept {
 #[test]
 fn the_adapter_reports_raposa_cues_and_alpha_only_from_a_run_of_reliable_frames() {
     let p = profile();
-    let Source::TwoBlock(mut cues) = Source::from_profile(&p).unwrap() else {
+    let tuning = marsupial::behaviors::catalog::tuning::<marsupial::behaviors::raposa::Raposa>(&p).unwrap();
+    let Source::TwoBlock(mut cues) = Source::from_profile(&p, &tuning.two_block).unwrap() else {
         panic!("two-block source expected");
     };
-    let window = p.behavior.bujold.unwrap().alpha_window_frames;
+    let window = tuning.two_block.alpha_window_frames;
     // Far (blocks 12 px tall): distance from the height, no α.
     let far = cues.view(&pair(12, 0.5, 0.0)).unwrap();
     assert!((far.ball_distance_m - 0.11 * 182.8 / 12.0).abs() < 0.05);
@@ -132,7 +133,7 @@ fn the_adapter_reports_raposa_cues_and_alpha_only_from_a_run_of_reliable_frames(
     assert_eq!(cues.view(&pair(12, 0.5, 0.0)).unwrap().alpha, None);
     assert_eq!(cues.view(&near).unwrap().alpha, None);
     // One bloomed frame among reliable ones does not move the median.
-    let mut cues2 = match Source::from_profile(&p).unwrap() {
+    let mut cues2 = match Source::from_profile(&p, &tuning.two_block).unwrap() {
         Source::TwoBlock(c) => c,
         Source::Pyramid(_) => unreachable!(),
     };

@@ -36,7 +36,7 @@ fn render(p: &Profile, w: &world::World, cam: usize, robot: &Pose2, seed: u64) -
     let spec = &p.cameras[cam];
     let model = CameraModel::from_spec(spec);
     let pose = camera_pose(robot, &spec.mount);
-    let circles = p.fiducial.circles.as_ref().expect("circles");
+    let circles = p.fiducial.get::<marsupial::profile::CirclesSpec>().expect("circles");
     let radius = circles.diameter_m / 2.0;
     let project = |q: Point3<f64>| model.project(&(pose.rotation.transpose() * (q - pose.position)));
     let truth = circles

@@ -185,7 +185,7 @@ fn bad_inputs_give_clear_errors() {
     assert!(
         String::from_utf8(out.stderr)
             .unwrap()
-            .contains("has no [fiducial.two_block]")
+            .contains("has no `two_block` fiducial")
     );
     let out = detect(&["--repeat", "0"], &[&f]);
     assert!(
@@ -222,8 +222,7 @@ fn render_axel(cam: usize, robot: &Pose2, seed: u64) -> (marsupial::perception::
     let pose = camera_pose(robot, &spec.mount);
     let truth = p
         .fiducial
-        .circles
-        .as_ref()
+        .get::<marsupial::profile::CirclesSpec>()
         .expect("circles")
         .placements
         .iter()
@@ -253,7 +252,7 @@ fn rover_error(pose: &serde_json::Value, robot: &Pose2) -> (f64, f64) {
 #[test]
 fn circles_marks_ids_and_pose_on_rendered_frames() {
     let p = common::shipped_profile("axel");
-    let placements = &p.fiducial.circles.as_ref().unwrap().placements;
+    let placements = &p.fiducial.get::<marsupial::profile::CirclesSpec>().unwrap().placements;
     // Two poses, through each camera (the mono pose through that camera's fish-eye).
     let cases = [
         (1.8, 15.0, 4.0, 0usize),
@@ -364,7 +363,7 @@ fn circles_fewer_than_five_marks_is_a_clean_not_found() {
 #[test]
 fn circles_undetected_marks_are_filled_in_from_the_reprojection() {
     let p = common::shipped_profile("axel");
-    let placements = &p.fiducial.circles.as_ref().unwrap().placements;
+    let placements = &p.fiducial.get::<marsupial::profile::CirclesSpec>().unwrap().placements;
     let robot = facing(2.0, -10.0, 2.0);
     let (mut im, truth) = render_axel(1, &robot, 23);
     // Hide marks 2 and 5: six remain, enough for a fit, and the two are filled in.
@@ -446,12 +445,9 @@ fn circles_bad_inputs_give_clear_errors() {
     for (args, want) in [
         (
             vec!["--imprint", f.to_str().unwrap()],
-            "--imprint applies to [fiducial.two_block] profiles only; `axel` has [fiducial.circles]",
+            "--imprint applies to `two_block` fiducials only; `axel` has `circles` fiducial",
         ),
-        (
-            vec!["--static"],
-            "--static applies to [fiducial.two_block] profiles only",
-        ),
+        (vec!["--static"], "--static applies to `two_block` fiducials only"),
         (
             vec!["--camera", "2"],
             "--camera 2: profile `axel` has 2 camera(s), numbered from 0",
@@ -487,7 +483,7 @@ fn circles_bad_inputs_give_clear_errors() {
     assert!(
         String::from_utf8(out.stderr)
             .unwrap()
-            .contains("has no [fiducial.two_block] or [fiducial.circles]")
+            .contains("has no `two_block` fiducial or `circles` fiducial")
     );
 }
 
@@ -560,8 +556,5 @@ fn stereo_misuse_gives_clear_errors() {
     let e = err(&["--stereo", "--camera", "1"], &[&f, &f], &axel_profile());
     assert!(e.contains("leave out --camera"), "{e}");
     let e = err(&["--stereo"], &[&f, &f], &profile());
-    assert!(
-        e.contains("--stereo applies to [fiducial.circles] profiles only"),
-        "{e}"
-    );
+    assert!(e.contains("--stereo applies to `circles` fiducials only"), "{e}");
 }

@@ -82,7 +82,12 @@ fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
 #[test]
 fn every_marker_is_found_within_0_3_px_and_identified_from_the_rest_prediction() {
     let p = krawler();
-    let side = p.fiducial.markers.unwrap().side_m;
+    let side = p
+        .fiducial
+        .get::<marsupial::profile::MarkersSpec>()
+        .copied()
+        .unwrap()
+        .side_m;
     let rest = KrawlerState::rest(&p).unwrap();
     let mut cam = Cam::of(&p);
     let predicted = cam.expected(&build(&p, &rest).unwrap(), side);
@@ -146,7 +151,12 @@ fn every_marker_is_found_within_0_3_px_and_identified_from_the_rest_prediction()
 #[test]
 fn a_marker_hidden_behind_an_occluder_or_cut_by_the_border_is_missing() {
     let p = krawler();
-    let side = p.fiducial.markers.unwrap().side_m;
+    let side = p
+        .fiducial
+        .get::<marsupial::profile::MarkersSpec>()
+        .copied()
+        .unwrap()
+        .side_m;
     let rest = KrawlerState::rest(&p).unwrap();
     let mut finder = MarkerFinder::new(640, 480, MarkerParams::default());
 
@@ -252,7 +262,12 @@ fn spurious_magenta_in_real_photos_gets_no_identity() {
         return;
     }
     let p = krawler();
-    let side = p.fiducial.markers.unwrap().side_m;
+    let side = p
+        .fiducial
+        .get::<marsupial::profile::MarkersSpec>()
+        .copied()
+        .unwrap()
+        .side_m;
     let cam = Cam::of(&p);
     let predicted = cam.expected(&build(&p, &KrawlerState::rest(&p).unwrap()).unwrap(), side);
     let (mut photos, mut blobs, mut assigned, mut with_blobs, mut matched) = (0, 0, 0, 0, 0);
@@ -302,7 +317,12 @@ fn axle_roll_and_drop_from_the_plate_markers_match_the_truth() {
     use marsupial::perception::body_from_camera;
     use marsupial::perception::krawler::AxleGeometry;
     let p = krawler();
-    let side = p.fiducial.markers.unwrap().side_m;
+    let side = p
+        .fiducial
+        .get::<marsupial::profile::MarkersSpec>()
+        .copied()
+        .unwrap()
+        .side_m;
     let rest = KrawlerState::rest(&p).unwrap();
     let mut cam = Cam::of(&p);
     let mount = &p.cameras[0].mount;

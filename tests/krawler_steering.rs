@@ -202,7 +202,7 @@ fn bad_sweeps_are_refused_naming_the_line() {
         assert!(e.contains(want), "want {want:?}, got {e:?}");
     }
     let e = calibrate(&common::shipped_profile("bujold"), &options(None, None, 1.0, 3)).unwrap_err();
-    assert!(e.contains("[fiducial.markers]"), "{e}");
+    assert!(e.contains("`markers` fiducial"), "{e}");
 }
 
 /// On rendered frames with sensor noise, at random roll, drop and steering on each axle
@@ -215,7 +215,12 @@ fn steering_on_noisy_rendered_frames_at_random_states() {
     let polys = SteeringPoly::from_profile(&p).unwrap();
     let pose = camera_pose(&Pose2::new(0.0, 0.0, 0.0), &p.cameras[0].mount);
     let rest = KrawlerState::rest(&p).unwrap();
-    let side = p.fiducial.markers.unwrap().side_m;
+    let side = p
+        .fiducial
+        .get::<marsupial::profile::MarkersSpec>()
+        .copied()
+        .unwrap()
+        .side_m;
     let mut renderer = Renderer::new(g.model.clone(), 640, 480, 3);
     let mut finder = MarkerFinder::new(640, 480, MarkerParams::default());
     let expected = |gear: &KrawlerScene| -> [ExpectedMarker; 8] {

@@ -81,10 +81,16 @@ fn scenario_file() -> std::path::PathBuf {
 /// of each block) in frames of `paint` under run `run`'s light, from every view.
 fn seen(paint: NamedColor, run: usize) -> Vec<Seen> {
     let mut loaded = Scenario::load(&scenario_file()).unwrap();
-    let fid = loaded.profile.fiducial.two_block.as_mut().unwrap();
-    fid.left_color = paint;
-    fid.right_color = paint;
-    let fid = *fid;
+    let fid = marsupial::profile::TwoBlockSpec {
+        left_color: paint,
+        right_color: paint,
+        ..*loaded
+            .profile
+            .fiducial
+            .get::<marsupial::profile::TwoBlockSpec>()
+            .unwrap()
+    };
+    loaded.profile.fiducial.set(fid);
     let p = campaign::prepare(loaded).unwrap();
     let profile = p.loaded.profile.clone();
     let cam = &profile.cameras[0];

@@ -1,6 +1,7 @@
 //! Every malformed profile fails with the file, field path, line and expectation, and
 //! never panics (nor does any mutant of a shipped profile); the shipped profiles pass.
 
+use marsupial::behaviors::Catalog;
 use marsupial::config::ConfigError;
 use marsupial::profile::{DriveKind, Profile};
 use std::path::Path;
@@ -51,29 +52,34 @@ const CASES: &[(&str, &str, Option<usize>, &str)] = &[
         Some(9),
         "unknown variant `hovercraft`",
     ),
-    ("two_fiducials.toml", "fiducial", Some(44), "expected exactly one of"),
+    (
+        "unknown_fiducial_kind.toml",
+        "fiducial.kind",
+        Some(45),
+        "unknown fiducial kind `two_blocks` (registered: circles, markers, pyramid, two_block)",
+    ),
     (
         "approach_without_gains.toml",
-        "behavior.approach",
-        Some(52),
-        "needs a [behavior.ratio_steering] table",
+        "robot",
+        Some(57),
+        "missing field `ratio_steering`",
     ),
     (
         "bad_circle_rotation.toml",
-        "fiducial.circles.placements[2].rotation_deg",
-        Some(57),
+        "fiducial.placements[2].rotation_deg",
+        Some(58),
         "expected one of −45, 0, 45, 90, got 30",
     ),
     (
         "bad_fixed_threshold.toml",
-        "fiducial.circles.fixed_threshold",
-        Some(83),
+        "fiducial.fixed_threshold",
+        Some(84),
         "black_below ≤ white_above, got [150, 70]",
     ),
     (
         "stale_below_tick.toml",
         "loop.camera_stale_s",
-        Some(67),
+        Some(71),
         "at least one tick",
     ),
     (
@@ -91,37 +97,37 @@ const CASES: &[(&str, &str, Option<usize>, &str)] = &[
     (
         "chroma_gate_too_wide.toml",
         "perception.min_chroma_deg",
-        Some(70),
+        Some(74),
         "expected a number in [0, 30], got 45",
     ),
     (
         "pairing_limits_out_of_range.toml",
         "perception.max_height_ratio",
-        Some(70),
+        Some(74),
         "expected a number in [1, ",
     ),
     (
         "cast_out_of_range.toml",
         "perception.cast_tau_s",
-        Some(70),
+        Some(74),
         "expected a number ≥ 0, got -1",
     ),
     (
         "cast_out_of_range.toml",
         "perception.cast_dead_band",
-        Some(71),
+        Some(75),
         "expected a number in [0, 0.5], got 0.8",
     ),
     (
         "pairing_limits_out_of_range.toml",
         "perception.min_count_ratio",
-        Some(71),
+        Some(75),
         "expected a number in [0, 1], got 1.5",
     ),
     (
         "steering_poly_wrong_length.toml",
-        "fiducial.markers.steering_poly_deg[1]",
-        Some(42),
+        "fiducial.steering_poly_deg[1]",
+        Some(43),
         "expected 3 coefficients (second order) or 4 (third order), got 5",
     ),
     ("empty.toml", "", None, "missing field `name`"),
@@ -151,7 +157,9 @@ fn shipped_profiles_are_valid() {
 #[test]
 fn every_malformed_profile_names_file_path_line_and_expectation() {
     for &(file, path, line, text) in CASES {
-        let err = Profile::load(&fixture(file)).expect_err(file);
+        // The catalog's check: the generic profile, its fiducial kind, its robot kind's
+        // tuning and its tree.
+        let err = Catalog::shipped().check_profile(&fixture(file)).expect_err(file);
         let ConfigError::Invalid { file: f, problems } = &err else {
             panic!("{file}: expected Invalid, got {err:?}");
         };
@@ -193,13 +201,25 @@ fn several_problems_are_reported_together() {
     );
 }
 
-/// `behavior.two_arc.max_arc_turn_deg` is optional (absent in the shipped profile: no
+/// `robot.two_arc.max_arc_turn_deg` is optional (absent in the shipped profile: no
 /// cap) and, when given, must be a finite number in (0, 180]; a bad one is reported by
 /// its field path and line.
 #[test]
 fn the_arc_turn_cap_is_optional_and_checked() {
     let src = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/axel.toml")).unwrap();
-    let gains = |p: &Profile| p.behavior.two_arc.expect("two-arc gains");
+    let gains = |p: &Profile| {
+        marsupial::behaviors::catalog::tuning::<marsupial::behaviors::axel::Axel>(p)
+            .expect("two-arc gains")
+            .two_arc
+    };
+    // The tuning is the robot kind's: checked when the robot is built.
+    let check = |src: &str| {
+        let p = Profile::parse(src, Path::new("axel.toml")).expect("the profile loads");
+        match marsupial::behaviors::catalog::tuning::<marsupial::behaviors::axel::Axel>(&p) {
+            Err(marsupial::behaviors::BuildError::Invalid(e)) => e,
+            other => panic!("expected the tuning refused, got {other:?}"),
+        }
+    };
     let shipped = Profile::parse(&src, Path::new("axel.toml")).expect("the shipped profile");
     assert_eq!(gains(&shipped).max_arc_turn_deg, None);
     let with = |cap: &str| {
@@ -213,11 +233,11 @@ fn the_arc_turn_cap_is_optional_and_checked() {
     assert_eq!(gains(&capped).max_arc_turn_deg, Some(30.0));
     let line = src.lines().position(|l| l.starts_with("arc_speed_mps")).unwrap() + 2;
     for bad in ["0.0", "-5.0", "180.5", "nan", "inf"] {
-        let err = Profile::parse(&with(bad), Path::new("axel.toml")).expect_err(bad);
+        let err = check(&with(bad));
         let p = err
             .problems()
             .iter()
-            .find(|p| p.path == "behavior.two_arc.max_arc_turn_deg")
+            .find(|p| p.path == "robot.two_arc.max_arc_turn_deg")
             .unwrap_or_else(|| panic!("{bad}: {:?}", err.problems()));
         assert!(
             p.message.contains("expected a number in (0, 180]"),

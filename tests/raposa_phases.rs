@@ -134,7 +134,9 @@ fn at(x: f64) -> Pose2 {
 #[test]
 fn servo_states_steer_on_what_they_see() {
     let mem = memory();
-    let g = profile().behavior.seven_state.unwrap();
+    let g = marsupial::behaviors::catalog::tuning::<marsupial::behaviors::raposa::Raposa>(&profile())
+        .unwrap()
+        .seven_state;
     // State 1 near the pyramid: slower than the far speed, turning against x_dev; the
     // camera looks back, so "toward the pyramid" is body-backward.
     let mut s1 = servo::Approach::new("approach", mem.clone());
@@ -359,7 +361,9 @@ fn look_clears_blind_settles_then_searches_away_from_the_last_turn() {
 #[test]
 fn final_runs_the_state_1_law_once_then_creeps_and_retries() {
     let mem = memory();
-    let g = profile().behavior.seven_state.unwrap();
+    let g = marsupial::behaviors::catalog::tuning::<marsupial::behaviors::raposa::Raposa>(&profile())
+        .unwrap()
+        .seven_state;
     let mut f = final_approach::FinalApproach::new("final", mem.clone(), 3);
     let near = seen(0.28, Some(3.0), [4.0, 10.0], true);
     enter(&mut f, &mem, 5.0, at(0.5), near);
@@ -391,7 +395,9 @@ fn final_runs_the_state_1_law_once_then_creeps_and_retries() {
 #[test]
 fn back_aways_leave_by_their_distance_then_clear() {
     let mem = memory();
-    let g = profile().behavior.seven_state.unwrap();
+    let g = marsupial::behaviors::catalog::tuning::<marsupial::behaviors::raposa::Raposa>(&profile())
+        .unwrap()
+        .seven_state;
     let mut retreat = BackAway::new("retreat", mem.clone(), Distance::Retreat(RetreatParams::default()));
     enter(&mut retreat, &mem, 0.0, at(0.5), nothing());
     let step = tick(&mut retreat, &mem, 0.1, at(0.6), nothing());

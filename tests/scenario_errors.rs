@@ -306,7 +306,7 @@ fn a_colour_axis_needs_a_two_block_flap() {
     assert_eq!(path, "axes.fiducial_colors");
     assert_eq!(line, None);
     assert!(
-        message.contains("profile `raposa` has no [fiducial.two_block]"),
+        message.contains("profile `raposa` has no `two_block` fiducial"),
         "{message}"
     );
 }
@@ -340,10 +340,15 @@ fn profile_patches_apply_and_bad_ones_name_the_patch() {
     let starts = "[starts]\ngrid = \"paper16\"\n";
     let ok = write(
         "patch_ok.toml",
-        &format!("{starts}[profile_patch.fiducial.two_block]\nright_color = \"yellow\"\n"),
+        &format!("{starts}[profile_patch.fiducial]\nright_color = \"yellow\"\n"),
     );
     let loaded = Scenario::load(&ok).unwrap();
-    let fid = loaded.profile.fiducial.two_block.unwrap();
+    let fid = loaded
+        .profile
+        .fiducial
+        .get::<marsupial::profile::TwoBlockSpec>()
+        .copied()
+        .unwrap();
     assert_eq!(format!("{:?}", fid.right_color), "Yellow");
     assert_eq!(
         format!("{:?}", fid.left_color),

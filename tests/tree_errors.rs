@@ -234,7 +234,7 @@ fn the_avoid_profile_builds() {
 fn gripper_profile(actuators: &str) -> Profile {
     let src = format!(
         "name = \"gripper\"\n{}{actuators}\n\
-         [behavior]\napproach = \"none\"\nmax_retries = 0\nsearch_timeout_s = 20.0\nphase_timeout_s = 20.0\n\
+         [behavior]\nmax_retries = 0\nsearch_timeout_s = 20.0\nphase_timeout_s = 20.0\n\
          [behavior.tree]\nroot = \"seek\"\ndocking = \"grip\"\n\
          [behavior.tree.nodes.seek]\nkind = \"sequencer\"\nstates = [\"grip\"]\n\
          [behavior.tree.nodes.grip]\nkind = \"leaf\"\nschema = \"test.grip\"\n\

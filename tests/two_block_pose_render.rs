@@ -20,7 +20,7 @@ fn alpha_tracks_the_true_pose_near_the_gate() {
     let p = shipped_profile("bujold");
     let w = world::build(&p, &[], &[]).unwrap();
     let cam = &p.cameras[0];
-    let fid = p.fiducial.two_block.unwrap();
+    let fid = p.fiducial.get::<marsupial::profile::TwoBlockSpec>().copied().unwrap();
     let g = TwoBlockGeometry::new(cam, &fid);
     let mut r = renderer(&p, 1);
     let mut s = TwoBlockSchema::from_profile(&p, 0).unwrap();

@@ -13,10 +13,12 @@
 pub mod agent;
 pub mod axel;
 pub mod bujold;
+pub mod catalog;
 pub mod common;
 pub mod composed;
 pub mod raposa;
 pub mod registry;
 
 pub use agent::{BuildError, agent_for};
+pub use catalog::{Catalog, RobotKind};
 pub use composed::{Composed, SharedMemory};

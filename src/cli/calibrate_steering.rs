@@ -49,7 +49,7 @@ pub struct CalibrateSteeringOptions {
     /// The simulated sweep's step, degrees.
     #[arg(long, value_name = "DEG", default_value_t = 1.0)]
     pub step_deg: f64,
-    /// Write the fitted coefficients into the profile's `[fiducial.markers]
+    /// Write the fitted coefficients into the profile's ``markers` fiducial
     /// steering_poly_deg`, keeping the file's comments and layout.
     #[arg(long)]
     pub write: bool,
@@ -186,9 +186,9 @@ fn save_sweep(dir: &Path, frames: &[SweepFrame]) -> Result<(), String> {
 /// A message for a profile without the gear, an unreadable or malformed sweep (naming
 /// the line), or a sweep that cannot be fitted (naming the axle).
 pub fn calibrate(profile: &Profile, opts: &CalibrateSteeringOptions) -> Result<SteeringCalibration, String> {
-    if profile.fiducial.markers.is_none() || profile.cameras.is_empty() {
+    if profile.fiducial.get::<crate::profile::MarkersSpec>().copied().is_none() || profile.cameras.is_empty() {
         return Err(format!(
-            "profile `{}` has no [fiducial.markers] or no camera: calibrate-steering is for a belly-camera gear like profiles/autokrawler.toml",
+            "profile `{}` has no `markers` fiducial or no camera: calibrate-steering is for a belly-camera gear like profiles/autokrawler.toml",
             profile.name
         ));
     }
@@ -256,20 +256,20 @@ pub fn calibrate(profile: &Profile, opts: &CalibrateSteeringOptions) -> Result<S
     })
 }
 
-/// Writes `polys` into the profile file at `path` as `[fiducial.markers]
+/// Writes `polys` into the profile file at `path` as ``markers` fiducial
 /// steering_poly_deg`, rounded to 1e-4°, keeping the rest of the file as it is.
 ///
 /// # Errors
 /// A message when the file cannot be read, parsed or written, or has no
-/// `[fiducial.markers]` table.
+/// `markers` fiducial table.
 pub fn write_polys(path: &Path, polys: &[SteeringPoly; 2]) -> Result<(), String> {
     let text = std::fs::read_to_string(path).map_err(|e| err(path, e))?;
     let mut doc: toml_edit::DocumentMut = text.parse().map_err(|e| err(path, e))?;
     let markers = doc
         .get_mut("fiducial")
-        .and_then(|f| f.get_mut("markers"))
         .and_then(|m| m.as_table_like_mut())
-        .ok_or_else(|| err(path, "no [fiducial.markers] table"))?;
+        .filter(|f| f.get("kind").and_then(|k| k.as_str()) == Some("markers"))
+        .ok_or_else(|| err(path, "no [fiducial] table of kind `markers`"))?;
     let mut outer = toml_edit::Array::new();
     for p in polys {
         let mut inner = toml_edit::Array::new();

@@ -1,17 +1,27 @@
 //! `marsupial check FILE...`: validate profiles (and scenarios) without running anything.
 
+use crate::behaviors::{BuildError, Catalog};
 use crate::config::ConfigError;
-use crate::profile::Profile;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// Validates one file, choosing its kind from its contents: a scenario names its profile
-/// with a top-level `profile = "path"` (a perception campaign for `pose-trials` also has
-/// a `[pose]` table); anything else is checked as a profile.
+/// Validates one file with the crate's catalog (see [`check_file_with`]).
 ///
 /// # Errors
 /// The file's [`ConfigError`].
 pub fn check_file(path: &Path) -> Result<(), ConfigError> {
+    check_file_with(path, crate::behaviors::catalog::shipped())
+}
+
+/// Validates one file, choosing its kind from its contents: a scenario names its profile
+/// with a top-level `profile = "path"` (a perception campaign for `pose-trials` also has
+/// a `[pose]` table); anything else is checked as a profile. A profile (a scenario's,
+/// as patched) naming a robot kind is also built with `catalog`, so its robot kind's
+/// tuning and its tree are checked too.
+///
+/// # Errors
+/// The file's [`ConfigError`].
+pub fn check_file_with(path: &Path, catalog: &Catalog) -> Result<(), ConfigError> {
     let table = std::fs::read_to_string(path)
         .ok()
         .and_then(|s| s.parse::<toml::Table>().ok());
@@ -25,18 +35,30 @@ pub fn check_file(path: &Path) -> Result<(), ConfigError> {
     {
         super::pose_trials::PoseCampaign::load(path).map(|_| ())
     } else if is_scenario {
-        crate::sim::scenario::Scenario::load(path).map(|_| ())
+        let loaded = crate::sim::scenario::Scenario::load_with(path, catalog.fiducials())?;
+        if loaded.profile.robot.is_none() {
+            return Ok(());
+        }
+        catalog.agent(&loaded.profile).map(|_| ()).map_err(|e| match e {
+            BuildError::Tree(e) | BuildError::Invalid(e) => e,
+            other => loaded.profile.problems(vec![("robot".into(), other.to_string())]),
+        })
     } else {
-        Profile::load(path).map(|_| ())
+        catalog.check_profile(path).map(|_| ())
     }
 }
 
 /// Checks every file, printing `ok FILE` to `out` for each valid one and the error to
 /// `err` for each invalid one. Returns the number of invalid files.
 pub fn run(files: &[PathBuf], out: &mut dyn Write, err: &mut dyn Write) -> usize {
+    run_with(files, crate::behaviors::catalog::shipped(), out, err)
+}
+
+/// [`run`] with `catalog`'s robot and fiducial kinds.
+pub fn run_with(files: &[PathBuf], catalog: &Catalog, out: &mut dyn Write, err: &mut dyn Write) -> usize {
     let mut bad = 0;
     for f in files {
-        match check_file(f) {
+        match check_file_with(f, catalog) {
             Ok(()) => {
                 let _ = writeln!(out, "ok {}", f.display());
             }

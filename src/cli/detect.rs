@@ -1,6 +1,6 @@
 //! `marsupial detect`: run a profile's fiducial detection over image files. A
-//! `[fiducial.two_block]` profile runs the two-block perceptual schema as a stream
-//! (adaptation carries from image to image); a `[fiducial.circles]` profile runs Axel's
+//! `two_block`-fiducial profile runs the two-block perceptual schema as a stream
+//! (adaptation carries from image to image); a `circles`-fiducial profile runs Axel's
 //! circle-mark detection, correspondence and monocular pose on each image independently,
 //! and with `--stereo` the stereo pose of each pair of images from cameras 0 and 1
 //! ([`run`] dispatches on the profile).
@@ -26,8 +26,8 @@ use thiserror::Error;
 /// Options of `marsupial detect` (also its command-line arguments).
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 pub struct DetectOptions {
-    /// Profile with a [fiducial.two_block] (e.g. profiles/bujold.toml) or a
-    /// [fiducial.circles] (profiles/axel.toml).
+    /// Profile with a `two_block` fiducial (e.g. profiles/bujold.toml) or a
+    /// `circles` fiducial (profiles/axel.toml).
     #[arg(long, value_name = "PROFILE")]
     pub profile: PathBuf,
     /// The profile camera the images come from (its colour order for two-block; its lens
@@ -88,7 +88,7 @@ pub enum DetectError {
     #[error("{0}")]
     Usage(String),
     /// The profile has no fiducial `detect` handles.
-    #[error("profile `{0}` has no [fiducial.two_block] or [fiducial.circles]: detect handles those two fiducials")]
+    #[error("profile `{0}` has no `two_block` fiducial or `circles` fiducial: detect handles those two fiducials")]
     NoFiducial(String),
     /// Writing the output failed.
     #[error("cannot write output: {0}")]
@@ -166,15 +166,20 @@ pub fn run(opts: &DetectOptions, out: &mut dyn Write) -> Result<(), DetectError>
             profile.cameras.len()
         )));
     }
-    if profile.fiducial.circles.is_some() {
+    if profile.fiducial.get::<crate::profile::CirclesSpec>().is_some() {
         return run_circles(opts, &profile, out);
     }
-    if profile.fiducial.two_block.is_none() {
+    if profile
+        .fiducial
+        .get::<crate::profile::TwoBlockSpec>()
+        .copied()
+        .is_none()
+    {
         return Err(DetectError::NoFiducial(profile.name.clone()));
     }
     if opts.stereo {
         return Err(DetectError::Usage(format!(
-            "--stereo applies to [fiducial.circles] profiles only; `{}` has [fiducial.two_block]",
+            "--stereo applies to `circles` fiducials only; `{}` has `two_block` fiducial",
             profile.name
         )));
     }
@@ -256,7 +261,7 @@ fn write_record(out: &mut dyn Write, image: &str, p: &TwoBlockPercept, us: f64, 
 /// One labelled mark of a circles record: a model mark, detected or filled in.
 #[derive(Debug, Clone, Serialize)]
 pub struct CircleMarkRecord {
-    /// Index of the mark in the profile's `[fiducial.circles].placements`.
+    /// Index of the mark in the profile's ``circles` fiducial.placements`.
     pub id: usize,
     /// The bar's rotation, degrees: as the detector read it for a detected mark, the
     /// model's for a filled-in one.
@@ -305,7 +310,7 @@ pub struct CirclePoseRecord {
     pub marks_used: usize,
 }
 
-/// One line of `--json` output for a `[fiducial.circles]` profile.
+/// One line of `--json` output for a `circles`-fiducial profile.
 #[derive(Debug, Clone, Serialize)]
 pub struct CirclesRecord<'a> {
     /// The image path as given.
@@ -450,7 +455,7 @@ fn run_circles(opts: &DetectOptions, profile: &Profile, out: &mut dyn Write) -> 
     ] {
         if given {
             return Err(DetectError::Usage(format!(
-                "{name} applies to [fiducial.two_block] profiles only; `{}` has [fiducial.circles]",
+                "{name} applies to `two_block` fiducials only; `{}` has `circles` fiducial",
                 profile.name
             )));
         }

@@ -352,7 +352,7 @@ fn run_frames(
     let geometry = AxleGeometry::from_profile(profile, 0).map_err(|e| pe(&e))?;
     let layout = GearLayout::from_profile(profile).map_err(|e| pe(&e))?;
     let polys = SteeringPoly::from_profile(profile)
-        .ok_or_else(|| pe(&"no [fiducial.markers] steering_poly_deg: run `marsupial calibrate-steering --write`"))?;
+        .ok_or_else(|| pe(&"no `markers` fiducial steering_poly_deg: run `marsupial calibrate-steering --write`"))?;
     let rest = KrawlerState::rest(profile).map_err(|e| pe(&e))?;
     let start = expected_markers(profile, &rest).map_err(|e| pe(&e))?;
     let axles = [0, 1].map(|a| AxleState {
@@ -369,7 +369,11 @@ fn run_frames(
         frame_interval_s: dt as f32,
         ..SensorParams::default()
     };
-    let side = profile.fiducial.markers.map_or(0.03, |m| m.side_m);
+    let side = profile
+        .fiducial
+        .get::<crate::profile::MarkersSpec>()
+        .copied()
+        .map_or(0.03, |m| m.side_m);
     let knobs = spec.errors;
     // The rover's true path over the floor, when the floor is fixed to the world.
     let ground = match (knobs.moving_ground, drive_of(profile)) {

@@ -77,7 +77,7 @@ mod tests {
         let base = "# Bujold\nname = \"a\"\n\n[drive]\nkind = \"x\" # why\nspeed = 1.0\n\n[[cameras]]\nw = 1\n";
         let out = patched(
             base,
-            &table("name = \"b\"\n[drive]\nspeed = 2.0\n[fiducial.two_block]\nright = \"yellow\"\n"),
+            &table("name = \"b\"\n[drive]\nspeed = 2.0\n`two_block` fiducial\nright = \"yellow\"\n"),
         )
         .unwrap();
         let v: toml::Table = out.parse().unwrap();

@@ -73,7 +73,7 @@ pub enum Region {
     Outside,
 }
 
-/// The regions' radii and the approach angle (profile `[behavior.two_arc]` radii,
+/// The regions' radii and the approach angle (profile `[robot.two_arc]` radii,
 /// `[dock]` `approach_radius_m` and `approach_half_angle_deg`). The paper gives no
 /// region radii: the profile's are ours.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -148,15 +148,15 @@ fn camera(profile: &Profile, camera: usize) -> Result<&CameraSpec, VisionError> 
 }
 
 impl PyramidGeometry {
-    /// From camera `camera` of a profile and its `[fiducial.pyramid]`.
+    /// From camera `camera` of a profile and its `pyramid` fiducial.
     ///
     /// # Errors
     /// [`VisionError::Profile`] without a pin-hole camera or a pyramid fiducial.
     pub fn from_profile(profile: &Profile, camera_index: usize) -> Result<Self, VisionError> {
-        let pyr = profile
+        let pyr = *profile
             .fiducial
-            .pyramid
-            .ok_or_else(|| missing(format!("profile `{}` has no [fiducial.pyramid]", profile.name)))?;
+            .require::<super::PyramidSpec>()
+            .map_err(|e| missing(format!("profile `{}` {e}", profile.name)))?;
         let cam = camera(profile, camera_index)?;
         let k = cam
             .pinhole_intrinsics()
@@ -173,17 +173,17 @@ impl PyramidGeometry {
 
 impl TwoBlockParams {
     /// The two-block tracker of camera `camera` of a profile with a
-    /// `[fiducial.two_block]`: table defaults from the fiducial's paint colours as painted
+    /// `two_block` fiducial: table defaults from the fiducial's paint colours as painted
     /// ([`NamedColor::paint_srgb`](crate::profile::NamedColor::paint_srgb)), in the
     /// order they appear in this camera's image, and everything else from `[perception]`.
     ///
     /// # Errors
     /// [`VisionError::Profile`] when the profile has no two-block fiducial or no such camera.
     pub fn from_profile(profile: &Profile, camera_index: usize) -> Result<Self, VisionError> {
-        let fid = profile
+        let fid = *profile
             .fiducial
-            .two_block
-            .ok_or_else(|| missing(format!("profile `{}` has no [fiducial.two_block]", profile.name)))?;
+            .require::<super::TwoBlockSpec>()
+            .map_err(|e| missing(format!("profile `{}` {e}", profile.name)))?;
         let cam = camera(profile, camera_index)?;
         let p = &profile.perception;
         let (img_left, img_right) = if cam.mount.is_flipped() {
@@ -211,7 +211,7 @@ impl TwoBlockParams {
 }
 
 impl CircleModel {
-    /// The correspondence model of a profile's `[fiducial.circles]`: each placement's
+    /// The correspondence model of a profile's `circles` fiducial: each placement's
     /// (y_m, z_m) as face coordinates (u, v) (the module's face looks along +x, so +y is
     /// to the right seen from in front), its rotation, and half the diameter as radius.
     ///
@@ -221,9 +221,8 @@ impl CircleModel {
     pub fn from_profile(profile: &Profile) -> Result<Self, VisionError> {
         let c = profile
             .fiducial
-            .circles
-            .as_ref()
-            .ok_or_else(|| missing(format!("profile `{}` has no [fiducial.circles]", profile.name)))?;
+            .require::<super::CirclesSpec>()
+            .map_err(|e| missing(format!("profile `{}` {e}", profile.name)))?;
         let mut marks = Vec::with_capacity(c.placements.len());
         for (i, p) in c.placements.iter().enumerate() {
             let r = MarkRotation::from_degrees(p.rotation_deg).ok_or_else(|| {
@@ -235,16 +234,19 @@ impl CircleModel {
             marks.push(([p.y_m, p.z_m], r));
         }
         CircleModel::new(c.diameter_m / 2.0, &marks)
-            .map_err(|e| missing(format!("profile `{}`: [fiducial.circles]: {e}", profile.name)))
+            .map_err(|e| missing(format!("profile `{}`: `circles` fiducial: {e}", profile.name)))
     }
 }
 
 impl CircleParams {
     /// The detector's parameters for frames `width_px` wide ([`CircleParams::for_image`]),
-    /// with the fixed threshold of the profile's `[fiducial.circles]` when it sets one.
+    /// with the fixed threshold of the profile's `circles` fiducial when it sets one.
     pub fn from_profile(profile: &Profile, width_px: usize) -> Self {
         let mut p = CircleParams::for_image(width_px);
-        let levels = profile.fiducial.circles.as_ref().and_then(|c| c.fixed_threshold);
+        let levels = profile
+            .fiducial
+            .get::<crate::profile::CirclesSpec>()
+            .and_then(|c| c.fixed_threshold);
         if let Some([black_below, white_above]) = levels {
             p.threshold = Threshold::Fixed(FixedThreshold {
                 black_below,
@@ -320,16 +322,19 @@ impl GearLayout {
 }
 
 impl SteeringPoly {
-    /// The steering calibrations (front, rear) of a profile's `[fiducial.markers]`, or
+    /// The steering calibrations (front, rear) of a profile's `markers` fiducial, or
     /// `None` when it has none yet (`marsupial calibrate-steering` writes them).
     pub fn from_profile(profile: &Profile) -> Option<[Self; 2]> {
-        let polys = profile.fiducial.markers.as_ref()?.steering_poly_deg?;
+        let polys = profile
+            .fiducial
+            .get::<crate::profile::MarkersSpec>()?
+            .steering_poly_deg?;
         Some(polys.map(|c| Self { deg: c.deg }))
     }
 }
 
 impl PyramidTrackerParams {
-    /// The pyramid tracker of camera `camera` of a profile with a `[fiducial.pyramid]`:
+    /// The pyramid tracker of camera `camera` of a profile with a `pyramid` fiducial:
     /// bands, filters and imprint/adapt settings from `[perception]` and
     /// `[perception.pyramid]`.
     ///

@@ -20,21 +20,21 @@ pub mod geometry;
 pub mod paint;
 pub mod perception;
 pub mod pyramid_perception;
+pub mod robot;
 pub mod tree;
 
-pub use behavior::{
-    ApproachKind, BehaviorSpec, BujoldTuning, LoopSpec, PotentialFieldGains, RatioSteeringGains, SevenStateGains,
-    TwoArcGains,
-};
+pub use behavior::{BehaviorSpec, LoopSpec};
 pub use camera::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount};
 pub use devices::{ActuatorSpec, RANGE_KIND, RangeParams, SensorSpec};
 pub use drive::{DriveKind, DriveSpec};
 pub use fiducial::{
-    CirclePlacement, CirclesSpec, FiducialSpec, MarkersSpec, NamedColor, PyramidSpec, SteeringCoeffs, TwoBlockSpec,
+    CirclePlacement, CirclesSpec, FiducialKind, FiducialKinds, FiducialSpec, MarkersSpec, NamedColor, PyramidSpec,
+    SteeringCoeffs, TwoBlockSpec,
 };
 pub use geometry::{BodySpec, ConeSpec, DockSpec, SuccessSpec, TetherSpec};
 pub use perception::{ImprintSpec, PerceptionSpec, SegmentationMode};
 pub use pyramid_perception::{HsvBand, PyramidPerceptionSpec};
+pub use robot::RobotSpec;
 pub use tree::{NodeSpec, TreeSpec};
 
 use crate::arbiter::{LoopConfig, Staleness};
@@ -69,7 +69,11 @@ pub struct Profile {
     /// Dock geometry (absent for profiles that do not dock).
     #[serde(default)]
     pub dock: Option<DockSpec>,
-    /// Visual target.
+    /// The robot kind that runs this platform, and its tuning (absent: a platform that
+    /// runs no behavior, only perception).
+    #[serde(default)]
+    pub robot: Option<RobotSpec>,
+    /// Visual target: a registered kind and its fields.
     pub fiducial: FiducialSpec,
     /// Colour perception settings (defaults: the paper's values, see
     /// [`PerceptionSpec::default`]).
@@ -84,7 +88,8 @@ pub struct Profile {
     /// Actuators beyond drive, tether, arm, lights, guides and posture (see [`devices`]).
     #[serde(default)]
     pub actuators: Vec<ActuatorSpec>,
-    /// Behavior selection and gains.
+    /// The behavior tree and the limits its leaves share.
+    #[serde(default)]
     pub behavior: BehaviorSpec,
     /// Loop timing.
     #[serde(rename = "loop")]
@@ -110,12 +115,9 @@ impl Validate for Profile {
             c.validate_at(v, &format!("cameras[{i}]"));
         }
         if let Some(d) = &self.dock {
-            geometry::validate_dock(d, &self.body, self.fiducial.pyramid.is_some(), v);
+            geometry::validate_dock(d, &self.body, self.fiducial.kind() == PyramidSpec::KIND, v);
             geometry::validate_cone_arm(d, self.tether.as_ref(), &self.body, v);
-        } else if self.behavior.approach != ApproachKind::None {
-            v.problem("behavior.approach", "a docking approach needs a [dock] table");
         }
-        fiducial::validate_fiducial(&self.fiducial, v);
         perception::validate_perception(&self.perception, v);
         if let Some(t) = &self.tether {
             geometry::validate_tether(t, v);
@@ -134,25 +136,60 @@ impl Validate for Profile {
 }
 
 impl Profile {
-    /// Loads and validates a profile file.
+    /// Loads and validates a profile file whose fiducial is one of the crate's kinds
+    /// ([`FiducialKinds::builtin`]).
     ///
     /// # Errors
     /// [`ConfigError`] naming the file, field path, line and expectation.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        Self::parse(&config::read_source(path)?, path)
+        Self::load_with(path, &FiducialKinds::builtin())
     }
 
-    /// Parses and validates profile text; `file` is used in messages.
+    /// Loads and validates a profile file whose fiducial is one of `kinds`.
+    ///
+    /// # Errors
+    /// As [`Profile::load`].
+    pub fn load_with(path: &Path, kinds: &FiducialKinds) -> Result<Self, ConfigError> {
+        Self::parse_with(&config::read_source(path)?, path, kinds)
+    }
+
+    /// Parses and validates profile text (the crate's fiducial kinds); `file` is used in
+    /// messages.
     ///
     /// # Errors
     /// As [`Profile::load`].
     pub fn parse(src: &str, file: &Path) -> Result<Self, ConfigError> {
+        Self::parse_with(src, file, &FiducialKinds::builtin())
+    }
+
+    /// Parses and validates profile text whose fiducial is one of `kinds`.
+    ///
+    /// # Errors
+    /// As [`Profile::load`]; the fiducial's own problems (an unknown kind, a field of
+    /// another kind, a value out of range) are listed with the others.
+    pub fn parse_with(src: &str, file: &Path, kinds: &FiducialKinds) -> Result<Self, ConfigError> {
         let mut p: Self = config::parse_str(src, file)?;
         p.source = Some(std::sync::Arc::new(ProfileSource {
             file: file.to_path_buf(),
             text: src.to_string(),
         }));
-        Ok(p)
+        let problems = p.checked(|p, v| kinds.resolve(&mut p.fiducial, v));
+        if problems.is_empty() {
+            Ok(p)
+        } else {
+            Err(p.problems(problems))
+        }
+    }
+
+    /// Runs `check` with a validator over this profile's source (so problems it reports
+    /// name their lines), and returns what it found as (path, message) pairs.
+    fn checked(&mut self, check: impl FnOnce(&mut Self, &mut Validator<'_>)) -> Vec<(String, String)> {
+        let source = self.source.clone();
+        let text = source.as_ref().map_or("", |s| s.text.as_str());
+        let doc = toml::de::DeTable::parse(text).ok();
+        let mut v = Validator::new(text, doc.as_ref().map(|d| d.get_ref()));
+        check(self, &mut v);
+        v.into_problems().into_iter().map(|p| (p.path, p.message)).collect()
     }
 
     /// Reports problems found after loading (when a behavior tree is built) the way
@@ -164,17 +201,17 @@ impl Profile {
         };
         let doc = toml::de::DeTable::parse(text).ok();
         let v = config::Validator::new(text, doc.as_ref().map(|d| d.get_ref()));
-        ConfigError::Invalid {
-            file,
-            problems: problems
-                .into_iter()
-                .map(|(path, message)| config::Problem {
-                    line: v.line_of(&path),
-                    path,
-                    message,
-                })
-                .collect(),
-        }
+        let mut problems: Vec<config::Problem> = problems
+            .into_iter()
+            .map(|(path, message)| config::Problem {
+                line: v.line_of(&path),
+                path,
+                message,
+            })
+            .collect();
+        // In file order, so a reader fixes them top to bottom.
+        problems.sort_by_key(|p| p.line.unwrap_or(usize::MAX));
+        ConfigError::Invalid { file, problems }
     }
 
     /// The reactive loop's configuration for this platform.

@@ -68,17 +68,22 @@ impl Session {
             let mut lp: ReactiveLoop<dyn Agent> = ReactiveLoop::new(agent, config);
             lp.begin(&Mission::docking()).map_err(|e| setup(&e.to_string()))?;
             Runner::Behavior(Box::new(lp))
-        } else if profile.fiducial.two_block.is_some() {
+        } else if profile
+            .fiducial
+            .get::<crate::profile::TwoBlockSpec>()
+            .copied()
+            .is_some()
+        {
             Runner::Perception(Perception::TwoBlock(Box::new(
                 TwoBlockSchema::from_profile(profile, 0).map_err(vision)?,
             )))
-        } else if profile.fiducial.pyramid.is_some() {
+        } else if profile.fiducial.get::<crate::profile::PyramidSpec>().copied().is_some() {
             Runner::Perception(Perception::Pyramid(Box::new(
                 PyramidSchema::from_profile(profile, 0).map_err(vision)?,
             )))
         } else {
             return Err(setup(
-                "replay runs the two-block or pyramid perceptual schema; the profile has neither [fiducial.two_block] nor [fiducial.pyramid] (use --behavior to run its agent)",
+                "replay runs the two-block or pyramid perceptual schema; the profile has neither `two_block` fiducial nor `pyramid` fiducial (use --behavior to run its agent)",
             ));
         };
         Ok(Self { runner, camera_size })

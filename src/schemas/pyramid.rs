@@ -95,7 +95,7 @@ impl PyramidSchema {
         }
     }
 
-    /// Builds the schema for camera `camera` of a profile with a `[fiducial.pyramid]`
+    /// Builds the schema for camera `camera` of a profile with a `pyramid` fiducial
     /// (see [`PyramidTrackerParams::from_profile`]). Allocates only here.
     ///
     /// # Errors

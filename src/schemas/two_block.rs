@@ -95,7 +95,7 @@ impl TwoBlockSchema {
     }
 
     /// Builds the schema for camera `camera` of `profile`, which needs a
-    /// `[fiducial.two_block]` (see [`TwoBlockParams::from_profile`]).
+    /// `two_block` fiducial (see [`TwoBlockParams::from_profile`]).
     ///
     /// # Errors
     /// [`VisionError::Profile`] when the profile has no two-block fiducial or no such camera.

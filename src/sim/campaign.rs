@@ -33,7 +33,7 @@ use super::tether::TetherTally;
 use super::world::{self, World};
 use crate::behaviors::BuildError;
 use crate::perception::RgbImage;
-use crate::profile::{NamedColor, Profile};
+use crate::profile::{NamedColor, Profile, TwoBlockSpec};
 use crate::schemas::Agent;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -285,9 +285,12 @@ pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
 /// `None` or a profile without a two-block flap.
 fn repainted(profile: &Profile, colors: Option<[NamedColor; 2]>) -> Profile {
     let mut p = profile.clone();
-    if let (Some(fid), Some([left, right])) = (p.fiducial.two_block.as_mut(), colors) {
-        fid.left_color = left;
-        fid.right_color = right;
+    if let (Some(&fid), Some([left, right])) = (p.fiducial.get::<TwoBlockSpec>(), colors) {
+        p.fiducial.set(TwoBlockSpec {
+            left_color: left,
+            right_color: right,
+            ..fid
+        });
     }
     p
 }

@@ -414,7 +414,7 @@ impl Sim {
     }
 
     fn robot_shadow(&self, light: &mut LightState) {
-        let Some(f) = self.profile.fiducial.two_block else {
+        let Some(f) = self.profile.fiducial.get::<crate::profile::TwoBlockSpec>().copied() else {
             return;
         };
         let (s, level) = light.sun();

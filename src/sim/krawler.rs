@@ -138,7 +138,11 @@ impl Gear {
             .wheel_radius_m
             .ok_or_else(|| missing("drive.wheel_radius_m"))?;
         let camera = profile.cameras.first().ok_or_else(|| missing("camera"))?;
-        let markers = profile.fiducial.markers.ok_or_else(|| missing("[fiducial.markers]"))?;
+        let markers = profile
+            .fiducial
+            .get::<crate::profile::MarkersSpec>()
+            .copied()
+            .ok_or_else(|| missing("`markers` fiducial"))?;
         if markers.count != 8 {
             return Err(SimError::Unsupported(format!(
                 "the gear carries 8 markers (two per axle plate and tie rod); profile `{}` asks for {}",
@@ -173,7 +177,7 @@ pub struct KrawlerScene {
 ///
 /// # Errors
 /// [`SimError::Unsupported`] for a profile without a double-Ackermann drive, a wheel
-/// radius, a camera, or eight `[fiducial.markers]`.
+/// radius, a camera, or eight `markers` fiducial.
 pub fn build(profile: &Profile, state: &KrawlerState) -> Result<KrawlerScene, SimError> {
     build_with(profile, state, &GearExtras::default())
 }
@@ -503,7 +507,11 @@ pub fn expected_markers(profile: &Profile, state: &KrawlerState) -> Result<[Expe
     let cam = &profile.cameras[0];
     let model = crate::perception::CameraModel::from_spec(cam);
     let pose = super::camera::camera_pose(&crate::geometry::Pose2::new(0.0, 0.0, 0.0), &cam.mount);
-    let side = profile.fiducial.markers.map_or(0.03, |m| m.side_m);
+    let side = profile
+        .fiducial
+        .get::<crate::profile::MarkersSpec>()
+        .copied()
+        .map_or(0.03, |m| m.side_m);
     let project = |q: [f64; 3]| model.project(&pose.to_camera(&Point3::from(q)));
     let mut out = [ExpectedMarker {
         at: [0.0; 2],

@@ -14,7 +14,7 @@ use super::rng::Rng;
 use super::world::ClutterSpec;
 use crate::config::{self, ConfigError, Validate, Validator};
 use crate::geometry::Pose2;
-use crate::profile::{NamedColor, Profile, SegmentationMode};
+use crate::profile::{FiducialKinds, NamedColor, Profile, SegmentationMode};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -111,10 +111,10 @@ pub struct AxesSpec {
     /// Terrains.
     #[serde(default = "default_terrain")]
     pub terrain: Vec<Terrain>,
-    /// Paints of the two-block flap, `[left, right]` as `[fiducial.two_block]` names them
+    /// Paints of the two-block flap, `[left, right]` as `two_block` fiducial names them
     /// (`[["cyan", "magenta"], ["yellow", "blue"]]`): each run repaints the flap with one
     /// pair, in the world and in the profile the robot is built from (its table
-    /// defaults), as `[profile_patch.fiducial.two_block] left_color/right_color` would.
+    /// defaults), as `[profile_patch.fiducial.get::<crate::profile::TwoBlockSpec>().copied()] left_color/right_color` would.
     /// Absent: the profile's own paints, and the campaign is what it was without the axis.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fiducial_colors: Option<Vec<[NamedColor; 2]>>,
@@ -433,7 +433,7 @@ pub struct Scenario {
     pub profile: PathBuf,
     /// Changes to the profile for this experiment only, merged key by key into the
     /// profile's TOML before it is parsed and validated (see [`crate::config::patch`]):
-    /// `[profile_patch.fiducial.two_block] right_color = "yellow"` repaints one block and
+    /// `[profile_patch.fiducial.get::<crate::profile::TwoBlockSpec>().copied()] right_color = "yellow"` repaints one block and
     /// leaves every other setting following the profile file.
     #[serde(default)]
     pub profile_patch: Option<toml::Table>,
@@ -701,7 +701,12 @@ pub struct Loaded {
 /// Loads `profile_file` with a scenario's `[profile_patch]` merged in. Problems are
 /// reported against "the profile as patched by the scenario", without line numbers (the
 /// merged text exists only in memory).
-fn load_patched(profile_file: &Path, patch: &toml::Table, scenario_file: &Path) -> Result<Profile, ConfigError> {
+fn load_patched(
+    profile_file: &Path,
+    patch: &toml::Table,
+    scenario_file: &Path,
+    kinds: &FiducialKinds,
+) -> Result<Profile, ConfigError> {
     let src = config::read_source(profile_file)?;
     let shown = PathBuf::from(format!(
         "{} as patched by [profile_patch] in {}",
@@ -716,7 +721,7 @@ fn load_patched(profile_file: &Path, patch: &toml::Table, scenario_file: &Path) 
             message,
         }],
     })?;
-    Profile::parse(&text, &shown).map_err(|e| match e {
+    Profile::parse_with(&text, &shown, kinds).map_err(|e| match e {
         ConfigError::Invalid { file, problems } => ConfigError::Invalid {
             file,
             problems: problems
@@ -798,21 +803,36 @@ impl Scenario {
     /// # Errors
     /// [`ConfigError`] for the scenario or its profile.
     pub fn load(path: &Path) -> Result<Loaded, ConfigError> {
+        Self::load_with(path, &FiducialKinds::builtin())
+    }
+
+    /// [`Scenario::load`] for a profile whose fiducial is one of `kinds` (a catalog's:
+    /// [`crate::behaviors::Catalog::fiducials`]).
+    ///
+    /// # Errors
+    /// As [`Scenario::load`].
+    pub fn load_with(path: &Path, kinds: &FiducialKinds) -> Result<Loaded, ConfigError> {
         let scenario: Scenario = config::load(path)?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let profile_file = dir.join(&scenario.profile);
         let profile = match &scenario.profile_patch {
-            None => Profile::load(&profile_file)?,
-            Some(patch) => load_patched(&profile_file, patch, path)?,
+            None => Profile::load_with(&profile_file, kinds)?,
+            Some(patch) => load_patched(&profile_file, patch, path, kinds)?,
         };
-        if scenario.axes.fiducial_colors.is_some() && profile.fiducial.two_block.is_none() {
+        if scenario.axes.fiducial_colors.is_some()
+            && profile
+                .fiducial
+                .get::<crate::profile::TwoBlockSpec>()
+                .copied()
+                .is_none()
+        {
             return Err(ConfigError::Invalid {
                 file: path.to_path_buf(),
                 problems: vec![config::Problem {
                     path: "axes.fiducial_colors".into(),
                     line: None,
                     message: format!(
-                        "repaints a two-block flap, but profile `{}` has no [fiducial.two_block]",
+                        "repaints a two-block flap, but profile `{}` has no `two_block` fiducial",
                         profile.name
                     ),
                 }],

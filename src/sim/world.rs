@@ -8,7 +8,7 @@ use super::dock::Cone;
 use super::obstacles::{Footprint, Obstacles};
 use super::scene::{CircleMark, Material, Prim, Scene, Shape, Tag, albedo, boxed};
 use crate::perception::RgbImage;
-use crate::profile::{CirclePlacement, CirclesSpec, NamedColor, Profile};
+use crate::profile::{CirclePlacement, CirclesSpec, FiducialKind, NamedColor, Profile, PyramidSpec, TwoBlockSpec};
 use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
@@ -76,7 +76,7 @@ pub enum ClutterKind {
     FiducialCopy,
     /// A copy of the fiducial turned upside down (rotated 180° in its plane).
     FiducialCopyUpsideDown,
-    /// One circle mark of a `[fiducial.circles]` profile (its diameter and pattern, the
+    /// One circle mark of a `circles`-fiducial profile (its diameter and pattern, the
     /// bar at `mark_rotation_deg`) on an upright panel of `size_m` (width, height) in
     /// `color` (default: the module's grey): a false mark near the module, the kind of
     /// circle-like blob seed 000's correspondence had to reject.
@@ -168,9 +168,31 @@ pub fn build(profile: &Profile, clutter: &[ClutterSpec], backdrops: &[Arc<RgbIma
     build_face(profile, clutter, backdrops, &[], &[])
 }
 
+/// [`build`] with `painters` drawing the dock (a crate's own fiducial kinds).
+///
+/// # Errors
+/// [`SimError::Unsupported`] for a fiducial kind no painter draws.
+pub fn build_with(
+    profile: &Profile,
+    clutter: &[ClutterSpec],
+    backdrops: &[Arc<RgbImage>],
+    painters: &DockPainters,
+) -> Result<World, SimError> {
+    paint_world(
+        profile,
+        clutter,
+        backdrops,
+        FaceMarks {
+            covered: &[],
+            painted: &[],
+        },
+        painters,
+    )
+}
+
 /// [`build`], with the module's face edited for `marsupial pose-trials`' occlusion
-/// campaigns (ignored by a profile without `[fiducial.circles]`):
-/// * the circle marks `covered` (indices into `[fiducial.circles].placements`) are covered
+/// campaigns (ignored by a profile without `circles` fiducial):
+/// * the circle marks `covered` (indices into ``circles` fiducial.placements`) are covered
 ///   flush with a patch of the face's paint: the module keeps its size and the other
 ///   marks, and those are not painted;
 /// * `painted` false marks are painted on the face among the real ones: circle marks of
@@ -190,6 +212,24 @@ pub fn build_face(
     backdrops: &[Arc<RgbImage>],
     covered: &[usize],
     painted: &[CirclePlacement],
+) -> Result<World, SimError> {
+    paint_world(
+        profile,
+        clutter,
+        backdrops,
+        FaceMarks { covered, painted },
+        &DockPainters::builtin(),
+    )
+}
+
+/// Builds the world: the dock `painters` draw for the profile's fiducial kind, the
+/// clutter, the backdrop walls.
+fn paint_world(
+    profile: &Profile,
+    clutter: &[ClutterSpec],
+    backdrops: &[Arc<RgbImage>],
+    face: FaceMarks<'_>,
+    painters: &DockPainters,
 ) -> Result<World, SimError> {
     let mut prims = Vec::new();
     let mut target_prims = Vec::new();
@@ -223,155 +263,22 @@ pub fn build_face(
             tip_height: t.tip_height_m,
         });
     }
-    let body_grey = albedo([70, 72, 75], 1.0);
-    if let Some(fid) = profile.fiducial.two_block {
-        // Silver Bullet's rear: a box body with the pouch opening at x = 0, the flap over it.
-        dock.needs_lowered = true;
-        let (h, w2) = (0.75, dock.body_half_width);
-        let top = fid.center_height_m + fid.height_m / 2.0 + 0.08;
-        let bottom = (fid.center_height_m - fid.height_m / 2.0 - 0.04).max(0.02);
-        let mut body = boxed(
-            Point3::new(-dock.body_length, -w2, 0.05),
-            Point3::new(0.0, w2, h),
-            Material::Solid(body_grey),
-            Tag::Body,
-        );
-        body.remove(0); // the rear face is rebuilt around the opening
-        prims.extend(body);
-        let rear = |y0: f64, y1: f64, z0: f64, z1: f64| {
-            Prim::new(
-                Shape::Rect {
-                    centre: Point3::new(0.0, (y0 + y1) / 2.0, (z0 + z1) / 2.0),
-                    u: y_axis(),
-                    v: z_axis(),
-                    half: [(y1 - y0) / 2.0, (z1 - z0) / 2.0],
-                },
-                Material::Solid(body_grey),
-                Tag::Body,
-            )
-        };
-        prims.push(rear(-w2, -entrance_half, 0.05, h));
-        prims.push(rear(entrance_half, w2, 0.05, h));
-        prims.push(rear(-entrance_half, entrance_half, top, h));
-        // The dark pouch behind the flap, and the gate folded down as a ramp.
-        prims.push(Prim::new(
-            Shape::Rect {
-                centre: Point3::new(-0.01, 0.0, (bottom + top) / 2.0),
-                u: y_axis(),
-                v: z_axis(),
-                half: [entrance_half, (top - bottom) / 2.0],
-            },
-            Material::Solid(albedo([20, 20, 22], 1.0)),
-            Tag::Body,
-        ));
-        let ramp_len: f64 = 0.35;
-        let slope = (bottom / ramp_len).atan();
-        prims.push(Prim::new(
-            Shape::Rect {
-                centre: Point3::new(ramp_len / 2.0, 0.0, bottom / 2.0),
-                u: y_axis(),
-                v: Vector3::new(-slope.cos(), 0.0, slope.sin()),
-                half: [entrance_half + 0.03, ramp_len / 2.0 / slope.cos()],
-            },
-            Material::Noise {
-                base: albedo([110, 110, 112], 1.0),
-                contrast: 0.15,
-                cell: 0.01,
-            },
-            Tag::Body,
-        ));
-        // The flap: left colour on the viewer's left (world −y) when facing it from +x.
-        target_prims.push(prims.len());
-        let mut flap = Prim::new(
-            Shape::Rect {
-                centre: Point3::new(0.004, 0.0, fid.center_height_m),
-                u: y_axis(),
-                v: z_axis(),
-                half: [fid.width_m / 2.0, fid.height_m / 2.0],
-            },
-            Material::TwoBlock {
-                left: paint(fid.left_color),
-                right: paint(fid.right_color),
-            },
-            Tag::Target,
-        );
-        flap.gloss = 0.6;
-        prims.push(flap);
-    } else if let Some(pyr) = profile.fiducial.pyramid {
-        // RAPOSA's tether-end pyramid lying on the ground, its axis along +x: the orange
-        // guide ball at the origin (what enters the socket), a grey pyramid body tapering
-        // back from it, and at distance m behind the ball a square frame of blue-painted
-        // edges of side h, centred at the ball's height (seed 001 Fig. 1, 2, 6). The frame
-        // bars have depth, so the edges stay visible (thin) even side-on.
-        let (h, m, r) = (pyr.blue_edge_length_m, pyr.edge_to_ball_m, pyr.ball_diameter_m / 2.0);
-        let zc = pyr.ball_height_m.max(h / 2.0);
-        dock.open = true;
-        dock.body_length = 0.0;
-        dock.body_half_width = 0.0;
-        dock.target_extent = Some([-m - 0.03, r, -h / 2.0 - 0.01, h / 2.0 + 0.01]);
-        let grey = Material::Solid(albedo([150, 150, 150], 1.0));
-        let b = 0.35 * h;
-        let base = [(-b, -b), (-b, b), (b, b), (b, -b)].map(|(y, dz)| Point3::new(-m, y, zc + dz));
-        let apex = Point3::new(0.0, 0.0, zc);
-        for i in 0..4 {
-            let mut t = Prim::new(
-                Shape::Triangle {
-                    p: [base[i], base[(i + 1) % 4], apex],
-                },
-                grey.clone(),
-                Tag::Target,
-            );
-            t.two_sided = true;
-            target_prims.push(prims.len());
-            prims.push(t);
-        }
-        let blue = Material::Solid(paint(pyr.edge_color));
-        let (bar, depth) = (0.15 * h, 0.02);
-        let (x0, x1) = (-m - depth / 2.0, -m + depth / 2.0);
-        let (y0, y1, z0, z1) = (-h / 2.0, h / 2.0, zc - h / 2.0, zc + h / 2.0);
-        for (lo, hi) in [
-            ((y0, z0), (y0 + bar, z1)),             // one side
-            ((y1 - bar, z0), (y1, z1)),             // other side
-            ((y0 + bar, z1 - bar), (y1 - bar, z1)), // top
-            ((y0 + bar, z0), (y1 - bar, z0 + bar)), // bottom
-        ] {
-            for p in boxed(
-                Point3::new(x0, lo.0, lo.1),
-                Point3::new(x1, hi.0, hi.1),
-                blue.clone(),
-                Tag::Target,
-            ) {
-                target_prims.push(prims.len());
-                prims.push(p);
-            }
-        }
-        target_prims.push(prims.len());
-        let mut ball = Prim::new(
-            Shape::Sphere {
-                centre: Point3::new(0.0, 0.0, zc),
-                radius: r,
-            },
-            Material::Solid(paint(pyr.ball_color)),
-            Tag::Target,
-        );
-        ball.gloss = 0.3;
-        prims.push(ball);
-        // The tether leaves the pyramid's back along the ground.
-        prims.extend(boxed(
-            Point3::new(-2.9, -0.01, 0.0),
-            Point3::new(-m - depth, 0.01, 0.012),
-            Material::Solid(albedo([30, 30, 32], 1.0)),
-            Tag::Body,
-        ));
-    } else if let Some(circles) = &profile.fiducial.circles {
-        let face = FaceMarks { covered, painted };
-        build_central_module(circles, face, &mut dock, &mut prims, &mut target_prims, body_grey);
-    } else {
-        return Err(SimError::Unsupported(format!(
-            "the simulator builds two-block, pyramid and circle targets so far; profile `{}` has another fiducial",
-            profile.name
-        )));
-    }
+    let painter = painters.get(profile.fiducial.kind()).ok_or_else(|| {
+        let known: Vec<&str> = painters.kinds().collect();
+        SimError::Unsupported(format!(
+            "the simulator has no dock painter for fiducial kind `{}` (profile `{}`; painters: {})",
+            profile.fiducial.kind(),
+            profile.name,
+            known.join(", ")
+        ))
+    })?;
+    painter(&mut DockCanvas {
+        profile,
+        prims: &mut prims,
+        target_prims: &mut target_prims,
+        dock: &mut dock,
+        face,
+    })?;
     for c in clutter {
         add_clutter(&mut prims, c, profile);
     }
@@ -432,6 +339,266 @@ pub fn build_face(
     })
 }
 
+/// The grey of a mother's or a module's painted body.
+const BODY_GREY: [u8; 3] = [70, 72, 75];
+
+/// What a dock painter paints on: the scene's primitives (the dock's body and its
+/// fiducial, in the dock frame of the module docs), the indices of the fiducial's
+/// primitives, and the 2-D geometry the judge and motion model use.
+pub struct DockCanvas<'a> {
+    /// The profile whose dock is painted.
+    pub profile: &'a Profile,
+    /// The scene's primitives so far (append to them).
+    pub prims: &'a mut Vec<Prim>,
+    /// Indices into `prims` of the fiducial's primitives (for shadows and tests).
+    pub target_prims: &'a mut Vec<usize>,
+    /// The dock's geometry, preset from `[dock]` and `[success]`: a painter sets what its
+    /// dock differs in (a body's size, an open target, a cone).
+    pub dock: &'a mut DockGeometry,
+    /// Marks a perception campaign covers or paints on a module's face
+    /// ([`build_face`]); painters of other kinds ignore them.
+    pub face: FaceMarks<'a>,
+}
+
+/// Paints one fiducial kind's dock ([`DockCanvas`]).
+pub type DockPainter = dyn Fn(&mut DockCanvas<'_>) -> Result<(), SimError> + Send + Sync;
+
+/// The dock painters by fiducial kind: how the simulator draws the dock of a profile
+/// whose `[fiducial] kind` names them. [`DockPainters::builtin`] paints the crate's
+/// kinds; a crate with a fiducial kind of its own registers a painter for it to run its
+/// robot in the simulator.
+#[derive(Clone)]
+pub struct DockPainters(std::collections::BTreeMap<String, Arc<DockPainter>>);
+
+impl Default for DockPainters {
+    fn default() -> Self {
+        Self::builtin()
+    }
+}
+
+impl std::fmt::Debug for DockPainters {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.0.keys()).finish()
+    }
+}
+
+impl DockPainters {
+    /// Painters of the crate's fiducial kinds: Silver Bullet's rear with the two-block
+    /// flap, RAPOSA's pyramid on the ground, Axel's central module with its circles.
+    pub fn builtin() -> Self {
+        let mut p = Self(Default::default());
+        p.register(TwoBlockSpec::KIND, paint_two_block)
+            .register(PyramidSpec::KIND, paint_pyramid)
+            .register(CirclesSpec::KIND, paint_circles);
+        p
+    }
+
+    /// Registers (or replaces) the painter of fiducial kind `kind`.
+    pub fn register(
+        &mut self,
+        kind: impl Into<String>,
+        painter: impl Fn(&mut DockCanvas<'_>) -> Result<(), SimError> + Send + Sync + 'static,
+    ) -> &mut Self {
+        self.0.insert(kind.into(), Arc::new(painter));
+        self
+    }
+
+    /// The painter of `kind`.
+    pub fn get(&self, kind: &str) -> Option<&DockPainter> {
+        self.0.get(kind).map(|p| p.as_ref())
+    }
+
+    /// The kinds painted, sorted.
+    pub fn kinds(&self) -> impl Iterator<Item = &str> {
+        self.0.keys().map(String::as_str)
+    }
+}
+
+/// Silver Bullet's rear: a box body with the pouch opening at x = 0, the two-block flap
+/// over it.
+fn paint_two_block(c: &mut DockCanvas<'_>) -> Result<(), SimError> {
+    let fid = *c
+        .profile
+        .fiducial
+        .require::<TwoBlockSpec>()
+        .map_err(SimError::Unsupported)?;
+    let (dock, prims, target_prims) = (&mut *c.dock, &mut *c.prims, &mut *c.target_prims);
+    let entrance_half = dock.entrance_half;
+    let body_grey = albedo(BODY_GREY, 1.0);
+    dock.needs_lowered = true;
+    let (h, w2) = (0.75, dock.body_half_width);
+    let top = fid.center_height_m + fid.height_m / 2.0 + 0.08;
+    let bottom = (fid.center_height_m - fid.height_m / 2.0 - 0.04).max(0.02);
+    let mut body = boxed(
+        Point3::new(-dock.body_length, -w2, 0.05),
+        Point3::new(0.0, w2, h),
+        Material::Solid(body_grey),
+        Tag::Body,
+    );
+    body.remove(0); // the rear face is rebuilt around the opening
+    prims.extend(body);
+    let rear = |y0: f64, y1: f64, z0: f64, z1: f64| {
+        Prim::new(
+            Shape::Rect {
+                centre: Point3::new(0.0, (y0 + y1) / 2.0, (z0 + z1) / 2.0),
+                u: y_axis(),
+                v: z_axis(),
+                half: [(y1 - y0) / 2.0, (z1 - z0) / 2.0],
+            },
+            Material::Solid(body_grey),
+            Tag::Body,
+        )
+    };
+    prims.push(rear(-w2, -entrance_half, 0.05, h));
+    prims.push(rear(entrance_half, w2, 0.05, h));
+    prims.push(rear(-entrance_half, entrance_half, top, h));
+    // The dark pouch behind the flap, and the gate folded down as a ramp.
+    prims.push(Prim::new(
+        Shape::Rect {
+            centre: Point3::new(-0.01, 0.0, (bottom + top) / 2.0),
+            u: y_axis(),
+            v: z_axis(),
+            half: [entrance_half, (top - bottom) / 2.0],
+        },
+        Material::Solid(albedo([20, 20, 22], 1.0)),
+        Tag::Body,
+    ));
+    let ramp_len: f64 = 0.35;
+    let slope = (bottom / ramp_len).atan();
+    prims.push(Prim::new(
+        Shape::Rect {
+            centre: Point3::new(ramp_len / 2.0, 0.0, bottom / 2.0),
+            u: y_axis(),
+            v: Vector3::new(-slope.cos(), 0.0, slope.sin()),
+            half: [entrance_half + 0.03, ramp_len / 2.0 / slope.cos()],
+        },
+        Material::Noise {
+            base: albedo([110, 110, 112], 1.0),
+            contrast: 0.15,
+            cell: 0.01,
+        },
+        Tag::Body,
+    ));
+    // The flap: left colour on the viewer's left (world −y) when facing it from +x.
+    target_prims.push(prims.len());
+    let mut flap = Prim::new(
+        Shape::Rect {
+            centre: Point3::new(0.004, 0.0, fid.center_height_m),
+            u: y_axis(),
+            v: z_axis(),
+            half: [fid.width_m / 2.0, fid.height_m / 2.0],
+        },
+        Material::TwoBlock {
+            left: paint(fid.left_color),
+            right: paint(fid.right_color),
+        },
+        Tag::Target,
+    );
+    flap.gloss = 0.6;
+    prims.push(flap);
+    Ok(())
+}
+
+/// RAPOSA's tether-end pyramid lying on the ground (an open dock).
+fn paint_pyramid(c: &mut DockCanvas<'_>) -> Result<(), SimError> {
+    let pyr = *c
+        .profile
+        .fiducial
+        .require::<PyramidSpec>()
+        .map_err(SimError::Unsupported)?;
+    let (dock, prims, target_prims) = (&mut *c.dock, &mut *c.prims, &mut *c.target_prims);
+    // RAPOSA's tether-end pyramid lying on the ground, its axis along +x: the orange
+    // guide ball at the origin (what enters the socket), a grey pyramid body tapering
+    // back from it, and at distance m behind the ball a square frame of blue-painted
+    // edges of side h, centred at the ball's height (seed 001 Fig. 1, 2, 6). The frame
+    // bars have depth, so the edges stay visible (thin) even side-on.
+    let (h, m, r) = (pyr.blue_edge_length_m, pyr.edge_to_ball_m, pyr.ball_diameter_m / 2.0);
+    let zc = pyr.ball_height_m.max(h / 2.0);
+    dock.open = true;
+    dock.body_length = 0.0;
+    dock.body_half_width = 0.0;
+    dock.target_extent = Some([-m - 0.03, r, -h / 2.0 - 0.01, h / 2.0 + 0.01]);
+    let grey = Material::Solid(albedo([150, 150, 150], 1.0));
+    let b = 0.35 * h;
+    let base = [(-b, -b), (-b, b), (b, b), (b, -b)].map(|(y, dz)| Point3::new(-m, y, zc + dz));
+    let apex = Point3::new(0.0, 0.0, zc);
+    for i in 0..4 {
+        let mut t = Prim::new(
+            Shape::Triangle {
+                p: [base[i], base[(i + 1) % 4], apex],
+            },
+            grey.clone(),
+            Tag::Target,
+        );
+        t.two_sided = true;
+        target_prims.push(prims.len());
+        prims.push(t);
+    }
+    let blue = Material::Solid(paint(pyr.edge_color));
+    let (bar, depth) = (0.15 * h, 0.02);
+    let (x0, x1) = (-m - depth / 2.0, -m + depth / 2.0);
+    let (y0, y1, z0, z1) = (-h / 2.0, h / 2.0, zc - h / 2.0, zc + h / 2.0);
+    for (lo, hi) in [
+        ((y0, z0), (y0 + bar, z1)),             // one side
+        ((y1 - bar, z0), (y1, z1)),             // other side
+        ((y0 + bar, z1 - bar), (y1 - bar, z1)), // top
+        ((y0 + bar, z0), (y1 - bar, z0 + bar)), // bottom
+    ] {
+        for p in boxed(
+            Point3::new(x0, lo.0, lo.1),
+            Point3::new(x1, hi.0, hi.1),
+            blue.clone(),
+            Tag::Target,
+        ) {
+            target_prims.push(prims.len());
+            prims.push(p);
+        }
+    }
+    target_prims.push(prims.len());
+    let mut ball = Prim::new(
+        Shape::Sphere {
+            centre: Point3::new(0.0, 0.0, zc),
+            radius: r,
+        },
+        Material::Solid(paint(pyr.ball_color)),
+        Tag::Target,
+    );
+    ball.gloss = 0.3;
+    prims.push(ball);
+    // The tether leaves the pyramid's back along the ground.
+    prims.extend(boxed(
+        Point3::new(-2.9, -0.01, 0.0),
+        Point3::new(-m - depth, 0.01, 0.012),
+        Material::Solid(albedo([30, 30, 32], 1.0)),
+        Tag::Body,
+    ));
+    Ok(())
+}
+
+/// Axel's central module with its circle marks ([`build_central_module`]).
+fn paint_circles(c: &mut DockCanvas<'_>) -> Result<(), SimError> {
+    let circles = c
+        .profile
+        .fiducial
+        .require::<CirclesSpec>()
+        .map_err(SimError::Unsupported)?;
+    let face = FaceMarks {
+        covered: c.face.covered,
+        painted: c.face.painted,
+    };
+    build_central_module(circles, face, c.dock, c.prims, c.target_prims, albedo(BODY_GREY, 1.0));
+    Ok(())
+}
+
+/// Which of the layout's marks the face shows, and what false marks it adds.
+#[derive(Clone, Copy)]
+pub struct FaceMarks<'a> {
+    /// Layout indices not painted.
+    pub covered: &'a [usize],
+    /// False marks painted besides the layout's.
+    pub painted: &'a [CirclePlacement],
+}
+
 /// Axel's central module (seed 000): a box body whose front face (x = 0, facing +x)
 /// carries the circle fiducials at their placements, above the funnel-like docking cone.
 /// The cone's mouth (drawn square, `entrance_width_m` on a side, about the cone's axis
@@ -439,15 +606,6 @@ pub fn build_face(
 /// a `[dock.cone]` table the mouth sits on the ground. The body is 1 m deep and wide
 /// enough for the mouth and the marks; it is tall enough for the highest mark. The
 /// station's forward tilt acts in the contact model ([`Cone`]) but is not drawn.
-/// Which of the layout's marks the face shows, and what false marks it adds.
-#[derive(Clone, Copy)]
-struct FaceMarks<'a> {
-    /// Layout indices not painted.
-    covered: &'a [usize],
-    /// False marks painted besides the layout's.
-    painted: &'a [CirclePlacement],
-}
-
 fn build_central_module(
     circles: &CirclesSpec,
     face: FaceMarks<'_>,
@@ -584,7 +742,7 @@ fn add_clutter(prims: &mut Vec<Prim>, c: &ClutterSpec, profile: &Profile) {
             prims.push(p);
         }
         ClutterKind::FiducialCopy | ClutterKind::FiducialCopyUpsideDown => {
-            if let Some(f) = profile.fiducial.two_block {
+            if let Some(f) = profile.fiducial.get::<crate::profile::TwoBlockSpec>().copied() {
                 let upside_down = c.kind == ClutterKind::FiducialCopyUpsideDown;
                 // Turning the flap 180° in its plane puts the right colour on the left.
                 let (left, right) = if upside_down {
@@ -609,7 +767,7 @@ fn add_clutter(prims: &mut Vec<Prim>, c: &ClutterSpec, profile: &Profile) {
             }
         }
         ClutterKind::CircleMark => {
-            if let Some(f) = &profile.fiducial.circles {
+            if let Some(f) = profile.fiducial.get::<crate::profile::CirclesSpec>() {
                 let base = c.color.map(paint).unwrap_or(albedo([70, 72, 75], 1.0));
                 let mark = CircleMark::new(0.0, 0.0, c.mark_rotation_deg.to_radians() as f32);
                 let mut p = Prim::new(

@@ -264,7 +264,10 @@ pub fn circle_mark(im: &mut RgbImage, cx: f64, cy: f64, r: f64, rot_deg: f64) {
 pub fn axel_marks_frame(w: usize, h: usize, px_per_m: f64, centre: [f64; 2]) -> RgbImage {
     let mut im = background(w, h);
     let p = shipped_profile("axel");
-    let c = p.fiducial.circles.expect("axel has circles");
+    let c = p
+        .fiducial
+        .get::<marsupial::profile::CirclesSpec>()
+        .expect("axel has circles");
     for pl in &c.placements {
         let x = centre[0] + px_per_m * pl.y_m;
         let y = centre[1] - px_per_m * (pl.z_m - 0.6);

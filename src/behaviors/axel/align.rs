@@ -3,7 +3,7 @@
 //! facing it, the arm's tip `look_m` from the cone's mouth, the penultimate step from
 //! which the paper's stereo pose was trusted to end the docking (§IV). It drives one
 //! step of at most `step_m`, then looks again. At the look pose (within `arrive_m`) it
-//! checks the alignment: the heading within `behavior.two_arc.heading_tolerance_deg`
+//! checks the alignment: the heading within `robot.two_arc.heading_tolerance_deg`
 //! (±5°, §V-B) and the gate of `[success]` (the tip's lateral offset and the arm's angle
 //! to the cone's axis); aligned, it commits to mating (event `aligned`, the pose kept in
 //! [`Memory::commit`]). A plan is finished before it is judged: one step drives one arc,

@@ -2,7 +2,7 @@
 //! ([`Memory::commit`]), the markers now too close to identify, the rover drives blind
 //! by odometry straight in until its arm's tip is `standoff_m` from the cone's mouth,
 //! reeling in to the exposed length at its end (by the reel's reading); then it puts its
-//! wheels in free rotation and reels in until the reel's paid-out length is `behavior.two_arc.reel_in_m` short
+//! wheels in free rotation and reels in until the reel's paid-out length is `robot.two_arc.reel_in_m` short
 //! of the exposed length at the mouth (about 25 cm into the module, §II), the tether
 //! pulling the arm into the cone. The reel's own length reading decides, so slack left
 //! from the approach is taken up first. Whether it seated is the

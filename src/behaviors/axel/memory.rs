@@ -9,7 +9,7 @@
 //! quality figures. A schema trusts a sighting only by its quality ([`Trust`]).
 
 use super::stereo::Perception;
-use crate::behaviors::BuildError;
+use super::tuning::{AxelRobot, TwoArcGains};
 use crate::behaviors::composed::SharedMemory;
 use crate::geometry::Pose2;
 use crate::kinematics::tether_length::TetherGeometry;
@@ -131,23 +131,23 @@ pub fn dead_reckon(at: &Pose2, odo_then: &Pose2, odo_now: &Pose2) -> Pose2 {
 /// The planning geometry every schema shares, from the profile.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Geometry {
-    /// The regions (`[behavior.two_arc]` radii, `[dock]` approach radius and angle).
+    /// The regions (`[robot.two_arc]` radii, `[dock]` approach radius and angle).
     pub regions: Regions,
     /// The tether's anchor and the arm (`[tether]`).
     pub tether: TetherGeometry,
     /// The planner's limits; the field of view is the cameras', the per-arc turn cap
-    /// `behavior.two_arc.max_arc_turn_deg` (none when absent).
+    /// `robot.two_arc.max_arc_turn_deg` (none when absent).
     pub plan: PlanParams,
-    /// Speed along arcs, m/s (`behavior.two_arc.arc_speed_mps`).
+    /// Speed along arcs, m/s (`robot.two_arc.arc_speed_mps`).
     pub arc_speed: f64,
     /// The base's turn-rate limit, rad/s.
     pub max_turn_rate: f64,
     /// The reel's top rate, m/s.
     pub max_reel_rate: f64,
-    /// Heading tolerance before reeling, rad (`behavior.two_arc.heading_tolerance_deg`,
+    /// Heading tolerance before reeling, rad (`robot.two_arc.heading_tolerance_deg`,
     /// seed 000 §V-B ±5°).
     pub heading_tolerance: f64,
-    /// Tether reeled in past the cone's mouth while mating, m (`behavior.two_arc.reel_in_m`).
+    /// Tether reeled in past the cone's mouth while mating, m (`robot.two_arc.reel_in_m`).
     pub reel_in: f64,
     /// The commitment gate before mating: the arm tip's largest lateral offset from the
     /// cone's axis, m (`success.lateral_tolerance_m`).
@@ -160,19 +160,15 @@ pub struct Geometry {
 }
 
 impl Geometry {
-    /// The geometry of an Axel profile (`[dock]`, `[tether]`, `[behavior.two_arc]`, two
+    /// The geometry of an Axel profile (`[dock]`, `[tether]`, `[robot.two_arc]`, two
     /// cameras).
     ///
     /// # Errors
-    /// [`BuildError::Profile`] naming the missing table.
-    pub fn from_profile(profile: &Profile, fov_half_angle: f64) -> Result<Self, BuildError> {
-        let err = |what: &str| BuildError::Profile {
-            profile: profile.name.clone(),
-            what: format!("Axel's behavior needs {what}"),
-        };
+    /// A message naming the missing table.
+    pub fn from_profile(profile: &Profile, fov_half_angle: f64, gains: &TwoArcGains) -> Result<Self, String> {
+        let err = |what: &str| format!("Axel's behavior needs {what}");
         let dock = profile.dock.as_ref().ok_or_else(|| err("[dock]"))?;
         let tether = profile.tether.ok_or_else(|| err("[tether]"))?;
-        let gains = profile.behavior.two_arc.ok_or_else(|| err("[behavior.two_arc]"))?;
         let limits = profile.drive.limits();
         Ok(Self {
             regions: Regions {
@@ -242,19 +238,25 @@ pub struct Memory {
 }
 
 impl Memory {
+    /// The memory of the robot `profile` describes, with the tuning of its `[robot]`
+    /// table read as Axel's ([`AxelRobot`]).
+    ///
+    /// # Errors
+    /// As [`crate::behaviors::catalog::memory`].
+    pub fn from_profile(profile: &Profile) -> Result<Self, crate::behaviors::BuildError> {
+        crate::behaviors::catalog::memory(&super::Axel, profile)
+    }
+
     /// The memory for an Axel profile.
     ///
     /// # Errors
-    /// [`BuildError::Profile`] when the profile lacks the cameras, fiducial, dock, tether
+    /// A message when the profile lacks the cameras, fiducial, dock, tether
     /// or two-arc gains.
-    pub fn from_profile(profile: &Profile) -> Result<Self, BuildError> {
-        let fov = Geometry::camera_half_fov(profile).ok_or_else(|| BuildError::Profile {
-            profile: profile.name.clone(),
-            what: "Axel's behavior needs a camera".into(),
-        })?;
+    pub fn new(profile: &Profile, robot: &AxelRobot) -> Result<Self, String> {
+        let fov = Geometry::camera_half_fov(profile).ok_or("Axel's behavior needs a camera")?;
         Ok(Self {
             perception: Perception::from_profile(profile)?,
-            geometry: Geometry::from_profile(profile, fov)?,
+            geometry: Geometry::from_profile(profile, fov, &robot.two_arc)?,
             looking: false,
             sighting: None,
             now: 0.0,

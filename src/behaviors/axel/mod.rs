@@ -28,6 +28,7 @@ pub mod memory;
 pub mod reel;
 pub mod stall;
 mod stereo;
+pub mod tuning;
 
 use super::agent::BuildError;
 use super::composed::Composed;
@@ -71,14 +72,14 @@ pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
 /// `[behavior.tree]`.
 pub type AxelAgent = Composed<Memory>;
 
-/// Builds Axel's robot from a profile with `[fiducial.circles]`, two cameras, `[dock]`,
-/// `[tether]`, `[behavior.two_arc]` and a `[behavior.tree]` of Axel's schemas (or the
+/// Builds Axel's robot from a profile with `circles` fiducial, two cameras, `[dock]`,
+/// `[tether]`, `[robot.two_arc]` and a `[behavior.tree]` of Axel's schemas (or the
 /// user's, registered in `registry`).
 ///
 /// # Errors
 /// [`BuildError`] when something it needs is missing or the tree does not build.
 pub fn agent_with(profile: &Profile, registry: &Registry<Blackboard<Memory>>) -> Result<AxelAgent, BuildError> {
-    Composed::build(profile, registry, Memory::from_profile(profile)?)
+    Composed::build(profile, registry, super::catalog::memory(&Axel, profile)?)
 }
 
 /// Builds Axel's robot with Axel's own schemas (see [`agent_with`]).
@@ -90,4 +91,23 @@ pub fn agent(profile: &Profile) -> Result<AxelAgent, BuildError> {
     super::common::register(&mut registry);
     register(&mut registry);
     agent_with(profile, &registry)
+}
+
+/// Axel's robot kind, `[robot] kind = "axel"`: its tuning is [`AxelRobot`](tuning::AxelRobot), its
+/// memory [`Memory`], its leaves those [`register`] adds.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Axel;
+
+impl super::catalog::RobotKind for Axel {
+    const NAME: &'static str = "axel";
+    type Tuning = tuning::AxelRobot;
+    type Memory = Memory;
+
+    fn memory(&self, profile: &Profile, tuning: &tuning::AxelRobot) -> Result<Memory, String> {
+        Memory::new(profile, tuning)
+    }
+
+    fn leaves(&self, registry: &mut super::catalog::LeafRegistry<Memory>) {
+        register(registry);
+    }
 }

@@ -3,7 +3,6 @@
 //! reused (seed 000 §III). Detection, correspondence and the stereo or mono pose are
 //! `perception::circles`'; this file only owns them for the two cameras.
 
-use crate::behaviors::BuildError;
 use crate::perception::circles::{
     CircleDetector, CircleModel, CircleParams, CorrespondenceParams, LensPlane, MarkObservations, ModulePose,
     PoseBuffers, PoseParams, RigCamera, correspond_through, module_pose,
@@ -24,11 +23,8 @@ pub(super) struct Perception {
 }
 
 impl Perception {
-    pub(super) fn from_profile(profile: &Profile) -> Result<Self, BuildError> {
-        let err = |what: String| BuildError::Profile {
-            profile: profile.name.clone(),
-            what,
-        };
+    pub(super) fn from_profile(profile: &Profile) -> Result<Self, String> {
+        let err = |what: String| what;
         if profile.cameras.len() < 2 {
             return Err(err("Axel's behavior needs the stereo pair: two [[cameras]]".into()));
         }

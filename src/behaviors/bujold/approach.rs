@@ -47,7 +47,7 @@ impl Approach {
     ) -> Result<Self, String> {
         if params.output == ApproachOutput::Vector && mem.lock().approach.field.is_none() {
             return Err(
-                "params.output: `vector` needs behavior.approach = \"potential_field\" (ratio steering has no vector)"
+                "params.output: `vector` needs robot.approach = \"potential_field\" (ratio steering has no vector)"
                     .into(),
             );
         }

@@ -8,15 +8,14 @@
 //! follows the light whichever phase runs; the phase schemas then read the views.
 
 pub use super::motor::{ApproachMotor, lowered, raised};
-use super::params::BujoldTuning;
-use crate::behaviors::BuildError;
+use super::tuning::{Approach, BujoldRobot, BujoldTuning};
 use crate::behaviors::common::median::MedianWindow;
 use crate::behaviors::composed::SharedMemory;
 use crate::geometry::Pose2;
 use crate::perception::TwoBlockPercept;
 use crate::perception::frame_change::FrameChange;
 use crate::perception::two_block_pose::{FiducialView, RatioJumpGate, TwoBlockGeometry};
-use crate::profile::{ApproachKind, Profile};
+use crate::profile::{Profile, TwoBlockSpec};
 use crate::schemas::TwoBlockSchema;
 use crate::schemas::{
     ColourRanges, Feedback, Inputs, Mission, MissionError, Observation, ObservedPercept, Percept, PerceptualSchema,
@@ -105,35 +104,33 @@ pub struct Memory {
 }
 
 impl Memory {
-    /// The memory of a robot just switched on, built from a profile with a
-    /// `[fiducial.two_block]`, a camera, a `[dock]` and `[behavior.ratio_steering]` (and
-    /// `[behavior.potential_field]` when `behavior.approach` selects it).
+    /// The memory of the robot `profile` describes, with the tuning of its `[robot]`
+    /// table read as Bujold's ([`BujoldRobot`]).
     ///
     /// # Errors
-    /// [`BuildError::Profile`] naming what is missing.
-    pub fn from_profile(profile: &Profile) -> Result<Self, BuildError> {
-        let missing = |what: &str| BuildError::Profile {
-            profile: profile.name.clone(),
-            what: what.into(),
-        };
-        let fid = profile
-            .fiducial
-            .two_block
-            .ok_or_else(|| missing("needs [fiducial.two_block]"))?;
+    /// As [`crate::behaviors::catalog::memory`].
+    pub fn from_profile(profile: &Profile) -> Result<Self, crate::behaviors::BuildError> {
+        crate::behaviors::catalog::memory(&super::Bujold, profile)
+    }
+
+    /// The memory of a robot just switched on, built from a profile with a two-block
+    /// fiducial, a camera and a `[dock]`, with Bujold's `[robot]` tuning.
+    ///
+    /// # Errors
+    /// A message naming what the profile lacks.
+    pub fn new(profile: &Profile, robot: &BujoldRobot) -> Result<Self, String> {
+        let missing = |what: &str| what.to_string();
+        let fid = *profile.fiducial.require::<TwoBlockSpec>()?;
         let cam = profile.cameras.first().ok_or_else(|| missing("needs a camera"))?;
         profile.dock.ok_or_else(|| missing("needs [dock]"))?;
-        let g = profile
-            .behavior
-            .ratio_steering
-            .ok_or_else(|| missing("needs [behavior.ratio_steering]"))?;
+        let g = robot.ratio_steering;
         let schema = TwoBlockSchema::from_profile(profile, 0).map_err(|e| missing(&e.to_string()))?;
         let geometry = TwoBlockGeometry::new(cam, &fid);
-        let field = match profile.behavior.approach {
-            ApproachKind::PotentialField => {
-                let p = profile
-                    .behavior
+        let field = match robot.approach {
+            Approach::PotentialField => {
+                let p = robot
                     .potential_field
-                    .ok_or_else(|| missing("needs [behavior.potential_field]"))?;
+                    .ok_or_else(|| missing("needs [robot.potential_field]"))?;
                 Some(PotentialField {
                     sector: p.approach_sector_deg.to_radians(),
                     coercive_attraction: p.coercive_attraction,
@@ -143,7 +140,7 @@ impl Memory {
                     final_radius: p.final_radius_m,
                 })
             }
-            _ => None,
+            Approach::RatioSteering => None,
         };
         let steering = RatioSteering {
             geometry,
@@ -157,7 +154,7 @@ impl Memory {
             tick_s: 1.0 / profile.loop_.rate_hz,
             restricted: profile.drive.kind == crate::profile::DriveKind::TurnOrDrive,
         };
-        let tuning = profile.behavior.bujold.unwrap_or_default();
+        let tuning = robot.shared;
         Ok(Memory {
             schema,
             geometry,

@@ -26,6 +26,7 @@ pub mod move_away;
 pub mod params;
 pub mod reposition;
 pub mod search;
+pub mod tuning;
 pub mod unjam;
 
 pub use decide::{Decision, at_dock_decision};
@@ -166,7 +167,7 @@ pub(crate) fn rear_behind_camera(profile: &Profile, geometry: &TwoBlockGeometry)
 /// with the rear at the plates, so the camera is then depth − rear_behind_camera inside
 /// the entrance.
 fn imprint_distance(profile: &Profile) -> Option<f64> {
-    let fid = profile.fiducial.two_block?;
+    let fid = profile.fiducial.get::<crate::profile::TwoBlockSpec>().copied()?;
     let cam = profile.cameras.first()?;
     let g = TwoBlockGeometry::new(cam, &fid);
     Some(profile.perception.imprint.at_distance_m + profile.dock?.depth_m - rear_behind_camera(profile, &g)?)
@@ -176,14 +177,14 @@ fn imprint_distance(profile: &Profile) -> Option<f64> {
 /// of `[behavior.tree]`.
 pub type BujoldAgent = Composed<Memory>;
 
-/// Builds Bujold's robot from a profile with a `[fiducial.two_block]`,
-/// `[behavior.ratio_steering]` (and `[behavior.potential_field]` when selected) and a
+/// Builds Bujold's robot from a profile with a `two_block` fiducial,
+/// `[robot.ratio_steering]` (and `[robot.potential_field]` when selected) and a
 /// `[behavior.tree]` of Bujold's schemas (or the user's, registered in `registry`).
 ///
 /// # Errors
 /// [`BuildError`] when something it needs is missing or the tree does not build.
 pub fn agent_with(profile: &Profile, registry: &Registry<Blackboard<Memory>>) -> Result<BujoldAgent, BuildError> {
-    Composed::build(profile, registry, Memory::from_profile(profile)?)
+    Composed::build(profile, registry, super::catalog::memory(&Bujold, profile)?)
 }
 
 /// Builds Bujold's robot with Bujold's own schemas (see [`agent_with`]).
@@ -195,4 +196,23 @@ pub fn agent(profile: &Profile) -> Result<BujoldAgent, BuildError> {
     super::common::register(&mut registry);
     register(&mut registry);
     agent_with(profile, &registry)
+}
+
+/// Bujold's robot kind, `[robot] kind = "bujold"`: its tuning is [`BujoldRobot`](tuning::BujoldRobot), its
+/// memory [`Memory`], its leaves those [`register`] adds.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Bujold;
+
+impl super::catalog::RobotKind for Bujold {
+    const NAME: &'static str = "bujold";
+    type Tuning = tuning::BujoldRobot;
+    type Memory = Memory;
+
+    fn memory(&self, profile: &Profile, tuning: &tuning::BujoldRobot) -> Result<Memory, String> {
+        Memory::new(profile, tuning)
+    }
+
+    fn leaves(&self, registry: &mut super::catalog::LeafRegistry<Memory>) {
+        register(registry);
+    }
 }

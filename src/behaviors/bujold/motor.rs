@@ -9,7 +9,7 @@ use crate::schemas::{
     Auxiliary, DriveCommand, MotionVector, MotorOutput, Posture, PotentialField, RatioSteering, Step,
 };
 
-/// The approach motor schema the profile selects (`behavior.approach`).
+/// The approach motor schema the profile selects (`robot.approach`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ApproachMotor {
     /// Ratio steering: also realises the field's heading error on a turn-or-drive base.

@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
-pub use crate::profile::BujoldTuning;
+pub use super::tuning::BujoldTuning;
 
 /// `undock`: leave the pouch front first, lowered.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -105,7 +105,7 @@ pub struct ApproachParams {
     pub reposition_lateral_m: f64,
     /// What the leaf proposes: a steering command, or the field's motion vector for a
     /// vector-sum arbiter to combine with other schemas (needs
-    /// `behavior.approach = "potential_field"`).
+    /// `robot.approach = "potential_field"`).
     pub output: ApproachOutput,
     /// When set, the event `near` fires once the fiducial is closer than this to the
     /// camera, m: the dock area, where a composition may hand over to a state without

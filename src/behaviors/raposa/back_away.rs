@@ -2,7 +2,7 @@
 //! odometry, body forward for the backward camera, at the far speed, keeping the ellipse
 //! centred when it is seen; then event `cleared` (the servo selects again).
 //!
-//! * leave the dead zone (ours, `[behavior.seven_state] leave_dead_zone`): a pair closer
+//! * leave the dead zone (ours, `[robot.seven_state] leave_dead_zone`): a pair closer
 //!   than `distance_threshold_m` shows misalignment, where α is unreliable and region II
 //!   cannot run: back off until the socket is `dead_zone_exit_m` from the ball (at least
 //!   `min_distance_m`), measured from the view on entry;

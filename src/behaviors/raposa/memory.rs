@@ -15,11 +15,11 @@
 
 use super::region2::Region2Plan;
 use super::source::Source;
-use crate::behaviors::BuildError;
+use super::tuning::{RaposaRobot, SevenStateGains};
 use crate::behaviors::composed::SharedMemory;
 use crate::geometry::{Pose2, Twist, wrap_angle};
 use crate::perception::PyramidPercept;
-use crate::profile::{Profile, SegmentationMode, SevenStateGains};
+use crate::profile::{Profile, SegmentationMode};
 use crate::schemas::{
     AgentStats, Auxiliary, ColourRanges, DriveCommand, Feedback, Guides, Inputs, Mission, MissionError, MotorOutput,
     Observation, ObservedPercept, PointController, ServoLaw, Step,
@@ -30,7 +30,7 @@ pub struct Memory {
     /// The perception source (detector, colour model, imprint): the pyramid schema, or the
     /// two-block schema through its adapter.
     pub source: Source,
-    /// The seven states' gains and thresholds (`[behavior.seven_state]`).
+    /// The seven states' gains and thresholds (`[robot.seven_state]`).
     pub gains: SevenStateGains,
     /// The state-1 servo law.
     pub law: ServoLaw,
@@ -95,22 +95,24 @@ pub struct Memory {
 }
 
 impl Memory {
-    /// The memory of a robot just switched on, built from a profile with a
-    /// `[fiducial.pyramid]` or a `[fiducial.two_block]`, a pin-hole back camera and
-    /// `[behavior.seven_state]`.
+    /// The memory of the robot `profile` describes, with the tuning of its `[robot]`
+    /// table read as Raposa's ([`RaposaRobot`]).
     ///
     /// # Errors
-    /// [`BuildError::Profile`] naming what is missing.
-    pub fn from_profile(profile: &Profile) -> Result<Self, BuildError> {
-        let missing = |what: String| BuildError::Profile {
-            profile: profile.name.clone(),
-            what,
-        };
-        let gains = profile
-            .behavior
-            .seven_state
-            .ok_or_else(|| missing("needs [behavior.seven_state]".into()))?;
-        let source = Source::from_profile(profile).map_err(missing)?;
+    /// As [`crate::behaviors::catalog::memory`].
+    pub fn from_profile(profile: &Profile) -> Result<Self, crate::behaviors::BuildError> {
+        crate::behaviors::catalog::memory(&super::Raposa, profile)
+    }
+
+    /// The memory of a robot just switched on, built from a profile with a
+    /// `pyramid` fiducial or a `two_block` fiducial, a pin-hole back camera and
+    /// `[robot.seven_state]`.
+    ///
+    /// # Errors
+    /// A message naming what is missing.
+    pub fn new(profile: &Profile, robot: &RaposaRobot) -> Result<Self, String> {
+        let gains = robot.seven_state;
+        let source = Source::from_profile(profile, &robot.two_block)?;
         let cam = &profile.cameras[0];
         let camera_backward = wrap_angle(cam.mount.yaw_deg.to_radians()).abs() > std::f64::consts::FRAC_PI_2;
         let half_length = profile.body.length_m / 2.0;

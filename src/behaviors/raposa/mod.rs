@@ -56,6 +56,7 @@ pub mod selector;
 pub mod servo;
 pub mod source;
 pub mod states;
+pub mod tuning;
 
 pub use memory::Memory;
 pub use region2::Region2Plan;
@@ -73,7 +74,7 @@ use manoeuvre::{Manoeuvre, Part};
 
 /// Registers RAPOSA's phase schemas (`raposa.approach`, `raposa.rotate_7`, ...) and the
 /// `raposa.seven_state` selector in `registry`; each schema takes its tuning from its
-/// node's `params` (see [`params`]) and the robot-wide `[behavior.seven_state]`.
+/// node's `params` (see [`params`]) and the robot-wide `[robot.seven_state]`.
 pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
     type Ctx = Blackboard<Memory>;
     let search_timeout = |a: &LeafArgs<'_>| a.profile.behavior.search_timeout_s;
@@ -178,15 +179,15 @@ pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
 /// in the shared [`Memory`] and the tree of `[behavior.tree]`.
 pub type RaposaAgent = Composed<Memory>;
 
-/// Builds RAPOSA's robot from a profile with a `[fiducial.pyramid]` (or a
-/// `[fiducial.two_block]`, read through [`source::TwoBlockCues`]), a pin-hole back
-/// camera, `[behavior.seven_state]` and a `[behavior.tree]` of RAPOSA's schemas (or the
+/// Builds RAPOSA's robot from a profile with a `pyramid` fiducial (or a
+/// `two_block` fiducial, read through [`source::TwoBlockCues`]), a pin-hole back
+/// camera, `[robot.seven_state]` and a `[behavior.tree]` of RAPOSA's schemas (or the
 /// user's, registered in `registry`).
 ///
 /// # Errors
 /// [`BuildError`] when something it needs is missing or the tree does not build.
 pub fn agent_with(profile: &Profile, registry: &Registry<Blackboard<Memory>>) -> Result<RaposaAgent, BuildError> {
-    Composed::build(profile, registry, Memory::from_profile(profile)?)
+    Composed::build(profile, registry, super::catalog::memory(&Raposa, profile)?)
 }
 
 /// Builds RAPOSA's robot with RAPOSA's own schemas (see [`agent_with`]).
@@ -198,4 +199,23 @@ pub fn agent(profile: &Profile) -> Result<RaposaAgent, BuildError> {
     super::common::register(&mut registry);
     register(&mut registry);
     agent_with(profile, &registry)
+}
+
+/// Raposa's robot kind, `[robot] kind = "raposa"`: its tuning is [`RaposaRobot`](tuning::RaposaRobot), its
+/// memory [`Memory`], its leaves those [`register`] adds.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Raposa;
+
+impl super::catalog::RobotKind for Raposa {
+    const NAME: &'static str = "raposa";
+    type Tuning = tuning::RaposaRobot;
+    type Memory = Memory;
+
+    fn memory(&self, profile: &Profile, tuning: &tuning::RaposaRobot) -> Result<Memory, String> {
+        Memory::new(profile, tuning)
+    }
+
+    fn leaves(&self, registry: &mut super::catalog::LeafRegistry<Memory>) {
+        register(registry);
+    }
 }

@@ -1,7 +1,7 @@
 //! Tuning of RAPOSA's phase schemas, each read from its node's `params` table in
 //! `profiles/raposa.toml` (`[behavior.tree.nodes.<phase>.params]`). The robot-wide gains
-//! and thresholds of the seven states stay in `[behavior.seven_state]`
-//! ([`SevenStateGains`](crate::profile::SevenStateGains)); what is here is what one phase
+//! and thresholds of the seven states stay in `[robot.seven_state]`
+//! ([`SevenStateGains`](super::tuning::SevenStateGains)); what is here is what one phase
 //! alone uses. Every field has the default the campaigns were tuned with, so a profile
 //! states only what it changes; the shipped profile states them all, with where each
 //! value comes from.
@@ -54,7 +54,7 @@ impl Default for LookParams {
 }
 
 /// `leave_dead_zone`: back away until the socket is `dead_zone_exit_m` from the ball
-/// (`[behavior.seven_state]`), at least `min_distance_m`.
+/// (`[robot.seven_state]`), at least `min_distance_m`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct LeaveDeadZoneParams {

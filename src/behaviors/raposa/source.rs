@@ -1,9 +1,9 @@
 //! Where RAPOSA's memory gets its percept: the perception source the profile's
 //! `[fiducial]` kind selects.
 //!
-//! * `[fiducial.pyramid]`: the [pyramid perceptual schema](PyramidSchema) (seed 001), as
+//! * `pyramid` fiducial: the [pyramid perceptual schema](PyramidSchema) (seed 001), as
 //!   RAPOSA runs it.
-//! * `[fiducial.two_block]`: Bujold's [two-block schema](TwoBlockSchema) (seed 004)
+//! * `two_block` fiducial: Bujold's [two-block schema](TwoBlockSchema) (seed 004)
 //!   through [`TwoBlockCues`], which reports what the seven states read in the same
 //!   [`PyramidPercept`] the pyramid schema fills.
 //!
@@ -18,7 +18,7 @@
 //! | `bearing` | the pair's bearing in the robot frame |
 //! | `ball_distance_m` (d = f·h/g − m·cos α with a pair) | camera to flap, d = f·h/H from the blocks' mean height |
 //! | `area_px` and A₁ (the ball's area at 1 m) for v = K_lin·√(A₁/A) | both blocks' pixels, and A₁ = f²·w·h, the flap's area at 1 m |
-//! | `alpha` from the quadratic in K = c·h/g (pairs only) | the block-ratio viewing angle sin α ≈ 4·d·(L − R)/(3·(L + R)·w): the median of the last `alpha_window_frames` frames whose blocks are at least `reliable_height_px` tall (`[behavior.bujold]`, as Bujold's repositioning decides), reported once that many were seen in a row; until then `None`, as a lone ellipse gives, and the selector chooses state 1 or 3 |
+//! | `alpha` from the quadratic in K = c·h/g (pairs only) | the block-ratio viewing angle sin α ≈ 4·d·(L − R)/(3·(L + R)·w): the median of the last `alpha_window_frames` frames whose blocks are at least `reliable_height_px` tall (`[robot.shared]`, as Bujold's repositioning decides), reported once that many were seen in a row; until then `None`, as a lone ellipse gives, and the selector chooses state 1 or 3 |
 //! | `alpha_saturated` (K past the quadratic's peak, 73°) | the ratio's sin α clipped at 1 |
 //!
 //! With no equivalent:
@@ -41,10 +41,11 @@
 //! edges leave its 25° window, the paper's dead zone) and holds far; the block ratio's α
 //! is noisy far (two pixels are ±35° at 1.3 m) and good close.
 
+use crate::behaviors::bujold::tuning::BujoldTuning;
 use crate::behaviors::common::median::MedianWindow;
 use crate::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
 use crate::perception::{PyramidDetection, PyramidPercept, PyramidView, RgbView, TwoBlockPercept};
-use crate::profile::{Profile, SegmentationMode};
+use crate::profile::{Profile, PyramidSpec, SegmentationMode, TwoBlockSpec};
 use crate::schemas::{Inputs, PerceptualSchema, PyramidSchema, TwoBlockSchema};
 
 /// RAPOSA's perception source (see the module docs). Boxed: built once, kept for the
@@ -63,16 +64,19 @@ impl Source {
     ///
     /// # Errors
     /// A message naming what the profile lacks.
-    pub fn from_profile(profile: &Profile) -> Result<Self, String> {
-        if profile.fiducial.pyramid.is_some() {
+    pub fn from_profile(profile: &Profile, two_block: &BujoldTuning) -> Result<Self, String> {
+        if profile.fiducial.get::<PyramidSpec>().is_some() {
             return PyramidSchema::from_profile(profile, 0)
                 .map(|s| Source::Pyramid(Box::new(s)))
                 .map_err(|e| e.to_string());
         }
-        if profile.fiducial.two_block.is_some() {
-            return TwoBlockCues::from_profile(profile).map(|c| Source::TwoBlock(Box::new(c)));
+        if profile.fiducial.get::<TwoBlockSpec>().is_some() {
+            return TwoBlockCues::from_profile(profile, two_block).map(|c| Source::TwoBlock(Box::new(c)));
         }
-        Err("needs [fiducial.pyramid] or [fiducial.two_block]".into())
+        Err(format!(
+            "needs a fiducial of kind `pyramid` or `two_block`, and the profile's is `{}`",
+            profile.fiducial.kind()
+        ))
     }
 
     /// This tick's percept; `looking` is false while the robot looks away on purpose (the
@@ -184,17 +188,16 @@ pub struct TwoBlockCues {
 }
 
 impl TwoBlockCues {
-    /// From a profile with a `[fiducial.two_block]` and a camera; the α window from
-    /// `[behavior.bujold]` (its defaults when absent).
+    /// From a profile with a two-block fiducial and a camera; the α window from
+    /// `tuning` (`[robot.two_block]`, its defaults when absent).
     ///
     /// # Errors
     /// A message naming what the profile lacks.
-    pub fn from_profile(profile: &Profile) -> Result<Self, String> {
-        let fid = profile.fiducial.two_block.ok_or("needs [fiducial.two_block]")?;
+    pub fn from_profile(profile: &Profile, tuning: &BujoldTuning) -> Result<Self, String> {
+        let fid = *profile.fiducial.require::<TwoBlockSpec>()?;
         let cam = profile.cameras.first().ok_or("needs a camera")?;
         let schema = TwoBlockSchema::from_profile(profile, 0).map_err(|e| e.to_string())?;
         let geometry = TwoBlockGeometry::new(cam, &fid);
-        let tuning = profile.behavior.bujold.unwrap_or_default();
         Ok(Self {
             schema,
             geometry,

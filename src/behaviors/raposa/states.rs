@@ -19,8 +19,8 @@
 //! angle threshold is widened by `settle_tolerance_deg`, the paper's tolerance for
 //! odometry error at the region boundary.
 
+use super::tuning::SevenStateGains;
 use crate::perception::PyramidPercept;
-use crate::profile::SevenStateGains;
 use serde::Serialize;
 
 /// The seven states of seed 001, plus our dead-zone exit.
@@ -146,11 +146,10 @@ mod tests {
     use crate::profile::Profile;
 
     fn gains() -> SevenStateGains {
-        Profile::load("profiles/raposa.toml".as_ref())
+        let p = Profile::load("profiles/raposa.toml".as_ref()).unwrap();
+        crate::behaviors::catalog::tuning::<super::super::Raposa>(&p)
             .unwrap()
-            .behavior
             .seven_state
-            .unwrap()
     }
 
     fn percept(ellipse: bool, blue: bool, pair: bool, d: f64, alpha_deg: f64) -> PyramidPercept {

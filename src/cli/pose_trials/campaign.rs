@@ -95,7 +95,7 @@ pub struct PoseCampaign {
     /// Description.
     #[serde(default)]
     pub description: String,
-    /// Profile path (relative to the file); it must have `[fiducial.circles]`.
+    /// Profile path (relative to the file); it must have `circles` fiducial.
     pub profile: PathBuf,
     /// Campaign seed.
     #[serde(default)]
@@ -195,24 +195,24 @@ impl PoseCampaign {
     }
 
     /// Loads and validates a campaign and its profile, which must have two cameras and
-    /// `[fiducial.circles]`.
+    /// `circles` fiducial.
     ///
     /// # Errors
     /// [`ConfigError`] for the file or its profile.
     pub fn load(path: &Path) -> Result<LoadedCampaign, ConfigError> {
         let campaign: PoseCampaign = config::load(path)?;
         let profile = Profile::load(&path.parent().unwrap_or(Path::new(".")).join(&campaign.profile))?;
-        if profile.fiducial.circles.is_none() || profile.cameras.len() < 2 {
+        if profile.fiducial.get::<crate::profile::CirclesSpec>().is_none() || profile.cameras.len() < 2 {
             return Err(ConfigError::Invalid {
                 file: path.to_path_buf(),
                 problems: vec![config::Problem {
                     path: "profile".into(),
                     line: None,
                     message: format!(
-                        "a perception campaign needs a stereo pair and [fiducial.circles]; profile `{}` has {} camera(s){}",
+                        "a perception campaign needs a stereo pair and `circles` fiducial; profile `{}` has {} camera(s){}",
                         profile.name,
                         profile.cameras.len(),
-                        if profile.fiducial.circles.is_none() {
+                        if profile.fiducial.get::<crate::profile::CirclesSpec>().is_none() {
                             " and no circles"
                         } else {
                             ""

@@ -3,7 +3,7 @@
 //!
 //! **Face coordinates** (u, v), metres: u across the face to the right as seen from in
 //! front of it, v up. For Axel's module, whose face looks along the dock frame's +x, that
-//! is (u, v) = (y, z) of the dock frame (`profile` builds it from `[fiducial.circles]`).
+//! is (u, v) = (y, z) of the dock frame (`profile` builds it from `circles` fiducial).
 
 use super::detect::MarkRotation;
 use thiserror::Error;
