@@ -6,10 +6,9 @@
 //! follows the light whichever phase runs, and between missions too), then the tree of
 //! arbiters built from `[behavior.tree]` by a [`Registry`] decides. The [`Composed`] owns
 //! the memory and lends it to the tree for the tick (`&mut`), so every node reads and
-//! writes it in tick order with no lock. A [`Mission`] starts
-//! the tree at the state the profile names for it (`departure`, `docking`, or `ballistic`
-//! for a docking with an a-priori dock pose); the mission ends when the tree reports an
-//! outcome.
+//! writes it in tick order with no lock. A [`Mission`] starts the tree at the state the
+//! profile names for it (`departure`, `docking`, or `ballistic` for a docking with an
+//! a-priori dock pose); the mission ends when the tree reports an outcome.
 
 use super::agent::BuildError;
 use super::registry::Registry;
