@@ -8,7 +8,8 @@
 //!    beacon and steer at it, as a motion vector), `toy.bumper` and `toy.docked`, each a
 //!    [`Behavior`] built from its node's `params` by a factory in a [`Registry`]. The
 //!    perception runs once per tick into the robot's [`SharedMemory`], which every leaf
-//!    reads through a [`Blackboard`] handle.
+//!    gets for the tick as `&mut` (a `Behavior<ToyMemory>`); a leaf that reads none is a
+//!    `Behavior<M>` for every `M`.
 //! 2. **Its own sensor kind.** A contact-strip `bumper`, declared in the profile's
 //!    `[[sensors]]` and registered with the check of its params, so `marsupial check`-style
 //!    errors name a bad `segments`. Its driver is a [`marsupial::robot::Sensor`].
@@ -32,8 +33,8 @@ mod red_beacon;
 #[path = "common/toy_world.rs"]
 mod toy_world;
 
+use marsupial::arbiter::ReactiveLoop;
 use marsupial::arbiter::runtime::{RuntimeConfig, StopHandle, run_missions};
-use marsupial::arbiter::{Blackboard, ReactiveLoop};
 use marsupial::behaviors::registry::{LeafArgs, Registry};
 use marsupial::behaviors::{Composed, SharedMemory, common};
 use marsupial::geometry::Pose2;
@@ -193,7 +194,7 @@ impl SharedMemory for ToyMemory {
     }
 }
 
-type Mem = Blackboard<ToyMemory>;
+type Mem = ToyMemory;
 
 // ---------------------------------------------------------------------------------------
 // The robot's schemas: leaves the tree names.
@@ -202,7 +203,6 @@ type Mem = Blackboard<ToyMemory>;
 /// `toy.search`: turn in place until the beacon is seen (event `seen`).
 struct Search {
     name: String,
-    mem: Mem,
     params: SearchParams,
 }
 
@@ -213,13 +213,13 @@ struct SearchParams {
     turn_rate_dps: f64,
 }
 
-impl Behavior for Search {
+impl Behavior<Mem> for Search {
     fn name(&self) -> &str {
         &self.name
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, m: &mut Mem, inputs: &Inputs<'_>) -> Option<Step> {
         let feedback = Feedback::new("search", inputs.now);
-        if self.mem.lock().beacon.found {
+        if m.beacon.found {
             return Some(Step::event("seen", MotorOutput::stop(), feedback));
         }
         let omega = self.params.turn_rate_dps.to_radians();
@@ -235,7 +235,6 @@ impl Behavior for Search {
 /// beacon was last seen, by odometry; event `lost` when unseen for `lost_after_s`.
 struct Steer {
     name: String,
-    mem: Mem,
     params: SteerParams,
 }
 
@@ -250,12 +249,11 @@ struct SteerParams {
     lost_after_s: f64,
 }
 
-impl Behavior for Steer {
+impl Behavior<Mem> for Steer {
     fn name(&self) -> &str {
         &self.name
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
-        let m = self.mem.lock();
+    fn tick(&mut self, m: &mut Mem, inputs: &Inputs<'_>) -> Option<Step> {
         let feedback = Feedback::new("steer", inputs.now);
         let p = &self.params;
         if inputs.now - m.last_seen > p.lost_after_s {
@@ -275,17 +273,18 @@ impl Behavior for Steer {
 }
 
 /// `toy.bumper`: any bumper segment pressed stops the robot and ends the mission with a
-/// typed failure (`stuck_contact`); silent otherwise, so the priority passes on.
+/// typed failure (`stuck_contact`); silent otherwise, so the priority passes on. It reads
+/// no memory, so it fits in any robot's tree.
 struct Bumper {
     name: String,
     sensor: usize,
 }
 
-impl Behavior for Bumper {
+impl<M: ?Sized> Behavior<M> for Bumper {
     fn name(&self) -> &str {
         &self.name
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
         let pressed = inputs.sensor(self.sensor)?.values.iter().any(|&v| v > 0.5);
         pressed.then(|| {
             Step::done(
@@ -302,11 +301,11 @@ struct Docked {
     name: String,
 }
 
-impl Behavior for Docked {
+impl<M: ?Sized> Behavior<M> for Docked {
     fn name(&self) -> &str {
         &self.name
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
         inputs.docked_contact().then(|| {
             Step::done(
                 Outcome::Docked,
@@ -334,17 +333,15 @@ fn registry() -> Registry<Mem> {
     let mut r = Registry::new();
     common::register(&mut r); // avoid_obstacles
     r.register_sensor_kind("bumper", check_bumper)
-        .register("toy.search", |m: &Mem, a: &LeafArgs<'_>| {
+        .register("toy.search", |_: &Mem, a: &LeafArgs<'_>| {
             Ok(Box::new(Search {
                 name: a.node.into(),
-                mem: m.clone(),
                 params: a.params()?,
             }))
         })
-        .register("toy.steer", |m: &Mem, a: &LeafArgs<'_>| {
+        .register("toy.steer", |_: &Mem, a: &LeafArgs<'_>| {
             Ok(Box::new(Steer {
                 name: a.node.into(),
-                mem: m.clone(),
                 params: a.params()?,
             }))
         })

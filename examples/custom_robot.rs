@@ -132,7 +132,7 @@ impl Behavior for Search {
     fn name(&self) -> &str {
         "search"
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &Inputs<'_>) -> Option<Step> {
         Some(Step::running(
             MotorOutput::drive(DriveCommand::Turn { omega: 0.6 }),
             Feedback::new("search", inputs.now),
@@ -146,7 +146,7 @@ impl Behavior for DockedCheck {
     fn name(&self) -> &str {
         "docked"
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &Inputs<'_>) -> Option<Step> {
         inputs.docked_contact().then(|| {
             Step::done(
                 Outcome::Docked,

@@ -8,7 +8,9 @@
 //! * [`arbiter`]: coordination ([`arbiter::Priority`], [`arbiter::VectorSum`],
 //!   [`arbiter::Sequencer`]) and the [`arbiter::ReactiveLoop`], whose tick is a pure
 //!   function of its state and timestamped inputs; [`arbiter::runtime`] runs it on
-//!   threads against a [`robot::Robot`].
+//!   threads against a [`robot::Robot`]. Arbiters and leaves are generic over the memory
+//!   `M` a robot's nodes share ([`schemas::Behavior<M>`]): a [`behaviors::Composed`] owns
+//!   it and hands it down the tree by `&mut` each tick, with no lock.
 //! * [`kinematics`]: differential, skid-steer (effective track), turn-or-drive and
 //!   double-Ackermann models, command realisation and odometry.
 //! * [`profile`]: one TOML file per platform, validated with precise errors.
@@ -22,11 +24,12 @@
 //! use marsupial::profile::Profile;
 //! use marsupial::schemas::{Behavior, Feedback, Inputs, MotorOutput, Step};
 //!
-//! /// A behavior that always drives forward slowly.
+//! /// A behavior that always drives forward slowly. It reads no tree memory, so it is a
+//! /// `Behavior<M>` for every memory `M`: the loop's root is a `Behavior` (memory `()`).
 //! struct Creep;
-//! impl Behavior for Creep {
+//! impl<M: ?Sized> Behavior<M> for Creep {
 //!     fn name(&self) -> &str { "creep" }
-//!     fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+//!     fn tick(&mut self, _mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
 //!         Some(Step::running(MotorOutput::twist(0.05, 0.0), Feedback::new("creep", inputs.now)))
 //!     }
 //! }

@@ -41,7 +41,7 @@ impl Behavior for Scripted {
     fn name(&self) -> &str {
         self.name
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &Inputs<'_>) -> Option<Step> {
         if !(inputs.now >= self.from && inputs.now < self.to) {
             return None;
         }
@@ -63,17 +63,17 @@ fn priority_picks_first_active_and_ticks_everyone() {
     let hi = Scripted::new("hi", 5.0, 10.0, MotorOutput::twist(0.0, 1.0));
     let lo = Scripted::new("lo", 0.0, 100.0, MotorOutput::twist(0.1, 0.0));
     let mut p = Priority::new("p", vec![Box::new(hi), Box::new(lo)]);
-    let s = p.tick(&Inputs::empty(1.0)).unwrap();
+    let s = p.tick(&mut (), &Inputs::empty(1.0)).unwrap();
     assert_eq!(s.output, MotorOutput::twist(0.1, 0.0));
     assert_eq!(p.decision().winner, Some(1));
     assert_eq!(p.decision().active().collect::<Vec<_>>(), vec![1]);
-    let s = p.tick(&Inputs::empty(6.0)).unwrap();
+    let s = p.tick(&mut (), &Inputs::empty(6.0)).unwrap();
     assert_eq!(s.output, MotorOutput::twist(0.0, 1.0));
     assert_eq!(p.decision().winner, Some(0));
     assert_eq!(p.decision().active().collect::<Vec<_>>(), vec![0, 1]);
     // Both proposals are recorded even though only one won.
     assert_eq!(p.decision().candidates[1].proposal, Some(MotorOutput::twist(0.1, 0.0)));
-    assert!(p.tick(&Inputs::empty(200.0)).is_none());
+    assert!(p.tick(&mut (), &Inputs::empty(200.0)).is_none());
     assert_eq!(p.decision().winner, None);
 }
 
@@ -98,7 +98,7 @@ fn vector_sum_weights_and_merges() {
         10.0,
         1.0,
     );
-    let step = s.tick(&Inputs::empty(1.0)).unwrap();
+    let step = s.tick(&mut (), &Inputs::empty(1.0)).unwrap();
     let DriveCommand::Twist(t) = step.output.drive else {
         panic!()
     };
@@ -106,12 +106,12 @@ fn vector_sum_weights_and_merges() {
     assert!((t.v - 0.5).abs() < 1e-12, "{t:?}");
     assert!((t.omega - (std::f64::consts::FRAC_PI_4 + 0.2)).abs() < 1e-12, "{t:?}");
     assert_eq!(step.output.aux.lights, Some(true));
-    let step = s.tick(&Inputs::empty(7.0)).unwrap();
+    let step = s.tick(&mut (), &Inputs::empty(7.0)).unwrap();
     let DriveCommand::Twist(t) = step.output.drive else {
         panic!()
     };
     assert!((t.v - 0.5).abs() < 1e-12 && (t.omega - 0.2).abs() < 1e-12);
-    assert!(s.tick(&Inputs::empty(20.0)).is_none());
+    assert!(s.tick(&mut (), &Inputs::empty(20.0)).is_none());
 }
 
 #[test]
@@ -124,7 +124,7 @@ fn vector_sum_clips_to_max_speed() {
     );
     let mut s = VectorSum::new("sum", vec![(1.0, Box::new(a))], 0.2, 1.0);
     assert_eq!(
-        s.tick(&Inputs::empty(0.0)).unwrap().output.drive,
+        s.tick(&mut (), &Inputs::empty(0.0)).unwrap().output.drive,
         DriveCommand::Twist(Twist::new(0.2, 0.0))
     );
 }
@@ -151,7 +151,7 @@ fn sequencer_follows_transitions_and_finishes() {
     let mut phases = Vec::new();
     let mut t = 0.0;
     let outcome = loop {
-        let s = seq.tick(&Inputs::empty(t)).unwrap();
+        let s = seq.tick(&mut (), &Inputs::empty(t)).unwrap();
         phases.push(seq.current());
         t += 0.1;
         if let Status::Done(o) = s.status {
@@ -175,11 +175,11 @@ fn sequencer_failure_goes_to_recovery_state() {
     let a = seq.state(Box::new(attempt), false);
     let b = seq.state(Box::new(back_off), false);
     seq.transitions(a, Next::Goto(b + 1), Next::Goto(b));
-    let s = seq.tick(&Inputs::empty(0.0)).unwrap();
+    let s = seq.tick(&mut (), &Inputs::empty(0.0)).unwrap();
     assert_eq!(s.status, Status::Running);
     assert_eq!(s.output.drive, DriveCommand::Stop, "a finishing state stops the base");
     assert_eq!(seq.current(), b);
-    let s = seq.tick(&Inputs::empty(0.1)).unwrap();
+    let s = seq.tick(&mut (), &Inputs::empty(0.1)).unwrap();
     assert_eq!(s.status, Status::Done(Outcome::Failed(FailureReason::RetriesExhausted)));
 }
 
@@ -189,7 +189,7 @@ fn latched_state_ignores_the_selector_until_done() {
     let latched = Scripted::new("latched", 0.0, 1e9, MotorOutput::twist(0.0, 0.5)).finishing(4, Outcome::Completed);
     let after = Scripted::new("after", 0.0, 1e9, MotorOutput::twist(0.2, 0.0));
     // The selector wants "latched" at t ≥ 1 and "normal" at t ≥ 1.2.
-    let mut seq = Sequencer::new("s").with_selector(|inp: &Inputs<'_>, _cur: usize| {
+    let mut seq = Sequencer::new("s").with_selector(|_: &mut (), inp: &Inputs<'_>, _cur: usize| {
         if inp.now >= 1.2 {
             Some(0)
         } else if inp.now >= 1.0 {
@@ -205,7 +205,7 @@ fn latched_state_ignores_the_selector_until_done() {
     let mut visited = Vec::new();
     for k in 0..16 {
         let t = 0.9 + 0.1 * k as f64;
-        seq.tick(&Inputs::empty(t)).unwrap();
+        seq.tick(&mut (), &Inputs::empty(t)).unwrap();
         visited.push(seq.current());
     }
     // 0.9: normal; 1.0..1.3: latched (4 ticks, selector ignored at 1.2 and 1.3), then the
@@ -226,7 +226,7 @@ impl Behavior for Emits {
     fn name(&self) -> &str {
         self.name
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &Inputs<'_>) -> Option<Step> {
         self.ticks += 1;
         let fb = Feedback::new(self.name, inputs.now);
         let out = MotorOutput::twist(0.0, 0.3);
@@ -267,7 +267,7 @@ fn an_event_a_nested_sequence_finishes_on_is_routed_by_its_parent() {
     outer.on_event(m, "seen", Next::Goto(approach));
     let mut at = Vec::new();
     for k in 0..5 {
-        let s = outer.tick(&Inputs::empty(0.1 * k as f64)).unwrap();
+        let s = outer.tick(&mut (), &Inputs::empty(0.1 * k as f64)).unwrap();
         assert_eq!(s.status, Status::Running, "tick {k}");
         at.push(outer.current());
     }
@@ -278,7 +278,7 @@ fn an_event_a_nested_sequence_finishes_on_is_routed_by_its_parent() {
     // An event the table does not declare still ends the sequence as failing to control.
     let mut lone = Sequencer::new("lone");
     lone.state(emits("turn", "turned", 1), false);
-    let s = lone.tick(&Inputs::empty(0.0)).unwrap();
+    let s = lone.tick(&mut (), &Inputs::empty(0.0)).unwrap();
     assert_eq!(s.status, Status::Done(Outcome::Failed(FailureReason::FailedToControl)));
     assert!(lone.is_finished());
 }
@@ -294,9 +294,9 @@ fn a_sum_ends_with_its_first_childs_event_so_it_can_be_a_sequencer_state() {
     let push = Scripted::new("avoid", 0.0, 100.0, MotorOutput::twist(0.0, 0.1));
     let mut s = VectorSum::new("sum", vec![(1.0, Box::new(near)), (1.0, Box::new(push))], 1.0, 1.0);
     for now in [0.0, 0.1] {
-        assert_eq!(s.tick(&Inputs::empty(now)).unwrap().status, Status::Running);
+        assert_eq!(s.tick(&mut (), &Inputs::empty(now)).unwrap().status, Status::Running);
     }
-    let step = s.tick(&Inputs::empty(0.2)).unwrap();
+    let step = s.tick(&mut (), &Inputs::empty(0.2)).unwrap();
     assert_eq!(step.status, Status::Event("near"));
     // The sum's command that tick still adds both children's turns.
     let DriveCommand::Twist(t) = step.output.drive else {
@@ -308,7 +308,7 @@ fn a_sum_ends_with_its_first_childs_event_so_it_can_be_a_sequencer_state() {
 #[test]
 fn a_rear_first_sum_backs_along_the_vector() {
     let vector = |x, y| MotorOutput::drive(DriveCommand::Vector(MotionVector::new(x, y)));
-    let twist = |s: &mut VectorSum| match s.tick(&Inputs::empty(0.0)).unwrap().output.drive {
+    let twist = |s: &mut VectorSum| match s.tick(&mut (), &Inputs::empty(0.0)).unwrap().output.drive {
         DriveCommand::Twist(t) => t,
         other => panic!("{other:?}"),
     };

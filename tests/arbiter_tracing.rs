@@ -10,7 +10,7 @@ impl Behavior for Fixed {
     fn name(&self) -> &str {
         self.0
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &Inputs<'_>) -> Option<Step> {
         (inputs.now >= self.1 && inputs.now < self.2).then(|| Step::running(self.3, Feedback::new("fixed", inputs.now)))
     }
 }
@@ -41,7 +41,7 @@ fn decisions_are_traced() {
         let hi = Fixed("avoid", 5.0, 10.0, MotorOutput::twist(0.0, 1.0));
         let lo = Fixed("approach", 0.0, 100.0, MotorOutput::twist(0.1, 0.0));
         let mut p = Priority::new("root", vec![Box::new(hi), Box::new(lo)]);
-        p.tick(&Inputs::empty(6.0));
+        p.tick(&mut (), &Inputs::empty(6.0));
     });
     let text = String::from_utf8(buf.0.lock().unwrap().clone()).unwrap();
     assert!(text.contains("decision"), "{text}");

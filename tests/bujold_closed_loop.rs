@@ -5,7 +5,6 @@
 
 mod common;
 
-use marsupial::arbiter::Blackboard;
 use marsupial::behaviors::BuildError;
 use marsupial::behaviors::bujold::{self, Memory};
 use marsupial::behaviors::registry::Registry;
@@ -54,7 +53,7 @@ impl Sensor for Probe {
 
 /// Bujold's robot, built with a registry that also knows the probe's kind.
 fn bujold_agent(profile: &Profile) -> Result<Box<dyn Agent>, BuildError> {
-    let mut registry: Registry<Blackboard<Memory>> = Registry::new();
+    let mut registry: Registry<Memory> = Registry::new();
     registry.register_sensor_kind(PROBE, |_| Ok(()));
     marsupial::behaviors::common::register(&mut registry);
     bujold::register(&mut registry);

@@ -3,7 +3,6 @@
 
 mod common;
 
-use marsupial::arbiter::Blackboard;
 use marsupial::behaviors::bujold::memory::{Memory, RepositionPlan};
 use marsupial::behaviors::bujold::params::*;
 use marsupial::behaviors::bujold::{approach, back_in, decide, departure, move_away, reposition, search};
@@ -16,8 +15,8 @@ use marsupial::schemas::{
     Stamped, Status, Step,
 };
 
-fn memory() -> Blackboard<Memory> {
-    Blackboard::new(Memory::from_profile(&common::shipped_profile("bujold")).unwrap())
+fn memory() -> Memory {
+    Memory::from_profile(&common::shipped_profile("bujold")).unwrap()
 }
 
 /// A view `d` m out, `alpha_deg` off the axis, with `px` pixels in both blocks.
@@ -36,17 +35,15 @@ fn view(d: f64, alpha_deg: f64, px: u64) -> FiducialView {
 
 /// Sets this tick's time, pose and view in memory (what the root's perception does), then
 /// ticks `leaf`.
-fn tick(leaf: &mut dyn Behavior, mem: &Blackboard<Memory>, now: f64, odo: Pose2, v: Option<FiducialView>) -> Step {
-    mem.with(|m| {
-        m.now = now;
-        m.odo = odo;
-        m.view = v;
-        m.planning = v;
-        if v.is_some() {
-            m.last_seen = Some(now);
-            m.ever_seen = true;
-        }
-    });
+fn tick(leaf: &mut dyn Behavior<Memory>, mem: &mut Memory, now: f64, odo: Pose2, v: Option<FiducialView>) -> Step {
+    mem.now = now;
+    mem.odo = odo;
+    mem.view = v;
+    mem.planning = v;
+    if v.is_some() {
+        mem.last_seen = Some(now);
+        mem.ever_seen = true;
+    }
     let mut inputs = Inputs::empty(now);
     inputs.odometry = Some(Stamped::new(
         now,
@@ -55,15 +52,13 @@ fn tick(leaf: &mut dyn Behavior, mem: &Blackboard<Memory>, now: f64, odo: Pose2,
             ..Default::default()
         },
     ));
-    leaf.tick(&inputs).expect("a phase is always active")
+    leaf.tick(mem, &inputs).expect("a phase is always active")
 }
 
-fn enter(leaf: &mut dyn Behavior, mem: &Blackboard<Memory>, now: f64, odo: Pose2) {
-    mem.with(|m| {
-        m.now = now;
-        m.odo = odo;
-    });
-    leaf.enter(&Inputs::empty(now));
+fn enter(leaf: &mut dyn Behavior<Memory>, mem: &mut Memory, now: f64, odo: Pose2) {
+    mem.now = now;
+    mem.odo = odo;
+    leaf.enter(mem, &Inputs::empty(now));
 }
 
 fn at(x: f64) -> Pose2 {
@@ -72,60 +67,60 @@ fn at(x: f64) -> Pose2 {
 
 #[test]
 fn search_turns_toward_the_last_side_acquires_and_times_out_by_what_it_saw() {
-    let mem = memory();
+    let mut mem = memory();
     let rot = SearchRotation {
         rate: 0.4,
         first_sweep: 0.0,
         doubling: false,
     };
-    let mut s = search::Search::new("search", mem.clone(), SearchParams::default(), rot, 40.0);
-    enter(&mut s, &mem, 0.0, at(1.0));
-    mem.with(|m| m.last_side = -1.0);
-    let step = tick(&mut s, &mem, 0.1, at(1.0), None);
+    let mut s = search::Search::new("search", SearchParams::default(), rot, 40.0);
+    enter(&mut s, &mut mem, 0.0, at(1.0));
+    mem.last_side = -1.0;
+    let step = tick(&mut s, &mut mem, 0.1, at(1.0), None);
     assert_eq!(step.status, Status::Running);
     assert_eq!(step.output.drive, DriveCommand::Turn { omega: -0.4 });
     // Acquisition hands over with the approach motor schema's command this very tick.
-    let step = tick(&mut s, &mem, 0.2, at(1.0), Some(view(1.0, 0.0, 800)));
+    let step = tick(&mut s, &mut mem, 0.2, at(1.0), Some(view(1.0, 0.0, 800)));
     assert_eq!(step.status, Status::Event("acquired"));
     assert!(
         matches!(step.output.drive, DriveCommand::Straight { v } if v != 0.0),
         "{step:?}"
     );
     // Never seen: the timeout says so; seen before: the target was lost.
-    let fresh = memory();
-    let mut s = search::Search::new("search", fresh.clone(), SearchParams::default(), rot, 40.0);
-    enter(&mut s, &fresh, 0.0, at(1.0));
-    assert_eq!(tick(&mut s, &fresh, 39.9, at(1.0), None).status, Status::Running);
-    let end = tick(&mut s, &fresh, 40.1, at(1.0), None).status;
+    let mut fresh = memory();
+    let mut s = search::Search::new("search", SearchParams::default(), rot, 40.0);
+    enter(&mut s, &mut fresh, 0.0, at(1.0));
+    assert_eq!(tick(&mut s, &mut fresh, 39.9, at(1.0), None).status, Status::Running);
+    let end = tick(&mut s, &mut fresh, 40.1, at(1.0), None).status;
     assert_eq!(end, Status::Done(Outcome::Failed(FailureReason::TargetNeverDetected)));
-    let mut s = search::Search::new("search", mem.clone(), SearchParams::default(), rot, 40.0);
-    enter(&mut s, &mem, 50.0, at(1.0));
-    let end = tick(&mut s, &mem, 90.1, at(1.0), None).status;
+    let mut s = search::Search::new("search", SearchParams::default(), rot, 40.0);
+    enter(&mut s, &mut mem, 50.0, at(1.0));
+    let end = tick(&mut s, &mut mem, 90.1, at(1.0), None).status;
     assert_eq!(end, Status::Done(Outcome::Failed(FailureReason::TargetLost)));
 }
 
 #[test]
 fn search_is_jammed_when_turning_does_not_change_the_view() {
-    let mem = memory();
+    let mut mem = memory();
     let rot = SearchRotation {
         rate: 0.4,
         first_sweep: 0.0,
         doubling: false,
     };
-    let mut s = search::Search::new("search", mem.clone(), SearchParams::default(), rot, 40.0);
-    enter(&mut s, &mem, 0.0, at(1.0));
+    let mut s = search::Search::new("search", SearchParams::default(), rot, 40.0);
+    enter(&mut s, &mut mem, 0.0, at(1.0));
     let still = RgbImage::new(256, 240);
     let mut events = Vec::new();
     for k in 1..=30 {
         let now = k as f64 * 0.1;
-        mem.with(|m| m.now = now);
+        mem.now = now;
         let cams = [Some(CameraInput {
             stamp: now,
             image: still.view(),
         })];
         let mut inputs = Inputs::empty(now);
         inputs.cameras = &cams;
-        events.push((now, s.tick(&inputs).unwrap().status));
+        events.push((now, s.tick(&mut mem, &inputs).unwrap().status));
     }
     // Still frames from the second on: jammed 1.5 s later; each jam turns the search the
     // other way, and after `max_unjams` (3) the search keeps turning.
@@ -137,72 +132,57 @@ fn search_is_jammed_when_turning_does_not_change_the_view() {
     assert_eq!(jammed.len(), 3, "{events:?}");
     assert!((jammed[0] - 1.7).abs() < 1e-9, "{jammed:?}");
     assert_eq!(events.last().unwrap().1, Status::Running);
-    mem.with(|m| {
-        assert_eq!(m.unjams, 3);
-        assert_eq!(m.last_side, -1.0);
-    });
+    assert_eq!(mem.unjams, 3);
+    assert_eq!(mem.last_side, -1.0);
 }
 
 #[test]
 fn approach_signals_the_dock_a_lost_target_and_an_off_axis_view() {
-    let mem = memory();
-    let total = mem.lock().approach.steering.dock_total_px;
-    let mut a = approach::Approach::new("approach", mem.clone(), ApproachParams::default(), total, 4).unwrap();
-    enter(&mut a, &mem, 0.0, at(1.0));
+    let mut mem = memory();
+    let total = mem.approach.steering.dock_total_px;
+    let mut a = approach::Approach::new("approach", &mem, ApproachParams::default(), total, 4).unwrap();
+    enter(&mut a, &mut mem, 0.0, at(1.0));
     assert_eq!(
-        tick(&mut a, &mem, 0.1, at(1.0), Some(view(1.0, 0.0, 900))).status,
+        tick(&mut a, &mut mem, 0.1, at(1.0), Some(view(1.0, 0.0, 900))).status,
         Status::Running
     );
-    let step = tick(&mut a, &mem, 0.2, at(0.4), Some(view(0.38, 0.0, total as u64)));
+    let step = tick(&mut a, &mut mem, 0.2, at(0.4), Some(view(0.38, 0.0, total as u64)));
     assert_eq!(step.status, Status::Event("at_dock"));
     // Out of sight: hold for 1.5 s, then back to search.
-    assert_eq!(tick(&mut a, &mem, 1.0, at(0.4), None).status, Status::Running);
-    assert_eq!(tick(&mut a, &mem, 1.8, at(0.4), None).status, Status::Event("lost"));
+    assert_eq!(tick(&mut a, &mut mem, 1.0, at(0.4), None).status, Status::Running);
+    assert_eq!(tick(&mut a, &mut mem, 1.8, at(0.4), None).status, Status::Event("lost"));
     // A full window of reliable frames 12° off the axis at 0.8 m is 17 cm off it.
-    mem.with(|m| {
-        for _ in 0..16 {
-            m.alpha_window.push(12f64.to_radians());
-        }
-    });
-    let step = tick(&mut a, &mem, 2.0, at(0.8), Some(view(0.8, 12.0, 1500)));
+    for _ in 0..16 {
+        mem.alpha_window.push(12f64.to_radians());
+    }
+    let step = tick(&mut a, &mut mem, 2.0, at(0.8), Some(view(0.8, 12.0, 1500)));
     assert_eq!(step.status, Status::Event("off_axis"));
-    mem.with(|m| {
-        assert_eq!(m.retries, 1);
-        assert!(m.plan.is_some());
-    });
+    assert_eq!(mem.retries, 1);
+    assert!(mem.plan.is_some());
 }
 
 #[test]
 fn decide_backs_in_aligned_retries_misaligned_and_gives_up_when_out_of_retries() {
-    let mem = memory();
-    let new = |mem: &Blackboard<Memory>| {
-        decide::Decide::new(
-            "decide",
-            mem.clone(),
-            DecideParams::default(),
-            0.02,
-            5f64.to_radians(),
-            1,
-        )
-    };
-    let mut d = new(&mem);
-    enter(&mut d, &mem, 0.0, at(0.4));
+    let mut mem = memory();
+    let new = || decide::Decide::new("decide", DecideParams::default(), 0.02, 5f64.to_radians(), 1);
+    let mut d = new();
+    enter(&mut d, &mut mem, 0.0, at(0.4));
     for k in 1..5 {
-        let s = tick(&mut d, &mem, k as f64 * 0.1, at(0.4), Some(view(0.38, 0.2, 4600)));
+        let s = tick(&mut d, &mut mem, k as f64 * 0.1, at(0.4), Some(view(0.38, 0.2, 4600)));
         assert_eq!(s.status, Status::Running);
     }
-    let s = tick(&mut d, &mem, 0.5, at(0.4), Some(view(0.38, 0.2, 4600)));
+    let s = tick(&mut d, &mut mem, 0.5, at(0.4), Some(view(0.38, 0.2, 4600)));
     assert_eq!(s.status, Status::Event("aligned"));
     assert_eq!(s.output.aux.posture, Some(Posture::Lowered));
     // 5° off at 0.38 m: reposition (a retry), then out of retries: give up.
     for (retries_before, expected) in [(0, "misaligned"), (1, "retries_exhausted")] {
-        mem.with(|m| m.retries = retries_before);
-        enter(&mut d, &mem, 1.0, at(0.4));
+        mem.retries = retries_before;
+        enter(&mut d, &mut mem, 1.0, at(0.4));
         let mut last = None;
         for k in 1..=5 {
             last = Some(tick(
                 &mut d,
-                &mem,
+                &mut mem,
                 1.0 + k as f64 * 0.1,
                 at(0.4),
                 Some(view(0.38, 5.0, 4600)),
@@ -210,76 +190,72 @@ fn decide_backs_in_aligned_retries_misaligned_and_gives_up_when_out_of_retries()
         }
         assert_eq!(last.unwrap().status, Status::Event(expected));
     }
-    assert_eq!(mem.lock().failing, Some(FailureReason::RetriesExhausted));
+    assert_eq!(mem.failing, Some(FailureReason::RetriesExhausted));
     // Too few views within 3 s: lost at the gate.
-    enter(&mut d, &mem, 10.0, at(0.4));
-    assert_eq!(tick(&mut d, &mem, 12.9, at(0.4), None).status, Status::Running);
-    assert_eq!(tick(&mut d, &mem, 13.1, at(0.4), None).status, Status::Event("lost"));
+    enter(&mut d, &mut mem, 10.0, at(0.4));
+    assert_eq!(tick(&mut d, &mut mem, 12.9, at(0.4), None).status, Status::Running);
+    assert_eq!(
+        tick(&mut d, &mut mem, 13.1, at(0.4), None).status,
+        Status::Event("lost")
+    );
 }
 
 #[test]
 fn back_in_drives_blind_and_lowered_then_reports_the_miss() {
-    let mem = memory();
-    mem.with(|m| m.samples_distance = 0.38);
-    let mut b = back_in::BackIn::new("back_in", mem.clone(), BackInParams::default(), 0.30);
-    enter(&mut b, &mem, 0.0, at(0.4));
-    let s = tick(&mut b, &mem, 0.1, at(0.35), None);
+    let mut mem = memory();
+    mem.samples_distance = 0.38;
+    let mut b = back_in::BackIn::new("back_in", BackInParams::default(), 0.30);
+    enter(&mut b, &mut mem, 0.0, at(0.4));
+    let s = tick(&mut b, &mut mem, 0.1, at(0.35), None);
     assert_eq!(s.output.aux.posture, Some(Posture::Lowered));
     assert!(matches!(s.output.drive, DriveCommand::Straight { .. }));
-    let s = tick(&mut b, &mem, 20.0, at(-0.5), None);
+    let s = tick(&mut b, &mut mem, 20.0, at(-0.5), None);
     assert_eq!(s.status, Status::Event("missed"));
-    assert_eq!(mem.lock().failing, Some(FailureReason::FailedToControl));
+    assert_eq!(mem.failing, Some(FailureReason::FailedToControl));
 }
 
 #[test]
 fn reposition_turns_drives_and_turns_to_the_staging_pose() {
-    let mem = memory();
+    let mut mem = memory();
     let target = Pose2::new(0.75, 0.0, 0.0);
-    mem.with(|m| {
-        m.plan = Some(RepositionPlan {
-            target,
-            clear_first: false,
-        });
-        m.alpha_window.push(0.3);
+    mem.plan = Some(RepositionPlan {
+        target,
+        clear_first: false,
     });
-    let mut r = reposition::Reposition::new(
-        "reposition",
-        mem.clone(),
-        RepositionParams::default(),
-        reposition::PlanFrom::Memory,
-    );
+    mem.alpha_window.push(0.3);
+    let mut r = reposition::Reposition::new("reposition", RepositionParams::default(), reposition::PlanFrom::Memory);
     let start = Pose2::new(0.75, 0.4, 0.0);
-    enter(&mut r, &mem, 0.0, start);
+    enter(&mut r, &mut mem, 0.0, start);
     // Facing along x with the target to the right: turn first.
-    let s = tick(&mut r, &mem, 0.1, start, None);
+    let s = tick(&mut r, &mut mem, 0.1, start, None);
     assert!(
         matches!(s.output.drive, DriveCommand::Turn { omega } if omega < 0.0),
         "{s:?}"
     );
     // Facing it: the stage changes, then it drives.
     let facing = Pose2::new(0.75, 0.4, -std::f64::consts::FRAC_PI_2);
-    assert_eq!(tick(&mut r, &mem, 0.2, facing, None).status, Status::Running);
-    let s = tick(&mut r, &mem, 0.3, facing, None);
+    assert_eq!(tick(&mut r, &mut mem, 0.2, facing, None).status, Status::Running);
+    let s = tick(&mut r, &mut mem, 0.3, facing, None);
     assert!(
         matches!(s.output.drive, DriveCommand::Straight { v } if v > 0.0),
         "{s:?}"
     );
     // Arrived, facing the wrong way: turn to the staging heading, then done.
     let there = Pose2::new(0.75, 0.0, -std::f64::consts::FRAC_PI_2);
-    tick(&mut r, &mem, 0.4, there, None);
-    let s = tick(&mut r, &mem, 0.5, there, None);
+    tick(&mut r, &mut mem, 0.4, there, None);
+    let s = tick(&mut r, &mut mem, 0.5, there, None);
     assert!(
         matches!(s.output.drive, DriveCommand::Turn { omega } if omega > 0.0),
         "{s:?}"
     );
-    let s = tick(&mut r, &mem, 0.6, target, None);
+    let s = tick(&mut r, &mut mem, 0.6, target, None);
     assert_eq!(s.status, Status::Event("aligned"));
-    assert!(!mem.lock().alpha_window.is_full() && mem.lock().alpha_window.median().is_none());
+    assert!(!mem.alpha_window.is_full() && mem.alpha_window.median().is_none());
 }
 
 #[test]
 fn move_away_retries_and_give_up_fails_with_the_reason_left_in_memory() {
-    let mem = memory();
+    let mut mem = memory();
     for (give_up, failing, expected) in [
         (false, None, Status::Event("done")),
         (true, None, Status::Done(Outcome::Failed(FailureReason::Timeout))),
@@ -289,61 +265,67 @@ fn move_away_retries_and_give_up_fails_with_the_reason_left_in_memory() {
             Status::Done(Outcome::Failed(FailureReason::FailedToControl)),
         ),
     ] {
-        mem.with(|m| m.failing = failing);
-        let mut m = move_away::MoveAway::new("away", mem.clone(), MoveAwayParams::default(), give_up);
-        enter(&mut m, &mem, 0.0, at(0.4));
-        assert_eq!(tick(&mut m, &mem, 0.1, at(0.5), None).status, Status::Running);
-        assert_eq!(tick(&mut m, &mem, 6.0, at(0.76), None).status, expected);
+        mem.failing = failing;
+        let mut m = move_away::MoveAway::new("away", MoveAwayParams::default(), give_up);
+        enter(&mut m, &mut mem, 0.0, at(0.4));
+        assert_eq!(tick(&mut m, &mut mem, 0.1, at(0.5), None).status, Status::Running);
+        assert_eq!(tick(&mut m, &mut mem, 6.0, at(0.76), None).status, expected);
     }
 }
 
 #[test]
 fn departure_undocks_imprints_once_and_fails_without_an_imprint() {
-    let mem = memory();
-    let mut u = departure::Undock::new("undock", mem.clone(), UndockParams::default(), 0.30);
-    enter(&mut u, &mem, 0.0, at(-0.2));
-    let s = tick(&mut u, &mem, 0.1, at(-0.1), None);
+    let mut mem = memory();
+    let mut u = departure::Undock::new("undock", UndockParams::default(), 0.30);
+    enter(&mut u, &mut mem, 0.0, at(-0.2));
+    let s = tick(&mut u, &mut mem, 0.1, at(-0.1), None);
     assert_eq!(
         (s.status, s.output.aux.posture),
         (Status::Running, Some(Posture::Lowered))
     );
-    assert_eq!(tick(&mut u, &mem, 5.0, at(0.16), None).status, Status::Event("out"));
-    let mut d = departure::DriveOut::new("drive_out", mem.clone(), DriveOutParams::default(), 0.6);
-    enter(&mut d, &mem, 5.0, at(0.16));
-    assert_eq!(tick(&mut d, &mem, 6.0, at(0.3), None).status, Status::Running);
-    assert_eq!(tick(&mut d, &mem, 9.0, at(0.41), None).status, Status::Event("imprint"));
-    // The imprint (here on no frames) failed: imprinting is tried again.
-    let mut i = Imprint::new("imprint", mem.clone(), 0, 2, ImprintEnd::Event("imprinted"));
-    enter(&mut i, &mem, 9.0, at(0.41));
-    assert_eq!(tick(&mut i, &mem, 9.1, at(0.41), None).status, Status::Running);
+    assert_eq!(tick(&mut u, &mut mem, 5.0, at(0.16), None).status, Status::Event("out"));
+    let mut d = departure::DriveOut::new("drive_out", DriveOutParams::default(), 0.6);
+    enter(&mut d, &mut mem, 5.0, at(0.16));
+    assert_eq!(tick(&mut d, &mut mem, 6.0, at(0.3), None).status, Status::Running);
     assert_eq!(
-        tick(&mut i, &mem, 9.2, at(0.41), None).status,
+        tick(&mut d, &mut mem, 9.0, at(0.41), None).status,
+        Status::Event("imprint")
+    );
+    // The imprint (here on no frames) failed: imprinting is tried again.
+    let mut i = Imprint::new("imprint", 0, 2, ImprintEnd::Event("imprinted"));
+    enter(&mut i, &mut mem, 9.0, at(0.41));
+    assert_eq!(tick(&mut i, &mut mem, 9.1, at(0.41), None).status, Status::Running);
+    assert_eq!(
+        tick(&mut i, &mut mem, 9.2, at(0.41), None).status,
         Status::Event("imprinted")
     );
-    assert!(!mem.lock().imprinted);
-    assert_eq!(tick(&mut d, &mem, 9.3, at(0.41), None).status, Status::Event("imprint"));
-    // Imprinted: on out, and done at the departure distance.
-    mem.with(|m| m.imprinted = true);
-    assert_eq!(tick(&mut d, &mem, 12.0, at(0.6), None).status, Status::Running);
+    assert!(!mem.imprinted);
     assert_eq!(
-        tick(&mut d, &mem, 20.0, at(1.1), None).status,
+        tick(&mut d, &mut mem, 9.3, at(0.41), None).status,
+        Status::Event("imprint")
+    );
+    // Imprinted: on out, and done at the departure distance.
+    mem.imprinted = true;
+    assert_eq!(tick(&mut d, &mut mem, 12.0, at(0.6), None).status, Status::Running);
+    assert_eq!(
+        tick(&mut d, &mut mem, 20.0, at(1.1), None).status,
         Status::Done(Outcome::Completed)
     );
     // An imprint distance beyond the departure's: it ends without imprinting, and says so.
-    mem.with(|m| m.imprinted = false);
-    let mut far = departure::DriveOut::new("drive_out", mem.clone(), DriveOutParams::default(), 2.0);
-    let end = tick(&mut far, &mem, 20.0, at(1.1), None).status;
+    mem.imprinted = false;
+    let mut far = departure::DriveOut::new("drive_out", DriveOutParams::default(), 2.0);
+    let end = tick(&mut far, &mut mem, 20.0, at(1.1), None).status;
     assert_eq!(end, Status::Done(Outcome::Failed(FailureReason::TargetNeverDetected)));
 }
 
 #[test]
 fn the_dock_switch_is_released_only_by_contact() {
-    let mem = memory();
-    let mut c = DockSwitch::new("dock_switch", mem.clone());
-    assert!(c.tick(&Inputs::empty(0.0)).is_none());
+    let mut mem = memory();
+    let mut c = DockSwitch::new("dock_switch");
+    assert!(c.tick(&mut mem, &Inputs::empty(0.0)).is_none());
     let mut inputs = Inputs::empty(0.1);
     inputs.dock_contact = Some(Stamped::new(0.1, true));
-    let s = c.tick(&inputs).unwrap();
+    let s = c.tick(&mut mem, &inputs).unwrap();
     assert_eq!(s.status, Status::Done(Outcome::Docked));
     assert_eq!(s.output.aux.posture, Some(Posture::Lowered));
 }

@@ -65,7 +65,7 @@ fn agent_for_builds_raposa_on_the_two_block_adapter() {
     let p = profile();
     assert!(agent_for(&p).is_ok());
     let agent = raposa::agent(&p).unwrap();
-    let m = agent.memory().lock();
+    let m = agent.memory();
     let Source::TwoBlock(cues) = &m.source else {
         panic!("the two-block flap must select the two-block source");
     };

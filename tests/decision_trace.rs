@@ -38,7 +38,7 @@ fn tick(agent: &mut Box<dyn Agent>, t: f64, frame: &RgbImage, contact: bool) -> 
         },
     ));
     inputs.dock_contact = Some(Stamped::new(t, contact));
-    agent.tick(&inputs);
+    agent.tick(&mut (), &inputs);
     let mut out = Vec::new();
     agent.explain(&mut out);
     out

@@ -67,7 +67,7 @@ impl Behavior for Watch {
     fn name(&self) -> &str {
         "watch"
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &Inputs<'_>) -> Option<Step> {
         let x = inputs.odometry.map_or(f64::NAN, |o| o.value.pose.x);
         let b = inputs.camera(0).map_or(0, |c| c.image.as_bytes()[0]);
         self.0.lock().unwrap().push((x, b));

@@ -296,7 +296,7 @@ fn composed_bujold_ticks_do_not_allocate() {
                     ..Default::default()
                 },
             ));
-            if let Some(s) = agent.tick(&inputs) {
+            if let Some(s) = agent.tick(&mut (), &inputs) {
                 phases = phases.wrapping_add(s.feedback.phase.len() as u64);
             }
         }
@@ -384,7 +384,7 @@ fn composed_raposa_ticks_do_not_allocate() {
                     ..Default::default()
                 },
             ));
-            if let Some(s) = agent.tick(&inputs) {
+            if let Some(s) = agent.tick(&mut (), &inputs) {
                 n = n.wrapping_add(s.feedback.phase.len() as u64);
                 pose = integrate_twist(&pose, &s.output.drive.to_twist(), 0.1);
                 if phases.len() < phases.capacity() && !phases.contains(&s.feedback.phase) {

@@ -87,7 +87,7 @@ impl Behavior for Creep {
     fn name(&self) -> &str {
         "creep"
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &Inputs<'_>) -> Option<Step> {
         let seen = inputs.camera(0).is_some() && inputs.sensor(0).is_some();
         Some(Step::running(
             MotorOutput::twist(if seen { 0.1 } else { 0.0 }, 0.0),

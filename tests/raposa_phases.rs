@@ -5,7 +5,7 @@
 
 mod common;
 
-use marsupial::arbiter::{Blackboard, Selector};
+use marsupial::arbiter::Selector;
 use marsupial::behaviors::SharedMemory;
 use marsupial::behaviors::common::docking::{DockSwitch, Imprint, ImprintEnd};
 use marsupial::behaviors::raposa::back_away::{BackAway, Distance};
@@ -29,8 +29,8 @@ fn profile() -> Profile {
     common::shipped_profile("raposa")
 }
 
-fn memory() -> Blackboard<Memory> {
-    Blackboard::new(Memory::from_profile(&profile()).unwrap())
+fn memory() -> Memory {
+    Memory::from_profile(&profile()).unwrap()
 }
 
 /// What the pyramid schema would report: an ellipse `d` m away (with a pair when
@@ -92,23 +92,19 @@ fn inputs(now: f64, odo: Pose2) -> Inputs<'static> {
 
 /// Sets this tick's time, pose and percept in memory (what the root's perception does),
 /// then ticks `leaf`.
-fn tick(leaf: &mut dyn Behavior, mem: &Blackboard<Memory>, now: f64, odo: Pose2, p: PyramidPercept) -> Step {
-    mem.with(|m| {
-        m.now = now;
-        m.odo = odo;
-        m.percept = p;
-    });
-    leaf.tick(&inputs(now, odo)).expect("a phase is always active")
+fn tick(leaf: &mut dyn Behavior<Memory>, mem: &mut Memory, now: f64, odo: Pose2, p: PyramidPercept) -> Step {
+    mem.now = now;
+    mem.odo = odo;
+    mem.percept = p;
+    leaf.tick(mem, &inputs(now, odo)).expect("a phase is always active")
 }
 
 /// Enters `leaf` at `now`, `odo`, with percept `p` in memory.
-fn enter(leaf: &mut dyn Behavior, mem: &Blackboard<Memory>, now: f64, odo: Pose2, p: PyramidPercept) {
-    mem.with(|m| {
-        m.now = now;
-        m.odo = odo;
-        m.percept = p;
-    });
-    leaf.enter(&inputs(now, odo));
+fn enter(leaf: &mut dyn Behavior<Memory>, mem: &mut Memory, now: f64, odo: Pose2, p: PyramidPercept) {
+    mem.now = now;
+    mem.odo = odo;
+    mem.percept = p;
+    leaf.enter(mem, &inputs(now, odo));
 }
 
 fn twist(s: &Step) -> Twist {
@@ -133,82 +129,91 @@ fn at(x: f64) -> Pose2 {
 
 #[test]
 fn servo_states_steer_on_what_they_see() {
-    let mem = memory();
+    let mut mem = memory();
     let g = marsupial::behaviors::catalog::tuning::<marsupial::behaviors::raposa::Raposa>(&profile())
         .unwrap()
         .seven_state;
     // State 1 near the pyramid: slower than the far speed, turning against x_dev; the
     // camera looks back, so "toward the pyramid" is body-backward.
-    let mut s1 = servo::Approach::new("approach", mem.clone());
-    let step = tick(&mut s1, &mem, 0.1, at(1.0), seen(0.6, Some(5.0), [20.0, 0.0], true));
+    let mut s1 = servo::Approach::new("approach");
+    let step = tick(&mut s1, &mut mem, 0.1, at(1.0), seen(0.6, Some(5.0), [20.0, 0.0], true));
     assert_eq!(step.status, Status::Running);
     let t = twist(&step);
     assert!(t.v < 0.0 && -t.v < g.far_speed_mps, "{t:?}");
     assert!((t.omega - -g.k_ang * 20.0).abs() < 1e-12, "{t:?}");
     // State 3: a lone ellipse far away, at the far speed.
-    let mut s3 = servo::FarEllipse::new("far_ellipse", mem.clone());
-    let t = twist(&tick(&mut s3, &mem, 0.2, at(1.0), seen(2.0, None, [0.0, 0.0], false)));
+    let mut s3 = servo::FarEllipse::new("far_ellipse");
+    let t = twist(&tick(
+        &mut s3,
+        &mut mem,
+        0.2,
+        at(1.0),
+        seen(2.0, None, [0.0, 0.0], false),
+    ));
     assert_eq!(t.v, -g.far_speed_mps);
     // Without an ellipse both stand still.
     assert_eq!(
-        tick(&mut s1, &mem, 0.3, at(1.0), nothing()).output.drive,
+        tick(&mut s1, &mut mem, 0.3, at(1.0), nothing()).output.drive,
         DriveCommand::Stop
     );
     // State 4: turn toward the blue edges; creep only within `centred_px` of the centre.
-    let mut s4 = servo::BlueOnly::new("blue_only", mem.clone(), BlueOnlyParams::default());
+    let mut s4 = servo::BlueOnly::new("blue_only", BlueOnlyParams::default());
     let mut blue = nothing();
     blue.detection.blue = Some(blue_at(80));
-    let t = twist(&tick(&mut s4, &mem, 0.4, at(1.0), blue));
+    let t = twist(&tick(&mut s4, &mut mem, 0.4, at(1.0), blue));
     assert_eq!((t.v, t.omega), (-g.final_speed_mps, 0.0), "centred: creep straight");
     blue.detection.blue = Some(blue_at(100));
-    let t = twist(&tick(&mut s4, &mem, 0.5, at(1.0), blue));
+    let t = twist(&tick(&mut s4, &mut mem, 0.5, at(1.0), blue));
     assert_eq!(t.v, 0.0, "20 px off: turn only");
     assert!((t.omega - -g.k_ang * 20.0).abs() < 1e-12);
     let wide = BlueOnlyParams { centred_px: 30.0 };
-    let mut s4 = servo::BlueOnly::new("blue_only", mem.clone(), wide);
-    assert_eq!(twist(&tick(&mut s4, &mem, 0.6, at(1.0), blue)).v, -g.final_speed_mps);
+    let mut s4 = servo::BlueOnly::new("blue_only", wide);
+    assert_eq!(
+        twist(&tick(&mut s4, &mut mem, 0.6, at(1.0), blue)).v,
+        -g.final_speed_mps
+    );
 }
 
 #[test]
 fn search_waits_its_grace_frames_turns_away_from_the_last_turn_and_times_out() {
-    let mem = memory();
-    let mut s = search::Search::new("search", mem.clone(), SearchParams::default(), 60.0);
-    mem.with(|m| m.last_turn = 1.0);
+    let mut mem = memory();
+    let mut s = search::Search::new("search", SearchParams::default(), 60.0);
+    mem.last_turn = 1.0;
     for k in 1..=3 {
-        let step = tick(&mut s, &mem, k as f64 * 0.1, at(1.0), nothing());
+        let step = tick(&mut s, &mut mem, k as f64 * 0.1, at(1.0), nothing());
         assert_eq!(step.output.drive, DriveCommand::Stop, "grace frame {k}");
     }
-    let step = tick(&mut s, &mem, 0.4, at(1.0), nothing());
+    let step = tick(&mut s, &mut mem, 0.4, at(1.0), nothing());
     assert!(turn_rate(&step) < 0.0, "away from the last (left) turn: {step:?}");
-    assert_eq!(mem.lock().search_start, Some(0.4));
-    assert_eq!(tick(&mut s, &mem, 60.4, at(1.0), nothing()).status, Status::Running);
+    assert_eq!(mem.search_start, Some(0.4));
+    assert_eq!(tick(&mut s, &mut mem, 60.4, at(1.0), nothing()).status, Status::Running);
     assert_eq!(
-        tick(&mut s, &mem, 60.5, at(1.0), nothing()).status,
+        tick(&mut s, &mut mem, 60.5, at(1.0), nothing()).status,
         Status::Done(Outcome::Failed(FailureReason::TargetLost))
     );
     // Five grace frames: still standing on the fourth.
-    let mem = memory();
-    let mut s = search::Search::new("search", mem.clone(), SearchParams { grace_frames: 5 }, 60.0);
+    let mut mem = memory();
+    let mut s = search::Search::new("search", SearchParams { grace_frames: 5 }, 60.0);
     for k in 1..=4 {
-        tick(&mut s, &mem, k as f64 * 0.1, at(1.0), nothing());
+        tick(&mut s, &mut mem, k as f64 * 0.1, at(1.0), nothing());
     }
-    assert_eq!(mem.lock().unseen, 4);
-    assert_eq!(mem.lock().search_start, None);
+    assert_eq!(mem.unseen, 4);
+    assert_eq!(mem.search_start, None);
 }
 
 #[test]
 fn align_plans_counts_and_hands_over_already_turning() {
-    let mem = memory();
-    mem.with(|m| m.settling = true);
-    let mut a = align::Align::new("align", mem.clone());
+    let mut mem = memory();
+    mem.settling = true;
+    let mut a = align::Align::new("align");
     // No pair, no plan.
-    let step = tick(&mut a, &mem, 0.1, at(1.0), seen(1.5, None, [0.0, 0.0], false));
+    let step = tick(&mut a, &mut mem, 0.1, at(1.0), seen(1.5, None, [0.0, 0.0], false));
     assert_eq!(step.status, Status::Running);
-    assert_eq!(mem.lock().manoeuvres, 0);
+    assert_eq!(mem.manoeuvres, 0);
     let p = seen(1.5, Some(40.0), [0.0, 0.0], true);
-    let step = tick(&mut a, &mem, 0.2, at(1.0), p);
+    let step = tick(&mut a, &mut mem, 0.2, at(1.0), p);
     assert_eq!(step.status, Status::Event("planned"));
-    let m = mem.lock();
+    let m = &mem;
     let pl = m.plan.expect("the plan is in memory for region II");
     let expected = plan(
         robot_in_ball_frame(&p.view.unwrap(), 40f64.to_radians(), m.camera_x),
@@ -223,13 +228,11 @@ fn align_plans_counts_and_hands_over_already_turning() {
 }
 
 /// A memory holding a plan that turns `rotation_deg` first.
-fn planned(rotation_deg: f64) -> Blackboard<Memory> {
-    let mem = memory();
-    mem.with(|m| {
-        let mut pl = plan(Pose2::new(1.5, 0.5, 0.0), 0.9, 0.4);
-        pl.rotation = rotation_deg.to_radians();
-        m.plan = Some(pl);
-    });
+fn planned(rotation_deg: f64) -> Memory {
+    let mut mem = memory();
+    let mut pl = plan(Pose2::new(1.5, 0.5, 0.0), 0.9, 0.4);
+    pl.rotation = rotation_deg.to_radians();
+    mem.plan = Some(pl);
     mem
 }
 
@@ -241,14 +244,20 @@ fn at_bearing(bearing: f64, dev_x: f64) -> PyramidPercept {
 
 #[test]
 fn rotate_7_measures_the_rotation_by_vision_and_resets_the_odometry_frame() {
-    let mem = planned(17.0);
-    let mut r = rotate7::Rotate7::new("rotate_7", mem.clone());
-    enter(&mut r, &mem, 0.0, at(1.0), at_bearing(0.0, 0.0));
+    let mut mem = planned(17.0);
+    let mut r = rotate7::Rotate7::new("rotate_7");
+    enter(&mut r, &mut mem, 0.0, at(1.0), at_bearing(0.0, 0.0));
     // 0.05 rad per frame toward a 17° (0.297 rad) goal, tolerance 2°: the predictor stops
     // at 0.25 rad turned (next frame would reach 0.30).
     let mut events = Vec::new();
     for k in 1..=6 {
-        let step = tick(&mut r, &mem, k as f64 * 0.1, at(1.0), at_bearing(-0.05 * k as f64, 0.0));
+        let step = tick(
+            &mut r,
+            &mut mem,
+            k as f64 * 0.1,
+            at(1.0),
+            at_bearing(-0.05 * k as f64, 0.0),
+        );
         events.push(step.status);
         if step.status != Status::Running {
             assert_eq!(step.output.drive, DriveCommand::Stop);
@@ -260,7 +269,7 @@ fn rotate_7_measures_the_rotation_by_vision_and_resets_the_odometry_frame() {
     assert_eq!(*events.last().unwrap(), Status::Event("rotated"));
     // The manoeuvre's frame: the robot's planned start, turned by what vision measured,
     // sits at this tick's odometry pose.
-    let m = mem.lock();
+    let m = &mem;
     let pl = m.plan.unwrap();
     let start = Pose2::new(pl.start.x, pl.start.y, pl.start.theta + 0.25);
     let here = m.map.compose(&start);
@@ -272,205 +281,200 @@ fn rotate_7_measures_the_rotation_by_vision_and_resets_the_odometry_frame() {
 
 #[test]
 fn rotate_7_stops_before_the_image_edge_and_gives_up_when_lost() {
-    let mem = planned(40.0);
-    let mut r = rotate7::Rotate7::new("rotate_7", mem.clone());
-    enter(&mut r, &mem, 0.0, at(1.0), at_bearing(0.0, 50.0));
+    let mut mem = planned(40.0);
+    let mut r = rotate7::Rotate7::new("rotate_7");
+    enter(&mut r, &mut mem, 0.0, at(1.0), at_bearing(0.0, 50.0));
     // 0.05 rad is 18 px at f = 361 px: 50 + 18 passes 80 − 10 px.
     assert_eq!(
-        tick(&mut r, &mem, 0.1, at(1.0), at_bearing(-0.05, 55.0)).status,
+        tick(&mut r, &mut mem, 0.1, at(1.0), at_bearing(-0.05, 55.0)).status,
         Status::Event("edge")
     );
     // Lost: stand still; the event comes on the `lost_frames`-th frame without it.
-    let lost_frames = mem.lock().gains.lost_frames;
-    enter(&mut r, &mem, 1.0, at(1.0), at_bearing(0.0, 0.0));
+    let lost_frames = mem.gains.lost_frames;
+    enter(&mut r, &mut mem, 1.0, at(1.0), at_bearing(0.0, 0.0));
     for k in 1..lost_frames {
-        let step = tick(&mut r, &mem, 1.0 + k as f64 * 0.1, at(1.0), nothing());
+        let step = tick(&mut r, &mut mem, 1.0 + k as f64 * 0.1, at(1.0), nothing());
         assert_eq!((step.status, step.output.drive), (Status::Running, DriveCommand::Stop));
     }
     assert_eq!(
-        tick(&mut r, &mem, 2.0, at(1.0), nothing()).status,
+        tick(&mut r, &mut mem, 2.0, at(1.0), nothing()).status,
         Status::Event("lost")
     );
 }
 
 #[test]
 fn the_blind_manoeuvre_turns_travels_and_faces_the_ball_by_odometry() {
-    let mem = memory();
+    let mut mem = memory();
     let pl = plan(Pose2::new(1.5, 0.8, 0.0), 0.9, 0.4);
-    mem.with(|m| {
-        m.plan = Some(pl);
-        m.map = Pose2::default();
-    });
-    let mut rot = Manoeuvre::new("rotate_odo", mem.clone(), Part::RotateOdo);
-    enter(&mut rot, &mem, 0.0, Pose2::new(1.5, 0.8, 0.0), nothing());
-    assert!(mem.lock().blind, "entering the blind part tells the perception");
-    let step = tick(&mut rot, &mem, 0.1, Pose2::new(1.5, 0.8, 0.0), nothing());
+    mem.plan = Some(pl);
+    mem.map = Pose2::default();
+    let mut rot = Manoeuvre::new("rotate_odo", Part::RotateOdo);
+    enter(&mut rot, &mut mem, 0.0, Pose2::new(1.5, 0.8, 0.0), nothing());
+    assert!(mem.blind, "entering the blind part tells the perception");
+    let step = tick(&mut rot, &mut mem, 0.1, Pose2::new(1.5, 0.8, 0.0), nothing());
     assert_eq!(step.status, Status::Running);
     assert_eq!(turn_rate(&step).signum(), pl.rotation.signum());
     let facing = Pose2::new(1.5, 0.8, pl.travel_heading);
     assert_eq!(
-        tick(&mut rot, &mem, 0.2, facing, nothing()).status,
+        tick(&mut rot, &mut mem, 0.2, facing, nothing()).status,
         Status::Event("rotated")
     );
-    let mut travel = Manoeuvre::new("travel", mem.clone(), Part::Travel);
-    enter(&mut travel, &mem, 0.2, facing, nothing());
-    let step = tick(&mut travel, &mem, 0.3, facing, nothing());
+    let mut travel = Manoeuvre::new("travel", Part::Travel);
+    enter(&mut travel, &mut mem, 0.2, facing, nothing());
+    let step = tick(&mut travel, &mut mem, 0.3, facing, nothing());
     assert!(twist(&step).v != 0.0, "{step:?}");
     let arrived = Pose2::new(pl.target.0, pl.target.1, pl.travel_heading);
     assert_eq!(
-        tick(&mut travel, &mem, 0.4, arrived, nothing()).status,
+        tick(&mut travel, &mut mem, 0.4, arrived, nothing()).status,
         Status::Event("arrived")
     );
     // φ: the ball is at the frame's origin; the camera looks back, so the body faces +x.
-    let mut phi = Manoeuvre::new("rotate_phi", mem.clone(), Part::RotatePhi);
-    enter(&mut phi, &mem, 0.4, arrived, nothing());
-    assert!(turn_rate(&tick(&mut phi, &mem, 0.5, arrived, nothing())) != 0.0);
-    let done = tick(&mut phi, &mem, 0.6, Pose2::new(pl.target.0, 0.0, 0.01), nothing());
+    let mut phi = Manoeuvre::new("rotate_phi", Part::RotatePhi);
+    enter(&mut phi, &mut mem, 0.4, arrived, nothing());
+    assert!(turn_rate(&tick(&mut phi, &mut mem, 0.5, arrived, nothing())) != 0.0);
+    let done = tick(&mut phi, &mut mem, 0.6, Pose2::new(pl.target.0, 0.0, 0.01), nothing());
     assert_eq!(done.status, Status::Event("facing"));
     assert_eq!(done.output.drive, DriveCommand::Stop);
 }
 
 #[test]
 fn look_clears_blind_settles_then_searches_away_from_the_last_turn() {
-    let mem = memory();
-    mem.with(|m| {
-        m.blind = true;
-        m.last_turn = 1.0;
-    });
-    let mut look = search::Look::new("look", mem.clone(), LookParams::default(), 60.0);
-    enter(&mut look, &mem, 10.0, at(1.0), nothing());
-    assert!(!mem.lock().blind);
-    mem.with(|m| m.last_turn = -1.0); // later turns do not change the first direction
+    let mut mem = memory();
+    mem.blind = true;
+    mem.last_turn = 1.0;
+    let mut look = search::Look::new("look", LookParams::default(), 60.0);
+    enter(&mut look, &mut mem, 10.0, at(1.0), nothing());
+    assert!(!mem.blind);
+    mem.last_turn = -1.0; // later turns do not change the first direction
     assert_eq!(
-        tick(&mut look, &mem, 10.4, at(1.0), nothing()).output.drive,
+        tick(&mut look, &mut mem, 10.4, at(1.0), nothing()).output.drive,
         DriveCommand::Stop
     );
-    assert!(turn_rate(&tick(&mut look, &mem, 10.6, at(1.0), nothing())) < 0.0);
+    assert!(turn_rate(&tick(&mut look, &mut mem, 10.6, at(1.0), nothing())) < 0.0);
     assert_eq!(
-        tick(&mut look, &mem, 70.1, at(1.0), nothing()).status,
+        tick(&mut look, &mut mem, 70.1, at(1.0), nothing()).status,
         Status::Done(Outcome::Failed(FailureReason::TargetLost))
     );
-    let mut slow = search::Look::new("look", mem.clone(), LookParams { settle_s: 2.0 }, 60.0);
-    enter(&mut slow, &mem, 0.0, at(1.0), nothing());
+    let mut slow = search::Look::new("look", LookParams { settle_s: 2.0 }, 60.0);
+    enter(&mut slow, &mut mem, 0.0, at(1.0), nothing());
     assert_eq!(
-        tick(&mut slow, &mem, 1.9, at(1.0), nothing()).output.drive,
+        tick(&mut slow, &mut mem, 1.9, at(1.0), nothing()).output.drive,
         DriveCommand::Stop
     );
 }
 
 #[test]
 fn final_runs_the_state_1_law_once_then_creeps_and_retries() {
-    let mem = memory();
+    let mut mem = memory();
     let g = marsupial::behaviors::catalog::tuning::<marsupial::behaviors::raposa::Raposa>(&profile())
         .unwrap()
         .seven_state;
-    let mut f = final_approach::FinalApproach::new("final", mem.clone(), 3);
+    let mut f = final_approach::FinalApproach::new("final", 3);
     let near = seen(0.28, Some(3.0), [4.0, 10.0], true);
-    enter(&mut f, &mem, 5.0, at(0.5), near);
-    let aux = mem.lock().aux;
+    enter(&mut f, &mut mem, 5.0, at(0.5), near);
+    let aux = mem.aux;
     assert_eq!(aux.arm, Some(-g.k_arm * 10.0));
     assert_eq!(aux.lights, Some(true));
-    let first = tick(&mut f, &mem, 5.0, at(0.5), near);
-    let mut approach = servo::Approach::new("approach", mem.clone());
-    assert_eq!(first.output, tick(&mut approach, &mem, 5.0, at(0.5), near).output);
+    let first = tick(&mut f, &mut mem, 5.0, at(0.5), near);
+    let mut approach = servo::Approach::new("approach");
+    assert_eq!(first.output, tick(&mut approach, &mut mem, 5.0, at(0.5), near).output);
     assert_eq!(first.output.aux.lights, Some(true));
-    let t = twist(&tick(&mut f, &mem, 5.1, at(0.5), near));
+    let t = twist(&tick(&mut f, &mut mem, 5.1, at(0.5), near));
     assert_eq!(t.v, -g.final_speed_mps);
-    assert_eq!(tick(&mut f, &mem, 14.9, at(0.5), near).status, Status::Running);
-    let end = tick(&mut f, &mem, 15.1, at(0.5), near);
+    assert_eq!(tick(&mut f, &mut mem, 14.9, at(0.5), near).status, Status::Running);
+    let end = tick(&mut f, &mut mem, 15.1, at(0.5), near);
     assert_eq!(end.status, Status::Event("retry"));
     assert_eq!(end.output.drive, DriveCommand::Stop);
     assert_eq!(end.output.aux.lights, Some(false));
-    assert_eq!(mem.lock().retries, 1);
+    assert_eq!(mem.retries, 1);
     // The last retry used: retries exhausted.
-    mem.with(|m| m.retries = 3);
-    enter(&mut f, &mem, 20.0, at(0.5), near);
-    tick(&mut f, &mem, 20.0, at(0.5), near);
+    mem.retries = 3;
+    enter(&mut f, &mut mem, 20.0, at(0.5), near);
+    tick(&mut f, &mut mem, 20.0, at(0.5), near);
     assert_eq!(
-        tick(&mut f, &mem, 30.1, at(0.5), near).status,
+        tick(&mut f, &mut mem, 30.1, at(0.5), near).status,
         Status::Done(Outcome::Failed(FailureReason::RetriesExhausted))
     );
 }
 
 #[test]
 fn back_aways_leave_by_their_distance_then_clear() {
-    let mem = memory();
+    let mut mem = memory();
     let g = marsupial::behaviors::catalog::tuning::<marsupial::behaviors::raposa::Raposa>(&profile())
         .unwrap()
         .seven_state;
-    let mut retreat = BackAway::new("retreat", mem.clone(), Distance::Retreat(RetreatParams::default()));
-    enter(&mut retreat, &mem, 0.0, at(0.5), nothing());
-    let step = tick(&mut retreat, &mem, 0.1, at(0.6), nothing());
+    let mut retreat = BackAway::new("retreat", Distance::Retreat(RetreatParams::default()));
+    enter(&mut retreat, &mut mem, 0.0, at(0.5), nothing());
+    let step = tick(&mut retreat, &mut mem, 0.1, at(0.6), nothing());
     assert_eq!(twist(&step).v, g.far_speed_mps, "body forward, away from the pyramid");
     assert_eq!(
-        tick(&mut retreat, &mem, 0.2, at(0.89), nothing()).status,
+        tick(&mut retreat, &mut mem, 0.2, at(0.89), nothing()).status,
         Status::Running
     );
     assert_eq!(
-        tick(&mut retreat, &mem, 0.3, at(0.91), nothing()).status,
+        tick(&mut retreat, &mut mem, 0.3, at(0.91), nothing()).status,
         Status::Event("cleared")
     );
     // The dead zone: the socket is 0.43 − 0.1 = 0.33 m from the ball; out to 0.6 m.
-    let mut dz = BackAway::new(
-        "leave_dead_zone",
-        mem.clone(),
-        Distance::DeadZone(LeaveDeadZoneParams::default()),
-    );
+    let mut dz = BackAway::new("leave_dead_zone", Distance::DeadZone(LeaveDeadZoneParams::default()));
     let close = seen(0.43, Some(60.0), [0.0, 0.0], true);
-    enter(&mut dz, &mem, 0.0, at(0.5), close);
-    assert_eq!(tick(&mut dz, &mem, 0.1, at(0.76), close).status, Status::Running);
+    enter(&mut dz, &mut mem, 0.0, at(0.5), close);
+    assert_eq!(tick(&mut dz, &mut mem, 0.1, at(0.76), close).status, Status::Running);
     assert_eq!(
-        tick(&mut dz, &mem, 0.2, at(0.78), close).status,
+        tick(&mut dz, &mut mem, 0.2, at(0.78), close).status,
         Status::Event("cleared")
     );
     // Already past the exit distance: the shortest back-away still runs.
     let out = seen(1.0, Some(60.0), [0.0, 0.0], true);
     let p = LeaveDeadZoneParams { min_distance_m: 0.2 };
-    let mut dz = BackAway::new("leave_dead_zone", mem.clone(), Distance::DeadZone(p));
-    enter(&mut dz, &mem, 0.0, at(0.5), out);
-    assert_eq!(tick(&mut dz, &mem, 0.1, at(0.69), out).status, Status::Running);
-    assert_eq!(tick(&mut dz, &mem, 0.2, at(0.71), out).status, Status::Event("cleared"));
+    let mut dz = BackAway::new("leave_dead_zone", Distance::DeadZone(p));
+    enter(&mut dz, &mut mem, 0.0, at(0.5), out);
+    assert_eq!(tick(&mut dz, &mut mem, 0.1, at(0.69), out).status, Status::Running);
+    assert_eq!(
+        tick(&mut dz, &mut mem, 0.2, at(0.71), out).status,
+        Status::Event("cleared")
+    );
 }
 
 #[test]
 fn departure_drives_out_to_the_imprint_distance_then_imprints() {
-    let mem = memory();
-    let mut d = departure::Depart::new("depart", mem.clone());
+    let mut mem = memory();
+    let mut d = departure::Depart::new("depart", &mem);
     // Docked, the camera is 0.1 m from the ball; it imprints from 0.6 m.
-    let step = tick(&mut d, &mem, 0.1, at(0.0), nothing());
+    let step = tick(&mut d, &mut mem, 0.1, at(0.0), nothing());
     assert!(twist(&step).v > 0.0, "body forward: {step:?}");
-    assert_eq!(tick(&mut d, &mem, 0.2, at(0.45), nothing()).status, Status::Running);
+    assert_eq!(tick(&mut d, &mut mem, 0.2, at(0.45), nothing()).status, Status::Running);
     assert_eq!(
-        tick(&mut d, &mem, 0.3, at(0.5), nothing()).status,
+        tick(&mut d, &mut mem, 0.3, at(0.5), nothing()).status,
         Status::Event("stopped")
     );
     // Imprint: the first frame skipped, then `imprint_frames` (5); nothing sampled here
     // (no camera), so the departure fails.
     // As `raposa.imprint` is registered.
-    let frames = mem.lock().source.imprint_frames_wanted();
-    let mut im = Imprint::new("imprint", mem.clone(), 1, frames, ImprintEnd::Outcome);
-    enter(&mut im, &mem, 0.3, at(0.5), nothing());
+    let frames = mem.source.imprint_frames_wanted();
+    let mut im = Imprint::new("imprint", 1, frames, ImprintEnd::Outcome);
+    enter(&mut im, &mut mem, 0.3, at(0.5), nothing());
     for k in 1..=5 {
         assert_eq!(
-            tick(&mut im, &mem, 0.3 + k as f64 * 0.1, at(0.5), nothing()).status,
+            tick(&mut im, &mut mem, 0.3 + k as f64 * 0.1, at(0.5), nothing()).status,
             Status::Running
         );
     }
     assert_eq!(
-        tick(&mut im, &mem, 0.9, at(0.5), nothing()).status,
+        tick(&mut im, &mut mem, 0.9, at(0.5), nothing()).status,
         Status::Done(Outcome::Failed(FailureReason::TargetNeverDetected))
     );
-    assert!(!mem.lock().imprinted);
+    assert!(!mem.imprinted);
 }
 
 #[test]
 fn the_dock_switch_closes_the_guides_and_docks() {
-    let mem = memory();
-    let mut s = DockSwitch::new("dock_switch", mem.clone());
-    assert!(s.tick(&Inputs::empty(0.0)).is_none());
+    let mut mem = memory();
+    let mut s = DockSwitch::new("dock_switch");
+    assert!(s.tick(&mut mem, &Inputs::empty(0.0)).is_none());
     let mut i = Inputs::empty(0.1);
     i.dock_contact = Some(Stamped::new(0.1, true));
-    let step = s.tick(&i).unwrap();
+    let step = s.tick(&mut mem, &i).unwrap();
     assert_eq!(step.status, Status::Done(Outcome::Docked));
     assert_eq!(step.output.drive, DriveCommand::Stop);
     assert_eq!(step.output.aux.guides, Some(Guides::Closed));
@@ -512,77 +516,85 @@ fn servo_states(p: &Profile) -> Vec<String> {
 fn the_selector_maps_percepts_to_states_and_looks_until_the_ellipse_is_seen() {
     let p = profile();
     let states = servo_states(&p);
-    let mem = memory();
+    let mut mem = memory();
     let args = SelectorArgs {
         node: "servo",
         states: &states,
         profile: &p,
     };
-    let mut sel = SevenState::new(mem.clone(), &args).unwrap();
+    let mut sel = SevenState::new(&args).unwrap();
     let idx = |name: &str| states.iter().position(|s| s == name).unwrap();
-    let mut select = |current: &str, percept: PyramidPercept| {
-        mem.with(|m| m.percept = percept);
-        sel.select(&Inputs::empty(0.0), idx(current))
+    let mut select = |mem: &mut Memory, current: &str, percept: PyramidPercept| {
+        mem.percept = percept;
+        sel.select(mem, &Inputs::empty(0.0), idx(current))
             .map(|i| states[i].as_str())
     };
     let from = "search";
-    assert_eq!(select(from, seen(1.5, Some(5.0), [0.0, 0.0], true)), Some("approach"));
-    assert_eq!(select(from, seen(1.5, Some(40.0), [0.0, 0.0], true)), Some("align"));
-    assert_eq!(select(from, seen(2.0, None, [0.0, 0.0], false)), Some("far_ellipse"));
+    assert_eq!(
+        select(&mut mem, from, seen(1.5, Some(5.0), [0.0, 0.0], true)),
+        Some("approach")
+    );
+    assert_eq!(
+        select(&mut mem, from, seen(1.5, Some(40.0), [0.0, 0.0], true)),
+        Some("align")
+    );
+    assert_eq!(
+        select(&mut mem, from, seen(2.0, None, [0.0, 0.0], false)),
+        Some("far_ellipse")
+    );
     let mut blue = nothing();
     blue.detection.blue = Some(blue_at(80));
-    assert_eq!(select(from, blue), Some("blue_only"));
-    assert_eq!(select("approach", nothing()), Some("search"));
-    assert_eq!(select(from, seen(0.28, Some(40.0), [0.0, 0.0], true)), Some("final"));
+    assert_eq!(select(&mut mem, from, blue), Some("blue_only"));
+    assert_eq!(select(&mut mem, "approach", nothing()), Some("search"));
     assert_eq!(
-        select(from, seen(0.43, Some(60.0), [0.0, 0.0], true)),
+        select(&mut mem, from, seen(0.28, Some(40.0), [0.0, 0.0], true)),
+        Some("final")
+    );
+    assert_eq!(
+        select(&mut mem, from, seen(0.43, Some(60.0), [0.0, 0.0], true)),
         Some("leave_dead_zone")
     );
     // Only the ball in the dead zone, no pair yet this docking: probe after
     // `lost_frames` frames (8), at most four times; a pair seen before means the side is
     // known, and the lone ball is approached.
     let lone_ball = || seen(0.43, None, [0.0, 0.0], false);
-    mem.with(|m| m.lone = 7);
-    assert_eq!(select(from, lone_ball()), Some("approach"));
-    mem.with(|m| m.lone = 8);
-    assert_eq!(select(from, lone_ball()), Some("probe"));
+    mem.lone = 7;
+    assert_eq!(select(&mut mem, from, lone_ball()), Some("approach"));
+    mem.lone = 8;
+    assert_eq!(select(&mut mem, from, lone_ball()), Some("probe"));
     assert_eq!(
-        select(from, seen(0.8, None, [0.0, 0.0], false)),
+        select(&mut mem, from, seen(0.8, None, [0.0, 0.0], false)),
         Some("approach"),
         "outside the dead zone"
     );
-    mem.with(|m| m.probes = 4);
-    assert_eq!(select(from, lone_ball()), Some("approach"));
-    mem.with(|m| {
-        m.probes = 0;
-        m.pair_seen = true;
-    });
-    assert_eq!(select(from, lone_ball()), Some("approach"));
-    mem.with(|m| {
-        m.pair_seen = false;
-        m.lone = 0;
-    });
+    mem.probes = 4;
+    assert_eq!(select(&mut mem, from, lone_ball()), Some("approach"));
+    mem.probes = 0;
+    mem.pair_seen = true;
+    assert_eq!(select(&mut mem, from, lone_ball()), Some("approach"));
+    mem.pair_seen = false;
+    mem.lone = 0;
     // A sighting restarts the search clock.
-    mem.with(|m| m.search_start = Some(3.0));
-    select(from, seen(1.5, Some(5.0), [0.0, 0.0], true));
-    assert_eq!(mem.lock().search_start, None);
+    mem.search_start = Some(3.0);
+    select(&mut mem, from, seen(1.5, Some(5.0), [0.0, 0.0], true));
+    assert_eq!(mem.search_start, None);
     // After region II: keep looking without the ellipse (blue alone does not count)...
-    assert_eq!(select("look", nothing()), None);
-    assert_eq!(select("look", blue), None);
-    assert!(!mem.lock().settling);
+    assert_eq!(select(&mut mem, "look", nothing()), None);
+    assert_eq!(select(&mut mem, "look", blue), None);
+    assert!(!mem.settling);
     // ...and select with the threshold widened once it is seen: 18° is not region II.
     assert_eq!(
-        select("look", seen(1.0, Some(18.0), [0.0, 0.0], true)),
+        select(&mut mem, "look", seen(1.0, Some(18.0), [0.0, 0.0], true)),
         Some("approach")
     );
-    assert!(mem.lock().settling);
+    assert!(mem.settling);
     assert_eq!(
-        select("approach", seen(1.0, Some(18.0), [0.0, 0.0], true)),
+        select(&mut mem, "approach", seen(1.0, Some(18.0), [0.0, 0.0], true)),
         Some("approach")
     );
-    mem.with(|m| m.settling = false);
+    mem.settling = false;
     assert_eq!(
-        select("approach", seen(1.0, Some(18.0), [0.0, 0.0], true)),
+        select(&mut mem, "approach", seen(1.0, Some(18.0), [0.0, 0.0], true)),
         Some("align")
     );
     // Every servo state of `select_state` but state 7 (align hands over to it) has one.
@@ -611,6 +623,6 @@ fn the_selector_names_a_missing_state() {
         states: &states,
         profile: &p,
     };
-    let e = SevenState::new(memory(), &args).err().unwrap();
+    let e = SevenState::new(&args).err().unwrap();
     assert!(e.contains("`look`"), "{e}");
 }

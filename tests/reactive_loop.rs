@@ -78,7 +78,7 @@ impl Behavior for Spin {
     fn name(&self) -> &str {
         "spin"
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<marsupial::schemas::Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &Inputs<'_>) -> Option<marsupial::schemas::Step> {
         Some(marsupial::schemas::Step::running(
             MotorOutput::drive(DriveCommand::Turn { omega: 0.4 }),
             marsupial::schemas::Feedback::new("search", inputs.now),
@@ -436,7 +436,7 @@ impl Behavior for FinishAt {
     fn name(&self) -> &str {
         "finish"
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<marsupial::schemas::Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &Inputs<'_>) -> Option<marsupial::schemas::Step> {
         let fb = marsupial::schemas::Feedback::new("go", inputs.now);
         Some(if inputs.now >= self.0 {
             marsupial::schemas::Step::done(Outcome::Docked, MotorOutput::twist(0.3, 0.0), fb)

@@ -54,7 +54,7 @@ impl Behavior for Creep {
     fn name(&self) -> &str {
         "creep"
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &Inputs<'_>) -> Option<Step> {
         if let Some(c) = inputs.camera(0) {
             self.0
                 .lock()
@@ -220,7 +220,7 @@ impl Behavior for TwoMissions {
     fn name(&self) -> &str {
         "two_missions"
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &Inputs<'_>) -> Option<Step> {
         let m = self.mission?;
         self.ticks += 1;
         let mut out = MotorOutput::twist(0.1, 0.0);

@@ -129,7 +129,7 @@ impl Behavior for Creep {
     fn name(&self) -> &str {
         "creep"
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &Inputs<'_>) -> Option<Step> {
         self.ticks += 1;
         if self.panic_at == Some(self.ticks) {
             panic!("behavior bug");

@@ -256,7 +256,7 @@ fn gripper_registry(
         fn name(&self) -> &str {
             "grip"
         }
-        fn tick(&mut self, _: &Inputs<'_>) -> Option<Step> {
+        fn tick(&mut self, _mem: &mut (), _: &Inputs<'_>) -> Option<Step> {
             None
         }
     }

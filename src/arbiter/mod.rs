@@ -6,7 +6,6 @@
 //! [`Decision`] and emits it through `tracing` (target `marsupial::arbiter`).
 //! [`ReactiveLoop`] is the pure tick; [`runtime::run`] is the threaded wrapper.
 
-pub mod blackboard;
 pub mod decision;
 pub mod lockstep;
 pub mod priority;
@@ -17,7 +16,6 @@ pub mod sequencer;
 pub mod trace;
 pub mod vector_sum;
 
-pub use blackboard::Blackboard;
 pub use decision::{Candidate, Decision, Strategy};
 pub use lockstep::Lockstep;
 pub use priority::Priority;

@@ -6,16 +6,16 @@ use crate::schemas::{Behavior, Inputs, Step};
 /// Ticks every child each tick (so their perceptual schemas keep adapting) and returns
 /// the proposal of the first active child in list order: earlier children subsume later
 /// ones. When no child is active the arbiter is itself inactive (`None`), and the
-/// reactive loop commands a stop.
-pub struct Priority {
+/// reactive loop commands a stop. `M` is the tree's memory, passed to each child in turn.
+pub struct Priority<M: ?Sized = ()> {
     name: String,
-    children: Vec<Box<dyn Behavior>>,
+    children: Vec<Box<dyn Behavior<M>>>,
     decision: Decision,
 }
 
-impl Priority {
+impl<M: ?Sized> Priority<M> {
     /// Builds the arbiter; `children` are in priority order, highest first.
-    pub fn new(name: impl Into<String>, children: Vec<Box<dyn Behavior>>) -> Self {
+    pub fn new(name: impl Into<String>, children: Vec<Box<dyn Behavior<M>>>) -> Self {
         let n = children.len();
         let mut decision = Decision::new(Strategy::Priority);
         decision.candidates.reserve(n);
@@ -32,16 +32,16 @@ impl Priority {
     }
 }
 
-impl Behavior for Priority {
+impl<M: ?Sized> Behavior<M> for Priority<M> {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
         self.decision.clear();
         let mut winner: Option<Step> = None;
         for (i, child) in self.children.iter_mut().enumerate() {
-            let step = child.tick(inputs);
+            let step = child.tick(mem, inputs);
             self.decision.push(i, step.as_ref());
             if winner.is_none() && step.is_some() {
                 winner = step;

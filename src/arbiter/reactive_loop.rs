@@ -533,7 +533,7 @@ impl LoopCore {
         if let Some(reason) = self.stopped.take() {
             tracing::info!(target: "marsupial::loop", now = inputs.now, %reason, "inputs recovered, resuming");
         }
-        let Some(step) = root.tick(inputs) else {
+        let Some(step) = root.tick(&mut (), inputs) else {
             return TickOutput {
                 command: MotorOutput::stop(),
                 status: LoopStatus::Idle,

@@ -19,8 +19,9 @@
 //! event `"timeout"` before ticking it (stopping the base that tick); with no entry for
 //! `"timeout"` the sequence ends with [`FailureReason::Timeout`].
 //!
-//! Entering a state calls its [`Behavior::enter`] with the inputs of the tick the
-//! transition happened in, so it can note where and when it began. A sequencer that has
+//! Entering a state calls its [`Behavior::enter`] with the tree's memory and the inputs of
+//! the tick the transition happened in, so it can note where and when it began. A
+//! sequencer that has
 //! finished is inactive (`None`) until it is started again ([`Behavior::start`],
 //! [`Behavior::enter`] or [`Behavior::reset`]).
 
@@ -43,23 +44,23 @@ pub enum Next {
     Finish,
 }
 
-/// Chooses the state to run from the inputs (and the current state).
-pub trait Selector: Send {
+/// Chooses the state to run from the tree's memory `M`, the inputs and the current state.
+pub trait Selector<M: ?Sized = ()>: Send {
     /// Returns the state to run this tick, or `None` to keep the current one.
-    fn select(&mut self, inputs: &Inputs<'_>, current: usize) -> Option<usize>;
+    fn select(&mut self, mem: &mut M, inputs: &Inputs<'_>, current: usize) -> Option<usize>;
 }
 
-impl<F> Selector for F
+impl<M: ?Sized, F> Selector<M> for F
 where
-    F: FnMut(&Inputs<'_>, usize) -> Option<usize> + Send,
+    F: FnMut(&mut M, &Inputs<'_>, usize) -> Option<usize> + Send,
 {
-    fn select(&mut self, inputs: &Inputs<'_>, current: usize) -> Option<usize> {
-        self(inputs, current)
+    fn select(&mut self, mem: &mut M, inputs: &Inputs<'_>, current: usize) -> Option<usize> {
+        self(mem, inputs, current)
     }
 }
 
-struct State {
-    behavior: Box<dyn Behavior>,
+struct State<M: ?Sized> {
+    behavior: Box<dyn Behavior<M>>,
     latched: bool,
     on_success: Next,
     on_failure: Next,
@@ -69,16 +70,17 @@ struct State {
     timeout: Option<f64>,
 }
 
-impl State {
+impl<M: ?Sized> State<M> {
     fn event(&self, name: &str) -> Option<Next> {
         self.on_event.iter().find(|(e, _)| e == name).map(|(_, n)| *n)
     }
 }
 
-/// A sequencer over behavior states.
-pub struct Sequencer {
+/// A sequencer over behavior states; `M` is the tree's memory, passed to the state it runs
+/// (and to its selector).
+pub struct Sequencer<M: ?Sized = ()> {
     name: String,
-    states: Vec<State>,
+    states: Vec<State<M>>,
     current: usize,
     /// The current state is entered at the next tick (after a start or a reset).
     pending_entry: bool,
@@ -89,7 +91,7 @@ pub struct Sequencer {
     pending_clock: bool,
     /// The sequence has ended; inactive until started again.
     finished: bool,
-    selector: Option<Box<dyn Selector>>,
+    selector: Option<Box<dyn Selector<M>>>,
     transitions: u64,
     /// Why the last transition fired (`"acquired"`, `"timeout"`, `"selected"`...).
     last_event: Option<&'static str>,
@@ -100,7 +102,7 @@ pub struct Sequencer {
     decision: Decision,
 }
 
-impl Sequencer {
+impl<M: ?Sized> Sequencer<M> {
     /// An empty sequencer; add states with [`Sequencer::state`]. It starts at state 0.
     pub fn new(name: impl Into<String>) -> Self {
         Self {
@@ -122,7 +124,7 @@ impl Sequencer {
 
     /// Appends a state and returns its index. By default success moves to the next state
     /// (or finishes after the last) and failure finishes the sequence.
-    pub fn state(&mut self, behavior: Box<dyn Behavior>, latched: bool) -> usize {
+    pub fn state(&mut self, behavior: Box<dyn Behavior<M>>, latched: bool) -> usize {
         let i = self.states.len();
         self.states.push(State {
             behavior,
@@ -165,13 +167,13 @@ impl Sequencer {
     }
 
     /// Installs a reactive selector.
-    pub fn with_selector(mut self, selector: impl Selector + 'static) -> Self {
+    pub fn with_selector(mut self, selector: impl Selector<M> + 'static) -> Self {
         self.selector = Some(Box::new(selector));
         self
     }
 
     /// Installs (or replaces) a reactive selector built elsewhere (by a registry).
-    pub fn set_selector(&mut self, selector: Box<dyn Selector>) {
+    pub fn set_selector(&mut self, selector: Box<dyn Selector<M>>) {
         self.selector = Some(selector);
     }
 
@@ -221,7 +223,7 @@ impl Sequencer {
         }
     }
 
-    fn enter(&mut self, i: usize, inputs: &Inputs<'_>, why: &'static str) {
+    fn enter(&mut self, i: usize, mem: &mut M, inputs: &Inputs<'_>, why: &'static str) {
         if i != self.current {
             tracing::debug!(
                 target: "marsupial::arbiter",
@@ -240,7 +242,7 @@ impl Sequencer {
         self.entered_at = inputs.now;
         self.pending_entry = false;
         if let Some(s) = self.states.get_mut(i) {
-            s.behavior.enter(inputs);
+            s.behavior.enter(mem, inputs);
         }
     }
 
@@ -274,7 +276,7 @@ impl Sequencer {
     }
 
     /// Ends state `cur` with `status`, returning the sequence's step for this tick.
-    fn finish_state(&mut self, cur: usize, step: Step, inputs: &Inputs<'_>) -> Step {
+    fn finish_state(&mut self, cur: usize, step: Step, mem: &mut M, inputs: &Inputs<'_>) -> Step {
         let next = self.next_for(cur, step.status);
         match next.and_then(|n| self.resolve(n)) {
             Some(j) => {
@@ -284,7 +286,7 @@ impl Sequencer {
                     Status::Done(Outcome::Completed) => "completed",
                     _ => "failed",
                 };
-                self.enter(j, inputs, why);
+                self.enter(j, mem, inputs, why);
                 Step {
                     status: Status::Running,
                     ..step
@@ -309,12 +311,12 @@ impl Sequencer {
     }
 }
 
-impl Behavior for Sequencer {
+impl<M: ?Sized> Behavior<M> for Sequencer<M> {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
         self.decision.clear();
         self.tick_transitions.clear();
         self.ran = None;
@@ -323,7 +325,7 @@ impl Behavior for Sequencer {
         }
         if self.pending_entry {
             let cur = self.current;
-            self.enter(cur, inputs, self.last_event.unwrap_or("started"));
+            self.enter(cur, mem, inputs, self.last_event.unwrap_or("started"));
         } else if self.pending_clock {
             self.entered_at = inputs.now;
         }
@@ -331,11 +333,11 @@ impl Behavior for Sequencer {
         if !self.states[self.current].latched {
             let cur = self.current;
             if let Some(sel) = self.selector.as_mut()
-                && let Some(j) = sel.select(inputs, cur)
+                && let Some(j) = sel.select(mem, inputs, cur)
                 && j < self.states.len()
                 && j != cur
             {
-                self.enter(j, inputs, "selected");
+                self.enter(j, mem, inputs, "selected");
             }
         }
         let cur = self.current;
@@ -350,11 +352,11 @@ impl Behavior for Sequencer {
             };
             self.decision.push(cur, None);
             self.decision.winner = Some(cur);
-            let result = self.finish_state(cur, step, inputs);
+            let result = self.finish_state(cur, step, mem, inputs);
             self.decision.output = Some(result.output);
             return Some(result);
         }
-        let step = self.states[cur].behavior.tick(inputs);
+        let step = self.states[cur].behavior.tick(mem, inputs);
         self.ran = Some(cur);
         self.decision.push(cur, step.as_ref());
         self.decision.winner = Some(cur);
@@ -364,7 +366,7 @@ impl Behavior for Sequencer {
         };
         let result = match step.status {
             Status::Running => step,
-            _ => self.finish_state(cur, step, inputs),
+            _ => self.finish_state(cur, step, mem, inputs),
         };
         self.decision.output = Some(result.output);
         let states = &self.states;
@@ -384,9 +386,9 @@ impl Behavior for Sequencer {
         }
     }
 
-    fn enter(&mut self, inputs: &Inputs<'_>) {
+    fn enter(&mut self, mem: &mut M, inputs: &Inputs<'_>) {
         self.reset();
-        self.enter(0, inputs, "started");
+        self.enter(0, mem, inputs, "started");
     }
 
     fn explain(&self, out: &mut Vec<super::NodeTrace>) {

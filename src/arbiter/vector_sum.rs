@@ -14,9 +14,10 @@ use crate::schemas::{Behavior, DriveCommand, Feedback, Inputs, MotionVector, Mot
 /// merge in list order (earlier children win). The first child (in list order) to end
 /// with an outcome or an event ends the sum with it, so a sum can be a sequencer's state
 /// whose leaf decides when it is over. With no active child the arbiter is inactive.
-pub struct VectorSum {
+/// `M` is the tree's memory, passed to each child in turn.
+pub struct VectorSum<M: ?Sized = ()> {
     name: String,
-    children: Vec<(f64, Box<dyn Behavior>)>,
+    children: Vec<(f64, Box<dyn Behavior<M>>)>,
     max_speed: f64,
     k_theta: f64,
     /// −1 when the robot follows the summed vector rear first, +1 front first.
@@ -24,9 +25,14 @@ pub struct VectorSum {
     decision: Decision,
 }
 
-impl VectorSum {
+impl<M: ?Sized> VectorSum<M> {
     /// Builds the arbiter from `(gain, behavior)` pairs.
-    pub fn new(name: impl Into<String>, children: Vec<(f64, Box<dyn Behavior>)>, max_speed: f64, k_theta: f64) -> Self {
+    pub fn new(
+        name: impl Into<String>,
+        children: Vec<(f64, Box<dyn Behavior<M>>)>,
+        max_speed: f64,
+        k_theta: f64,
+    ) -> Self {
         Self {
             name: name.into(),
             decision: Decision::new(Strategy::VectorSum),
@@ -49,12 +55,12 @@ impl VectorSum {
     }
 }
 
-impl Behavior for VectorSum {
+impl<M: ?Sized> Behavior<M> for VectorSum<M> {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
         self.decision.clear();
         let mut vec_sum = MotionVector::ZERO;
         let mut any_vec = false;
@@ -65,7 +71,7 @@ impl Behavior for VectorSum {
         let mut any = false;
         for (i, (gain, child)) in self.children.iter_mut().enumerate() {
             let gain = *gain;
-            let step = child.tick(inputs);
+            let step = child.tick(mem, inputs);
             self.decision.push(i, step.as_ref());
             let Some(step) = step else { continue };
             any = true;

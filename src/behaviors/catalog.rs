@@ -54,7 +54,7 @@ use std::path::Path;
 use std::sync::{Arc, OnceLock};
 
 /// The leaf registry a robot kind of memory `M` fills.
-pub type LeafRegistry<M> = Registry<crate::arbiter::Blackboard<M>>;
+pub type LeafRegistry<M> = Registry<M>;
 
 /// A kind of robot a profile's `[robot] kind` can name (see the module docs).
 pub trait RobotKind: Send + Sync + 'static {
@@ -150,7 +150,7 @@ struct Devices {
 }
 
 impl Devices {
-    fn install<C>(&self, registry: &mut Registry<C>) {
+    fn install<M: 'static>(&self, registry: &mut Registry<M>) {
         for (kind, check) in &self.sensors {
             let check = Arc::clone(check);
             registry.register_sensor_kind(kind.clone(), move |t| check(t));

@@ -4,14 +4,15 @@
 //! Every robot this crate ships, and any a user composes, runs the same way: each tick the
 //! robot's perceptual schemas run once into its [`SharedMemory`] (so colour adaptation
 //! follows the light whichever phase runs, and between missions too), then the tree of
-//! arbiters built from `[behavior.tree]` by a [`Registry`] decides. A [`Mission`] starts
-//! the tree at the state the profile names for it (`departure`, `docking`, or `ballistic`
-//! for a docking with an a-priori dock pose); the mission ends when the tree reports an
-//! outcome.
+//! arbiters built from `[behavior.tree]` by a [`Registry`] decides. The [`Composed`] owns
+//! the memory and lends it to the tree for the tick (`&mut`), so every node reads and
+//! writes it in tick order with no lock. A [`Mission`] starts the tree at the state the
+//! profile names for it (`departure`, `docking`, or `ballistic` for a docking with an
+//! a-priori dock pose); the mission ends when the tree reports an outcome.
 
 use super::agent::BuildError;
 use super::registry::Registry;
-use crate::arbiter::{Blackboard, NodeTrace};
+use crate::arbiter::NodeTrace;
 use crate::profile::Profile;
 use crate::schemas::{Agent, AgentStats, Behavior, Inputs, Mission, MissionError, Observation, Status, Step};
 
@@ -58,26 +59,25 @@ struct Entries {
 /// A robot's composed behavior (see the module docs).
 pub struct Composed<M: SharedMemory> {
     name: String,
-    memory: Blackboard<M>,
-    tree: Box<dyn Behavior>,
+    memory: M,
+    tree: Box<dyn Behavior<M>>,
     entries: Entries,
     /// A mission is running.
     active: bool,
 }
 
 impl<M: SharedMemory> Composed<M> {
-    /// Builds the profile's `[behavior.tree]` with the schemas of `registry`, each given a
-    /// handle on `memory`.
+    /// Builds the profile's `[behavior.tree]` with the schemas of `registry` (their
+    /// factories may read `memory`), and keeps `memory` for the tree's ticks.
     ///
     /// # Errors
     /// [`BuildError::Profile`] without a tree, [`BuildError::Tree`] when it does not build
     /// (an unknown schema, params a schema refuses; the error names the profile's line).
-    pub fn build(profile: &Profile, registry: &Registry<Blackboard<M>>, memory: M) -> Result<Self, BuildError> {
+    pub fn build(profile: &Profile, registry: &Registry<M>, memory: M) -> Result<Self, BuildError> {
         let spec = profile.behavior.tree.as_ref().ok_or_else(|| BuildError::Profile {
             profile: profile.name.clone(),
             what: "needs [behavior.tree]".into(),
         })?;
-        let memory = Blackboard::new(memory);
         let tree = registry.build(profile, &memory).map_err(BuildError::Tree)?;
         Ok(Self {
             name: profile.name.clone(),
@@ -92,9 +92,14 @@ impl<M: SharedMemory> Composed<M> {
         })
     }
 
-    /// The shared memory (to inspect the perceptual schemas' state, or retune them).
-    pub fn memory(&self) -> &Blackboard<M> {
+    /// The shared memory (to inspect the perceptual schemas' state).
+    pub fn memory(&self) -> &M {
         &self.memory
+    }
+
+    /// The shared memory, to change (retune the perceptual schemas, or set up a test).
+    pub fn memory_mut(&mut self) -> &mut M {
+        &mut self.memory
     }
 
     /// True while a mission runs.
@@ -107,11 +112,11 @@ impl<M: SharedMemory> Composed<M> {
     /// another core, or measuring the decision alone (`benches/tick.rs`). Otherwise the
     /// same as [`Behavior::tick`].
     pub fn tick_perceived(&mut self, inputs: &Inputs<'_>, perceive: impl FnOnce(&mut M)) -> Option<Step> {
-        self.memory.with(perceive);
+        perceive(&mut self.memory);
         if !self.active {
             return None;
         }
-        let step = self.tree.tick(inputs)?;
+        let step = self.tree.tick(&mut self.memory, inputs)?;
         if matches!(step.status, Status::Done(_)) {
             self.active = false;
         }
@@ -124,7 +129,7 @@ impl<M: SharedMemory> Behavior for Composed<M> {
         &self.name
     }
 
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &Inputs<'_>) -> Option<Step> {
         self.tick_perceived(inputs, |m| m.perceive(inputs))
     }
 
@@ -154,7 +159,7 @@ impl<M: SharedMemory> Agent for Composed<M> {
                 _ => self.entries.docking.clone(),
             },
         };
-        self.memory.with(|m| m.begin(mission))?;
+        self.memory.begin(mission)?;
         self.active = self.tree.start(&entry);
         if self.active {
             Ok(())
@@ -168,10 +173,10 @@ impl<M: SharedMemory> Agent for Composed<M> {
     }
 
     fn stats(&self) -> AgentStats {
-        self.memory.lock().stats()
+        self.memory.stats()
     }
 
     fn observe(&self) -> Option<Observation> {
-        self.memory.lock().observe()
+        self.memory.observe()
     }
 }

@@ -1,19 +1,21 @@
 //! Named schemas and selectors, and building a profile's `[behavior.tree]` from them.
 //!
-//! A [`Registry`] maps the names a profile's leaves use (`bujold.search`) to factories
-//! that build the leaf from its `params` table. Factories receive a build context `C`
-//! chosen by whoever builds the tree: for a paper's robot, the handle on that robot's
-//! shared memory ([`crate::arbiter::Blackboard`]); for a user's robot, whatever its
-//! schemas share. A user's crate registers its own schemas next to the shipped ones:
+//! A [`Registry<M>`] maps the names a profile's leaves use (`bujold.search`) to factories
+//! that build the leaf from its `params` table. `M` is the memory the tree's nodes share
+//! (for a paper's robot, that robot's memory; for a user's robot, whatever its schemas
+//! share): every leaf built is a `Behavior<M>`, handed the memory by `&mut` at each tick
+//! and entry, and each factory may read the memory as it builds (a turn rate, a
+//! calibration). A user's crate registers its own schemas next to the shipped ones:
 //!
 //! ```
 //! use marsupial::behaviors::registry::{LeafArgs, Registry};
 //! use marsupial::schemas::{Behavior, Feedback, Inputs, MotorOutput, Step};
 //!
 //! struct Creep(String, f64);
-//! impl Behavior for Creep {
+//! // Reads no memory, so it fits in any robot's tree.
+//! impl<M: ?Sized> Behavior<M> for Creep {
 //!     fn name(&self) -> &str { &self.0 }
-//!     fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+//!     fn tick(&mut self, _mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
 //!         Some(Step::running(MotorOutput::twist(self.1, 0.0), Feedback::new("creep", inputs.now)))
 //!     }
 //! }
@@ -100,8 +102,9 @@ impl LeafArgs<'_> {
     }
 }
 
-/// Builds one leaf; the error says what is wrong with its params or the profile.
-pub type LeafFactory<C> = dyn Fn(&C, &LeafArgs<'_>) -> Result<Box<dyn Behavior>, String> + Send + Sync;
+/// Builds one leaf of a tree over memory `M` (which it may read); the error says what is
+/// wrong with its params or the profile.
+pub type LeafFactory<M> = dyn Fn(&M, &LeafArgs<'_>) -> Result<Box<dyn Behavior<M>>, String> + Send + Sync;
 
 /// What a factory gets to build a sequencer's selector.
 pub struct SelectorArgs<'a> {
@@ -126,27 +129,29 @@ impl SelectorArgs<'_> {
     }
 }
 
-/// Builds one selector; the error says what the sequencer lacks.
-pub type SelectorFactory<C> = dyn Fn(&C, &SelectorArgs<'_>) -> Result<Box<dyn Selector>, String> + Send + Sync;
+/// Builds one selector of a tree over memory `M` (which it may read); the error says what
+/// the sequencer lacks.
+pub type SelectorFactory<M> = dyn Fn(&M, &SelectorArgs<'_>) -> Result<Box<dyn Selector<M>>, String> + Send + Sync;
 
 /// Checks a device kind's `params` table; the error names the field.
 pub type KindCheck = dyn Fn(&toml::Table) -> Result<(), String> + Send + Sync;
 
-/// Schemas, selectors and device kinds by name (see the module docs).
-pub struct Registry<C> {
-    leaves: BTreeMap<String, Box<LeafFactory<C>>>,
-    selectors: BTreeMap<String, Box<SelectorFactory<C>>>,
+/// Schemas, selectors and device kinds by name, for trees over memory `M` (see the module
+/// docs).
+pub struct Registry<M> {
+    leaves: BTreeMap<String, Box<LeafFactory<M>>>,
+    selectors: BTreeMap<String, Box<SelectorFactory<M>>>,
     sensor_kinds: BTreeMap<String, Box<KindCheck>>,
     actuator_kinds: BTreeMap<String, Box<KindCheck>>,
 }
 
-impl<C> Default for Registry<C> {
+impl<M: 'static> Default for Registry<M> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<C> Registry<C> {
+impl<M: 'static> Registry<M> {
     /// A registry with no schemas, knowing the device kinds the crate ships (the
     /// [`RANGE_KIND`] range finder).
     pub fn new() -> Self {
@@ -186,7 +191,7 @@ impl<C> Registry<C> {
     pub fn register(
         &mut self,
         name: impl Into<String>,
-        factory: impl Fn(&C, &LeafArgs<'_>) -> Result<Box<dyn Behavior>, String> + Send + Sync + 'static,
+        factory: impl Fn(&M, &LeafArgs<'_>) -> Result<Box<dyn Behavior<M>>, String> + Send + Sync + 'static,
     ) -> &mut Self {
         self.leaves.insert(name.into(), Box::new(factory));
         self
@@ -197,7 +202,7 @@ impl<C> Registry<C> {
     pub fn register_selector(
         &mut self,
         name: impl Into<String>,
-        factory: impl Fn(&C, &SelectorArgs<'_>) -> Result<Box<dyn Selector>, String> + Send + Sync + 'static,
+        factory: impl Fn(&M, &SelectorArgs<'_>) -> Result<Box<dyn Selector<M>>, String> + Send + Sync + 'static,
     ) -> &mut Self {
         self.selectors.insert(name.into(), Box::new(factory));
         self
@@ -208,13 +213,14 @@ impl<C> Registry<C> {
         self.leaves.keys().map(String::as_str)
     }
 
-    /// Builds the profile's `[behavior.tree]` with context `ctx`.
+    /// Builds the profile's `[behavior.tree]`, its factories reading `memory` (the memory
+    /// the tree will be ticked with).
     ///
     /// # Errors
     /// [`ConfigError::Invalid`] naming the profile's line for an absent tree, an unknown
     /// schema, params a schema refuses, or a leaf that misreports its name. (The tree's
     /// structure was checked when the profile loaded.)
-    pub fn build(&self, profile: &Profile, ctx: &C) -> Result<Box<dyn Behavior>, ConfigError> {
+    pub fn build(&self, profile: &Profile, memory: &M) -> Result<Box<dyn Behavior<M>>, ConfigError> {
         let Some(tree) = &profile.behavior.tree else {
             return Err(profile.problems(vec![(
                 "behavior".into(),
@@ -226,7 +232,7 @@ impl<C> Registry<C> {
         check_devices("sensors", "sensor", sensors, &self.sensor_kinds, &mut problems);
         let actuators = profile.actuators.iter().map(|d| (&d.kind, &d.params));
         check_devices("actuators", "actuator", actuators, &self.actuator_kinds, &mut problems);
-        let root = self.node(tree, &tree.root, profile, ctx, &mut problems, 0);
+        let root = self.node(tree, &tree.root, profile, memory, &mut problems, 0);
         match root {
             Some(r) if problems.is_empty() => Ok(r),
             _ => Err(profile.problems(problems)),
@@ -238,10 +244,10 @@ impl<C> Registry<C> {
         tree: &TreeSpec,
         name: &str,
         profile: &Profile,
-        ctx: &C,
+        memory: &M,
         problems: &mut Vec<(String, String)>,
         depth: usize,
-    ) -> Option<Box<dyn Behavior>> {
+    ) -> Option<Box<dyn Behavior<M>>> {
         let path = format!("behavior.tree.nodes.{name}");
         let Some(spec) = tree.nodes.get(name) else {
             problems.push((path, format!("no node named `{name}`")));
@@ -251,10 +257,10 @@ impl<C> Registry<C> {
             problems.push((path, format!("`{name}` contains itself")));
             return None;
         }
-        let children = |problems: &mut Vec<(String, String)>| -> Vec<Option<Box<dyn Behavior>>> {
+        let children = |problems: &mut Vec<(String, String)>| -> Vec<Option<Box<dyn Behavior<M>>>> {
             spec.children()
                 .iter()
-                .map(|c| self.node(tree, c, profile, ctx, problems, depth + 1))
+                .map(|c| self.node(tree, c, profile, memory, problems, depth + 1))
                 .collect()
         };
         match spec {
@@ -272,7 +278,7 @@ impl<C> Registry<C> {
                     params,
                     profile,
                 };
-                match factory(ctx, &args) {
+                match factory(memory, &args) {
                     Ok(b) if b.name() == name => Some(b),
                     Ok(b) => {
                         problems.push((
@@ -325,7 +331,7 @@ impl<C> Registry<C> {
                         states,
                         profile,
                     };
-                    match self.selectors.get(sel).map(|f| f(ctx, &args)) {
+                    match self.selectors.get(sel).map(|f| f(memory, &args)) {
                         Some(Ok(s)) => seq.set_selector(s),
                         Some(Err(e)) => problems.push((format!("{path}.selector"), format!("`{sel}`: {e}"))),
                         None => {

@@ -170,19 +170,28 @@ impl Step {
 /// A behavior: ticked by the arbiter; returns `None` when its activation condition does
 /// not hold this tick (it is not "released"), or a [`Step`] with its proposal.
 ///
-/// Implementations must be deterministic functions of their state and the inputs.
-pub trait Behavior: Send {
+/// `M` is the memory the node reads and writes: the robot's shared memory, handed down
+/// the tree by `&mut` for the tick (the arbiters pass theirs to each child in turn; see
+/// [`Composed`](crate::behaviors::Composed), which owns it). A node with no memory is a
+/// `Behavior` (`M = ()`): that is what the reactive loop, the runtime, an
+/// [`Agent`](crate::schemas::Agent) and the simulator run, ticking it with `&mut ()`. A
+/// leaf that reads no memory can implement `Behavior<M>` for every `M`
+/// (`impl<M: ?Sized> Behavior<M> for MyLeaf`), so it fits in any robot's tree.
+///
+/// Implementations must be deterministic functions of their state, the memory and the
+/// inputs.
+pub trait Behavior<M: ?Sized = ()>: Send {
     /// A short name for logs and decisions.
     fn name(&self) -> &str;
-    /// Runs one tick.
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step>;
+    /// Runs one tick with the tree's memory.
+    fn tick(&mut self, mem: &mut M, inputs: &Inputs<'_>) -> Option<Step>;
     /// Returns to the initial state.
     fn reset(&mut self) {}
-    /// Called when a sequencer enters this behavior as its state, with the inputs of the
-    /// tick the transition happened in (so a state can note where and when it began:
-    /// its odometry mark, its start time). The default resets.
-    fn enter(&mut self, inputs: &Inputs<'_>) {
-        let _ = inputs;
+    /// Called when a sequencer enters this behavior as its state, with the tree's memory
+    /// and the inputs of the tick the transition happened in (so a state can note where
+    /// and when it began: its odometry mark, its start time). The default resets.
+    fn enter(&mut self, mem: &mut M, inputs: &Inputs<'_>) {
+        let _ = (mem, inputs);
         self.reset();
     }
     /// Starts this behavior at the state named `state` (of a sequencer in it), entered at
@@ -199,18 +208,18 @@ pub trait Behavior: Send {
     }
 }
 
-impl<B: Behavior + ?Sized> Behavior for Box<B> {
+impl<M: ?Sized, B: Behavior<M> + ?Sized> Behavior<M> for Box<B> {
     fn name(&self) -> &str {
         (**self).name()
     }
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
-        (**self).tick(inputs)
+    fn tick(&mut self, mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
+        (**self).tick(mem, inputs)
     }
     fn reset(&mut self) {
         (**self).reset()
     }
-    fn enter(&mut self, inputs: &Inputs<'_>) {
-        (**self).enter(inputs)
+    fn enter(&mut self, mem: &mut M, inputs: &Inputs<'_>) {
+        (**self).enter(mem, inputs)
     }
     fn start(&mut self, state: &str) -> bool {
         (**self).start(state)
@@ -223,7 +232,8 @@ impl<B: Behavior + ?Sized> Behavior for Box<B> {
 /// The basic schema-theoretic behavior: perceive, test the releaser on the percept, act.
 ///
 /// It never ends by itself (status is always `Running`); wrap it in a sequencer or write a
-/// dedicated behavior when an outcome is needed.
+/// dedicated behavior when an outcome is needed. It reads no tree memory, so it is a
+/// `Behavior<M>` for every `M`.
 pub struct SchemaBehavior<P, M, C> {
     name: String,
     perceptual: P,
@@ -255,7 +265,7 @@ where
     }
 }
 
-impl<P, M, C> Behavior for SchemaBehavior<P, M, C>
+impl<P, M, C, Mem: ?Sized> Behavior<Mem> for SchemaBehavior<P, M, C>
 where
     P: PerceptualSchema,
     M: MotorSchema<Percept = P::Percept>,
@@ -265,7 +275,7 @@ where
         &self.name
     }
 
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut Mem, inputs: &Inputs<'_>) -> Option<Step> {
         let percept = self.perceptual.perceive(inputs);
         if !(self.releaser)(&percept) {
             return None;

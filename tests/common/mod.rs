@@ -309,7 +309,7 @@ impl marsupial::schemas::Behavior for Backer {
     fn name(&self) -> &str {
         "scripted_backer"
     }
-    fn tick(&mut self, inputs: &marsupial::schemas::Inputs<'_>) -> Option<marsupial::schemas::Step> {
+    fn tick(&mut self, _mem: &mut (), inputs: &marsupial::schemas::Inputs<'_>) -> Option<marsupial::schemas::Step> {
         use marsupial::schemas::{Auxiliary, DriveCommand, Feedback, MotorOutput, Outcome, Posture, Step};
         let t0 = *self.started.get_or_insert(inputs.now);
         let fb = Feedback::new("back_in", inputs.now - t0);

@@ -27,7 +27,6 @@
 
 use super::cycle::{Cycle, CycleParams, Decision};
 use super::memory::{Memory, Trust, ViewLimits};
-use crate::arbiter::Blackboard;
 use crate::geometry::Pose2;
 use crate::kinematics::two_arc::{Arc, Polar};
 use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, Step};
@@ -115,7 +114,6 @@ pub fn recovery(at: &Pose2, near: f64, range: f64, step: f64) -> Option<Decision
 /// See the module docs.
 pub struct Acquire {
     name: String,
-    mem: Blackboard<Memory>,
     params: AcquireParams,
     timeout_s: f64,
     cycle: Cycle,
@@ -125,10 +123,9 @@ pub struct Acquire {
 
 impl Acquire {
     /// A leaf named `name` giving up after `timeout_s`.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: AcquireParams, timeout_s: f64) -> Self {
+    pub fn new(name: &str, params: AcquireParams, timeout_s: f64) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             timeout_s,
             cycle: Cycle::new(params.cycle, params.trust),
@@ -138,19 +135,18 @@ impl Acquire {
     }
 }
 
-impl Behavior for Acquire {
+impl Behavior<Memory> for Acquire {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, inputs: &Inputs<'_>) {
+    fn enter(&mut self, _mem: &mut Memory, inputs: &Inputs<'_>) {
         self.since = inputs.now;
         self.recovered = 0;
         self.cycle.restart(inputs.now);
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let mut m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         if m.now - self.since > self.timeout_s {
             let why = if m.seen {
                 FailureReason::TargetLost
@@ -164,7 +160,7 @@ impl Behavior for Acquire {
         // A reel step is progress, not search: the search's clock restarts with it (the
         // steps are bounded: each shortens the tether until it is within range).
         let since = &mut self.since;
-        Some(self.cycle.tick(&mut m, "acquire", |m, seen| match seen {
+        Some(self.cycle.tick(m, "acquire", |m, seen| match seen {
             Some(s) => {
                 m.search_sign = Polar::from_pose(&s.pose).bearing().signum();
                 Decision::Event("acquired")

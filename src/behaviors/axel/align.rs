@@ -23,7 +23,6 @@
 use super::approach::{one_step, spiral};
 use super::cycle::{Cycle, CycleParams, Decision};
 use super::memory::{Memory, Sighting, Trust, ViewLimits};
-use crate::arbiter::Blackboard;
 use crate::geometry::{Pose2, wrap_angle};
 use crate::kinematics::two_arc::{Arc, Polar, plan};
 use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, Step};
@@ -88,7 +87,6 @@ impl Default for AlignParams {
 /// See the module docs.
 pub struct Align {
     name: String,
-    mem: Blackboard<Memory>,
     params: AlignParams,
     cycle: Cycle,
     /// Steps driven to finish a plan inside the arrival circle since the rover last
@@ -98,10 +96,9 @@ pub struct Align {
 
 impl Align {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: AlignParams) -> Self {
+    pub fn new(name: &str, params: AlignParams) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             cycle: Cycle::new(params.cycle, params.trust),
             finishing: 0,
@@ -222,22 +219,21 @@ fn past_unseen(m: &mut Memory, p: &AlignParams, s: Sighting) -> Option<Decision>
     })
 }
 
-impl Behavior for Align {
+impl Behavior<Memory> for Align {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, inputs: &Inputs<'_>) {
+    fn enter(&mut self, _mem: &mut Memory, inputs: &Inputs<'_>) {
         self.cycle.begin(inputs.now);
         self.finishing = 0;
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let mut m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let p = self.params;
         let finishing = &mut self.finishing;
         Some(self.cycle.tick_seeing(
-            &mut m,
+            m,
             "align",
             p.lost_looks,
             |m, s| decide(m, &p, finishing, s),

@@ -10,7 +10,6 @@
 
 use super::cycle::{Cycle, CycleParams, Decision};
 use super::memory::{Memory, Trust, ViewLimits};
-use crate::arbiter::Blackboard;
 use crate::geometry::{Pose2, wrap_angle};
 use crate::kinematics::two_arc::{Arc, PlanParams, Polar, Region, TwoArc, keeps_in_view, plan};
 use crate::schemas::{Behavior, Inputs, Step};
@@ -125,37 +124,34 @@ pub(super) fn spiral(pose: &Pose2, spiral: f64, step: f64, params: &PlanParams) 
 /// See the module docs.
 pub struct Approach {
     name: String,
-    mem: Blackboard<Memory>,
     params: ApproachParams,
     cycle: Cycle,
 }
 
 impl Approach {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: ApproachParams) -> Self {
+    pub fn new(name: &str, params: ApproachParams) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             cycle: Cycle::new(params.cycle, params.trust),
         }
     }
 }
 
-impl Behavior for Approach {
+impl Behavior<Memory> for Approach {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, inputs: &Inputs<'_>) {
+    fn enter(&mut self, _mem: &mut Memory, inputs: &Inputs<'_>) {
         self.cycle.begin(inputs.now);
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let mut m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let p = self.params;
         Some(self.cycle.tick_seeing(
-            &mut m,
+            m,
             "approach",
             p.lost_looks,
             |m, s| {

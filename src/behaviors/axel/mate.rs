@@ -12,7 +12,6 @@
 //! separate `axel.stall` leaf's (by the reel's current).
 
 use super::memory::Memory;
-use crate::arbiter::Blackboard;
 use crate::geometry::Pose2;
 use crate::kinematics::two_arc::Arc;
 use crate::schemas::{Behavior, DriveCommand, FailureReason, Inputs, Outcome, Step};
@@ -46,30 +45,27 @@ enum Phase {
 /// See the module docs.
 pub struct Mate {
     name: String,
-    mem: Blackboard<Memory>,
     params: MateParams,
     phase: Phase,
 }
 
 impl Mate {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: MateParams) -> Self {
+    pub fn new(name: &str, params: MateParams) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             phase: Phase::Reel { until: f64::INFINITY },
         }
     }
 }
 
-impl Behavior for Mate {
+impl Behavior<Memory> for Mate {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {
-        let m = self.mem.lock();
+    fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         let g = m.geometry;
         let Some(at) = m.commit else {
             self.phase = Phase::Reel { until: f64::INFINITY };
@@ -89,8 +85,7 @@ impl Behavior for Mate {
         };
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let g = m.geometry;
         match self.phase {
             Phase::Close { left, last, reel } => {

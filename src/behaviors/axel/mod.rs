@@ -33,38 +33,36 @@ pub mod tuning;
 use super::agent::BuildError;
 use super::composed::Composed;
 use super::registry::{LeafArgs, Registry};
-use crate::arbiter::Blackboard;
 use crate::profile::Profile;
 pub use memory::Memory;
 
 /// Registers Axel's schemas (`axel.acquire`, `axel.approach`, `axel.align`, `axel.mate`,
 /// `axel.stall`, and `axel.reel`, the paper's pure-reeling baseline) in `registry`; each
 /// takes its tuning from its node's `params`.
-pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
+pub fn register(registry: &mut Registry<Memory>) {
     registry
-        .register("axel.acquire", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+        .register("axel.acquire", |_: &Memory, a: &LeafArgs<'_>| {
             Ok(Box::new(acquire::Acquire::new(
                 a.node,
-                m.clone(),
                 a.params()?,
                 a.profile.behavior.search_timeout_s,
             )))
         })
-        .register("axel.approach", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(approach::Approach::new(a.node, m.clone(), a.params()?)))
+        .register("axel.approach", |_: &Memory, a: &LeafArgs<'_>| {
+            Ok(Box::new(approach::Approach::new(a.node, a.params()?)))
         })
-        .register("axel.align", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(align::Align::new(a.node, m.clone(), a.params()?)))
+        .register("axel.align", |_: &Memory, a: &LeafArgs<'_>| {
+            Ok(Box::new(align::Align::new(a.node, a.params()?)))
         })
-        .register("axel.mate", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(mate::Mate::new(a.node, m.clone(), a.params()?)))
+        .register("axel.mate", |_: &Memory, a: &LeafArgs<'_>| {
+            Ok(Box::new(mate::Mate::new(a.node, a.params()?)))
         })
-        .register("axel.stall", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(stall::Stall::new(a.node, m.clone(), a.params()?)))
+        .register("axel.stall", |_: &Memory, a: &LeafArgs<'_>| {
+            Ok(Box::new(stall::Stall::new(a.node, a.params()?)))
         })
-        .register("axel.reel", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+        .register("axel.reel", |_: &Memory, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(reel::Reel::new(a.node, m.clone())))
+            Ok(Box::new(reel::Reel::new(a.node)))
         });
 }
 
@@ -78,8 +76,8 @@ pub type AxelAgent = Composed<Memory>;
 ///
 /// # Errors
 /// [`BuildError`] when something it needs is missing or the tree does not build.
-pub fn agent_with(profile: &Profile, registry: &Registry<Blackboard<Memory>>) -> Result<AxelAgent, BuildError> {
-    Composed::build(profile, registry, super::catalog::memory(&Axel, profile)?)
+pub fn agent_with(profile: &Profile, registry: &Registry<Memory>) -> Result<AxelAgent, BuildError> {
+    Composed::build(profile, registry, Memory::from_profile(profile)?)
 }
 
 /// Builds Axel's robot with Axel's own schemas (see [`agent_with`]).

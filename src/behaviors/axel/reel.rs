@@ -11,28 +11,26 @@
 //! `tests/axel_reel.rs` checks the same limits through the engine alone.
 
 use super::memory::Memory;
-use crate::arbiter::Blackboard;
 use crate::schemas::{Behavior, Inputs, Step};
 
 /// See the module docs.
 pub struct Reel {
     name: String,
-    mem: Blackboard<Memory>,
 }
 
 impl Reel {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<Memory>) -> Self {
-        Self { name: name.into(), mem }
+    pub fn new(name: &str) -> Self {
+        Self { name: name.into() }
     }
 }
 
-impl Behavior for Reel {
+impl Behavior<Memory> for Reel {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        Some(self.mem.lock().free_reel("reel"))
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
+        Some(m.free_reel("reel"))
     }
 }

@@ -7,7 +7,6 @@
 //! released.
 
 use super::memory::Memory;
-use crate::arbiter::Blackboard;
 use crate::schemas::{Auxiliary, Behavior, FailureReason, Inputs, MotorOutput, Outcome, Step, TetherCommand};
 use serde::Deserialize;
 
@@ -34,24 +33,22 @@ impl Default for StallParams {
 /// See the module docs.
 pub struct Stall {
     name: String,
-    mem: Blackboard<Memory>,
     params: StallParams,
     since: Option<f64>,
 }
 
 impl Stall {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: StallParams) -> Self {
+    pub fn new(name: &str, params: StallParams) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             since: None,
         }
     }
 }
 
-impl Behavior for Stall {
+impl Behavior<Memory> for Stall {
     fn name(&self) -> &str {
         &self.name
     }
@@ -60,8 +57,7 @@ impl Behavior for Stall {
         self.since = None;
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let high = m.reel.is_some_and(|r| r.motor_current_a >= self.params.current_a);
         if !high {
             self.since = None;

@@ -18,34 +18,32 @@
 use super::memory::Memory;
 use super::memory::raised;
 use super::params::{ApproachOutput, ApproachParams};
-use crate::arbiter::Blackboard;
 use crate::perception::two_block_pose::FiducialView;
 use crate::schemas::{Behavior, DriveCommand, Inputs, MotionVector, MotorOutput, Step};
 
 /// See the module docs.
 pub struct Approach {
     name: String,
-    mem: Blackboard<Memory>,
     params: ApproachParams,
     dock_total_px: f64,
     max_retries: u32,
 }
 
 impl Approach {
-    /// A leaf named `name`; at the dock at `dock_total_px`, repositioning at most
-    /// `max_retries` times per docking.
+    /// A leaf named `name` of a tree over `mem` (read here for its approach); at the dock
+    /// at `dock_total_px`, repositioning at most `max_retries` times per docking.
     ///
     /// # Errors
     /// A message when `output = "vector"` but the memory's approach has no potential
     /// field.
     pub fn new(
         name: &str,
-        mem: Blackboard<Memory>,
+        mem: &Memory,
         params: ApproachParams,
         dock_total_px: f64,
         max_retries: u32,
     ) -> Result<Self, String> {
-        if params.output == ApproachOutput::Vector && mem.lock().approach.field.is_none() {
+        if params.output == ApproachOutput::Vector && mem.approach.field.is_none() {
             return Err(
                 "params.output: `vector` needs robot.approach = \"potential_field\" (ratio steering has no vector)"
                     .into(),
@@ -53,7 +51,6 @@ impl Approach {
         }
         Ok(Self {
             name: name.into(),
-            mem,
             params,
             dock_total_px,
             max_retries,
@@ -86,20 +83,18 @@ impl Approach {
     }
 }
 
-impl Behavior for Approach {
+impl Behavior<Memory> for Approach {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+    fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
-        let mem = self.mem.clone();
-        let mut m = mem.lock();
+    fn tick(&mut self, m: &mut Memory, inputs: &Inputs<'_>) -> Option<Step> {
         m.observe_change(inputs);
         // Repositioning is decided on the median viewing angle, not the filtered one.
         let off_axis = match &m.planning {
-            Some(p) if m.retries < self.max_retries => self.off_axis(&m, p),
+            Some(p) if m.retries < self.max_retries => self.off_axis(m, p),
             _ => None,
         };
         let step = match (m.view, off_axis) {
@@ -110,9 +105,9 @@ impl Behavior for Approach {
                 m.hold("approach").with_event("off_axis")
             }
             (Some(v), _) if self.params.near_m.is_some_and(|near| v.distance < near) => {
-                Step::event("near", self.propose(&m, &v), m.feedback("approach"))
+                Step::event("near", self.propose(m, &v), m.feedback("approach"))
             }
-            (Some(v), _) => Step::running(self.propose(&m, &v), m.feedback("approach")),
+            (Some(v), _) => Step::running(self.propose(m, &v), m.feedback("approach")),
             (None, _) => {
                 let lost = m.last_seen.is_none_or(|t| m.now - t > self.params.lost_after_s);
                 // Out of sight for a moment: a vector approach follows the field toward

@@ -9,14 +9,12 @@
 
 use super::memory::{Memory, lowered};
 use super::params::BackInParams;
-use crate::arbiter::Blackboard;
 use crate::geometry::{Pose2, wrap_angle};
 use crate::schemas::{Behavior, DeadReckoning, FailureReason, Inputs, MotorOutput, Step};
 
 /// See the module docs.
 pub struct BackIn {
     name: String,
-    mem: Blackboard<Memory>,
     params: BackInParams,
     depth: f64,
     mark: Pose2,
@@ -24,10 +22,9 @@ pub struct BackIn {
 
 impl BackIn {
     /// A leaf named `name`; `depth` is the pouch's depth, m.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: BackInParams, depth: f64) -> Self {
+    pub fn new(name: &str, params: BackInParams, depth: f64) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             depth,
             mark: Pose2::default(),
@@ -35,18 +32,16 @@ impl BackIn {
     }
 }
 
-impl Behavior for BackIn {
+impl Behavior<Memory> for BackIn {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {
-        self.mark = self.mem.lock().odo;
+    fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
+        self.mark = m.odo;
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let mem = self.mem.clone();
-        let mut m = mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let p = self.params;
         if wrap_angle(m.odo.theta - self.mark.theta).abs() > p.max_yaw_drift_deg.to_radians() {
             m.failing = Some(FailureReason::FailedToControl);

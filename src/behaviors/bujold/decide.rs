@@ -8,7 +8,6 @@
 
 use super::memory::{Memory, lowered};
 use super::params::DecideParams;
-use crate::arbiter::Blackboard;
 use crate::perception::two_block_pose::FiducialView;
 use crate::schemas::{Behavior, FailureReason, Inputs, MotorOutput, Step};
 
@@ -71,7 +70,6 @@ fn heading_margin(margin: f64, retries: u32, max_retries: u32) -> f64 {
 /// See the module docs.
 pub struct Decide {
     name: String,
-    mem: Blackboard<Memory>,
     params: DecideParams,
     tol_lateral: f64,
     tol_heading: f64,
@@ -82,17 +80,9 @@ pub struct Decide {
 
 impl Decide {
     /// A leaf named `name` with the profile's success tolerances (m, rad).
-    pub fn new(
-        name: &str,
-        mem: Blackboard<Memory>,
-        params: DecideParams,
-        tol_lateral: f64,
-        tol_heading: f64,
-        max_retries: u32,
-    ) -> Self {
+    pub fn new(name: &str, params: DecideParams, tol_lateral: f64, tol_heading: f64, max_retries: u32) -> Self {
         Self {
             name: name.into(),
-            mem,
             samples: Vec::with_capacity(params.frames.max(1)),
             params,
             tol_lateral,
@@ -103,19 +93,17 @@ impl Decide {
     }
 }
 
-impl Behavior for Decide {
+impl Behavior<Memory> for Decide {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, inputs: &Inputs<'_>) {
+    fn enter(&mut self, _mem: &mut Memory, inputs: &Inputs<'_>) {
         self.started = inputs.now;
         self.samples.clear();
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let mem = self.mem.clone();
-        let mut m = mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         if let Some(v) = m.planning {
             self.samples.push(v);
         }

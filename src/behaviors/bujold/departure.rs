@@ -5,42 +5,38 @@
 
 use super::memory::{Memory, lowered};
 use super::params::{DriveOutParams, UndockParams};
-use crate::arbiter::Blackboard;
 use crate::schemas::{Behavior, DriveCommand, FailureReason, Inputs, MotorOutput, Outcome, Step};
 
 /// `bujold.undock`: drive out of the pouch front first, lowered, until clear of it;
 /// event `out`.
 pub struct Undock {
     name: String,
-    mem: Blackboard<Memory>,
     params: UndockParams,
     depth: f64,
 }
 
 impl Undock {
     /// A leaf named `name`; `depth` is the pouch's depth, m.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: UndockParams, depth: f64) -> Self {
+    pub fn new(name: &str, params: UndockParams, depth: f64) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             depth,
         }
     }
 }
 
-impl Behavior for Undock {
+impl Behavior<Memory> for Undock {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {
+    fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         // Departure distances are measured from where it began.
-        self.mem.with(|m| m.departure_mark = m.odo);
+        m.departure_mark = m.odo;
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let out = MotorOutput {
             drive: DriveCommand::Straight {
                 v: -m.geometry.drive_dir * self.params.speed_mps,
@@ -63,7 +59,6 @@ impl Behavior for Undock {
 /// succeeded, failed (target never detected) otherwise.
 pub struct DriveOut {
     name: String,
-    mem: Blackboard<Memory>,
     params: DriveOutParams,
     /// Travel from the departure's start at which to imprint, m.
     imprint_at: f64,
@@ -71,25 +66,23 @@ pub struct DriveOut {
 
 impl DriveOut {
     /// A leaf named `name`; imprints `imprint_at` m from where the departure began.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: DriveOutParams, imprint_at: f64) -> Self {
+    pub fn new(name: &str, params: DriveOutParams, imprint_at: f64) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             imprint_at,
         }
     }
 }
 
-impl Behavior for DriveOut {
+impl Behavior<Memory> for DriveOut {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+    fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let out = m.travelled(&m.departure_mark);
         Some(if !m.imprinted && out >= self.imprint_at {
             m.hold("drive_out").with_event("imprint")

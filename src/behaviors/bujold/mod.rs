@@ -35,7 +35,6 @@ use super::agent::BuildError;
 use super::common::docking::{DockSwitch, Imprint, ImprintEnd};
 use super::composed::Composed;
 use super::registry::{LeafArgs, Registry};
-use crate::arbiter::Blackboard;
 use crate::perception::two_block_pose::TwoBlockGeometry;
 use crate::profile::Profile;
 use crate::schemas::SearchRotation;
@@ -44,116 +43,86 @@ use reposition::PlanFrom;
 
 /// Registers Bujold's phase schemas (`bujold.undock`, `bujold.search`, ...) in `registry`;
 /// each takes its tuning from its node's `params` (see [`params`]).
-pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
+pub fn register(registry: &mut Registry<Memory>) {
     let depth = |a: &LeafArgs<'_>| a.profile.dock.map(|d| d.depth_m).ok_or("needs [dock]");
     registry
-        .register("bujold.undock", move |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(departure::Undock::new(
-                a.node,
-                m.clone(),
-                a.params()?,
-                depth(a)?,
-            )))
+        .register("bujold.undock", move |_: &Memory, a: &LeafArgs<'_>| {
+            Ok(Box::new(departure::Undock::new(a.node, a.params()?, depth(a)?)))
         })
-        .register("bujold.drive_out", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+        .register("bujold.drive_out", |_: &Memory, a: &LeafArgs<'_>| {
             let imprint_at = imprint_distance(a.profile).ok_or("needs [dock] and a camera")?;
-            Ok(Box::new(departure::DriveOut::new(
-                a.node,
-                m.clone(),
-                a.params()?,
-                imprint_at,
-            )))
+            Ok(Box::new(departure::DriveOut::new(a.node, a.params()?, imprint_at)))
         })
-        .register("bujold.imprint", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+        .register("bujold.imprint", |_: &Memory, a: &LeafArgs<'_>| {
             a.no_params()?;
             // Samples from its first tick; the departure goes on whether it worked.
             Ok(Box::new(Imprint::new(
                 a.node,
-                m.clone(),
                 0,
                 a.profile.perception.imprint.frames,
                 ImprintEnd::Event("imprinted"),
             )))
         })
-        .register("bujold.search", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            let rate = m.lock().approach.steering.turn_rate;
+        .register("bujold.search", |m: &Memory, a: &LeafArgs<'_>| {
+            let rate = m.approach.steering.turn_rate;
             let rotation = SearchRotation {
                 rate,
                 first_sweep: 0.0,
                 doubling: false,
             };
             let timeout = a.profile.behavior.search_timeout_s;
-            Ok(Box::new(search::Search::new(
-                a.node,
-                m.clone(),
-                a.params()?,
-                rotation,
-                timeout,
-            )))
+            Ok(Box::new(search::Search::new(a.node, a.params()?, rotation, timeout)))
         })
-        .register("bujold.unjam", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(unjam::Unjam::new(a.node, m.clone(), a.params()?)))
+        .register("bujold.unjam", |_: &Memory, a: &LeafArgs<'_>| {
+            Ok(Box::new(unjam::Unjam::new(a.node, a.params()?)))
         })
-        .register("bujold.approach", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            let dock_total = m.lock().approach.steering.dock_total_px;
+        .register("bujold.approach", |m: &Memory, a: &LeafArgs<'_>| {
+            let dock_total = m.approach.steering.dock_total_px;
             let retries = a.profile.behavior.max_retries;
             Ok(Box::new(approach::Approach::new(
                 a.node,
-                m.clone(),
+                m,
                 a.params()?,
                 dock_total,
                 retries,
             )?))
         })
-        .register("bujold.decide", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+        .register("bujold.decide", |_: &Memory, a: &LeafArgs<'_>| {
             let s = &a.profile.success;
             Ok(Box::new(decide::Decide::new(
                 a.node,
-                m.clone(),
                 a.params()?,
                 s.lateral_tolerance_m,
                 s.heading_tolerance_deg.to_radians(),
                 a.profile.behavior.max_retries,
             )))
         })
-        .register("bujold.back_in", move |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(back_in::BackIn::new(
-                a.node,
-                m.clone(),
-                a.params()?,
-                depth(a)?,
-            )))
+        .register("bujold.back_in", move |_: &Memory, a: &LeafArgs<'_>| {
+            Ok(Box::new(back_in::BackIn::new(a.node, a.params()?, depth(a)?)))
         })
-        .register("bujold.reposition", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+        .register("bujold.reposition", |_: &Memory, a: &LeafArgs<'_>| {
             Ok(Box::new(reposition::Reposition::new(
                 a.node,
-                m.clone(),
                 a.params()?,
                 PlanFrom::Memory,
             )))
         })
-        .register("bujold.ballistic", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+        .register("bujold.ballistic", |_: &Memory, a: &LeafArgs<'_>| {
             Ok(Box::new(reposition::Reposition::new(
                 a.node,
-                m.clone(),
                 a.params()?,
                 PlanFrom::DockHint,
             )))
         })
-        .register("bujold.move_away", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(move_away::MoveAway::new(
-                a.node,
-                m.clone(),
-                a.params()?,
-                false,
-            )))
+        .register("bujold.move_away", |_: &Memory, a: &LeafArgs<'_>| {
+            Ok(Box::new(move_away::MoveAway::new(a.node, a.params()?, false)))
         })
-        .register("bujold.give_up", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
-            Ok(Box::new(move_away::MoveAway::new(a.node, m.clone(), a.params()?, true)))
+        .register("bujold.give_up", |_: &Memory, a: &LeafArgs<'_>| {
+            Ok(Box::new(move_away::MoveAway::new(a.node, a.params()?, true)))
         })
-        .register("bujold.dock_switch", |m: &Blackboard<Memory>, a: &LeafArgs<'_>| {
+        .register("bujold.dock_switch", |_: &Memory, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(DockSwitch::new(a.node, m.clone())))
+            Ok(Box::new(DockSwitch::new(a.node)))
         });
 }
 
@@ -183,8 +152,8 @@ pub type BujoldAgent = Composed<Memory>;
 ///
 /// # Errors
 /// [`BuildError`] when something it needs is missing or the tree does not build.
-pub fn agent_with(profile: &Profile, registry: &Registry<Blackboard<Memory>>) -> Result<BujoldAgent, BuildError> {
-    Composed::build(profile, registry, super::catalog::memory(&Bujold, profile)?)
+pub fn agent_with(profile: &Profile, registry: &Registry<Memory>) -> Result<BujoldAgent, BuildError> {
+    Composed::build(profile, registry, Memory::from_profile(profile)?)
 }
 
 /// Builds Bujold's robot with Bujold's own schemas (see [`agent_with`]).

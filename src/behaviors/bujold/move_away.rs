@@ -6,14 +6,12 @@
 
 use super::memory::Memory;
 use super::params::MoveAwayParams;
-use crate::arbiter::Blackboard;
 use crate::geometry::Pose2;
 use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, Step};
 
 /// See the module docs.
 pub struct MoveAway {
     name: String,
-    mem: Blackboard<Memory>,
     params: MoveAwayParams,
     give_up: bool,
     started: f64,
@@ -22,10 +20,9 @@ pub struct MoveAway {
 
 impl MoveAway {
     /// A leaf named `name`; `give_up` ends the docking failed instead of retrying.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: MoveAwayParams, give_up: bool) -> Self {
+    pub fn new(name: &str, params: MoveAwayParams, give_up: bool) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             give_up,
             started: 0.0,
@@ -34,18 +31,17 @@ impl MoveAway {
     }
 }
 
-impl Behavior for MoveAway {
+impl Behavior<Memory> for MoveAway {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, inputs: &Inputs<'_>) {
+    fn enter(&mut self, m: &mut Memory, inputs: &Inputs<'_>) {
         self.started = inputs.now;
-        self.mark = self.mem.lock().odo;
+        self.mark = m.odo;
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let p = self.params;
         let phase = if self.give_up { "give_up" } else { "move_away" };
         if m.travelled(&self.mark) < p.distance_m && m.now - self.started <= p.timeout_s {

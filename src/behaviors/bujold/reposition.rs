@@ -10,7 +10,6 @@
 
 use super::memory::{Memory, RepositionPlan, raised};
 use super::params::RepositionParams;
-use crate::arbiter::Blackboard;
 use crate::geometry::{Pose2, wrap_angle};
 use crate::schemas::{Behavior, DriveCommand, Inputs, MotorOutput, Step};
 use std::f64::consts::FRAC_PI_2;
@@ -39,7 +38,6 @@ enum Stage {
 /// See the module docs.
 pub struct Reposition {
     name: String,
-    mem: Blackboard<Memory>,
     params: RepositionParams,
     from: PlanFrom,
     stage: Stage,
@@ -49,10 +47,9 @@ pub struct Reposition {
 
 impl Reposition {
     /// A leaf named `name` taking its plan `from` memory or the dock hint.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: RepositionParams, from: PlanFrom) -> Self {
+    pub fn new(name: &str, params: RepositionParams, from: PlanFrom) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             from,
             stage: Stage::Face,
@@ -69,13 +66,12 @@ impl Reposition {
     }
 }
 
-impl Behavior for Reposition {
+impl Behavior<Memory> for Reposition {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {
-        let mut m = self.mem.lock();
+    fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         self.mark = m.odo;
         let plan = match self.from {
             PlanFrom::Memory => m.plan.take(),
@@ -93,9 +89,7 @@ impl Behavior for Reposition {
         self.stage = if plan.clear_first { Stage::Clear } else { Stage::Face };
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let mem = self.mem.clone();
-        let mut m = mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let phase = self.phase();
         let p = self.params;
         let odo = m.odo;

@@ -9,13 +9,11 @@
 
 use super::memory::{Memory, raised};
 use super::params::SearchParams;
-use crate::arbiter::Blackboard;
 use crate::schemas::{Behavior, FailureReason, Inputs, MotorOutput, Outcome, SearchRotation, Step};
 
 /// See the module docs.
 pub struct Search {
     name: String,
-    mem: Blackboard<Memory>,
     params: SearchParams,
     rotation: SearchRotation,
     timeout_s: f64,
@@ -26,16 +24,9 @@ pub struct Search {
 
 impl Search {
     /// A leaf named `name` turning at `rotation`'s rate, giving up after `timeout_s`.
-    pub fn new(
-        name: &str,
-        mem: Blackboard<Memory>,
-        params: SearchParams,
-        rotation: SearchRotation,
-        timeout_s: f64,
-    ) -> Self {
+    pub fn new(name: &str, params: SearchParams, rotation: SearchRotation, timeout_s: f64) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             rotation,
             timeout_s,
@@ -60,19 +51,17 @@ impl Search {
     }
 }
 
-impl Behavior for Search {
+impl Behavior<Memory> for Search {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, inputs: &Inputs<'_>) {
+    fn enter(&mut self, _mem: &mut Memory, inputs: &Inputs<'_>) {
         self.started = inputs.now;
         self.still_since = None;
     }
 
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
-        let mem = self.mem.clone();
-        let mut m = mem.lock();
+    fn tick(&mut self, m: &mut Memory, inputs: &Inputs<'_>) -> Option<Step> {
         let change = m.observe_change(inputs);
         let now = m.now;
         let in_phase = now - self.started;

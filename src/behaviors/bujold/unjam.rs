@@ -5,14 +5,12 @@
 
 use super::memory::Memory;
 use super::params::UnjamParams;
-use crate::arbiter::Blackboard;
 use crate::geometry::{Pose2, wrap_angle};
 use crate::schemas::{Behavior, Inputs, Step};
 
 /// See the module docs.
 pub struct Unjam {
     name: String,
-    mem: Blackboard<Memory>,
     params: UnjamParams,
     /// 0: turning back; 1: driving out.
     stage: u8,
@@ -22,10 +20,9 @@ pub struct Unjam {
 
 impl Unjam {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: UnjamParams) -> Self {
+    pub fn new(name: &str, params: UnjamParams) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             stage: 0,
             stage_start: 0.0,
@@ -34,20 +31,18 @@ impl Unjam {
     }
 }
 
-impl Behavior for Unjam {
+impl Behavior<Memory> for Unjam {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, inputs: &Inputs<'_>) {
+    fn enter(&mut self, m: &mut Memory, inputs: &Inputs<'_>) {
         self.stage = 0;
         self.stage_start = inputs.now;
-        self.mark = self.mem.lock().odo;
+        self.mark = m.odo;
     }
 
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
-        let mem = self.mem.clone();
-        let mut m = mem.lock();
+    fn tick(&mut self, m: &mut Memory, inputs: &Inputs<'_>) -> Option<Step> {
         // The frame-change cue keeps running so the search that follows compares its
         // first frame with the one just before it.
         m.observe_change(inputs);

@@ -104,7 +104,8 @@ impl AvoidLeaf {
     }
 }
 
-impl Behavior for AvoidLeaf {
+/// Reads no tree memory: it fits in any robot's tree.
+impl<M: ?Sized> Behavior<M> for AvoidLeaf {
     fn name(&self) -> &str {
         &self.name
     }
@@ -113,7 +114,7 @@ impl Behavior for AvoidLeaf {
         self.side = None;
     }
 
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, _mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
         let Some(reading) = inputs.sensor(self.sensor) else {
             self.side = None;
             return None;

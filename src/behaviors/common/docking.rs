@@ -3,9 +3,9 @@
 //! (the dock's contact sensor closed: docked, whatever phase was running; under a
 //! priority node it subsumes them). They reach the robot's perceptual schema and its
 //! auxiliary commands through [`DockingMemory`], which each robot's shared memory
-//! implements.
+//! implements: each leaf is a [`Behavior<M>`] for every `M: DockingMemory`, handed the
+//! memory by its tree at each tick.
 
-use crate::arbiter::Blackboard;
 use crate::perception::RgbView;
 use crate::schemas::{Auxiliary, Behavior, FailureReason, Feedback, Inputs, MotorOutput, Outcome, Status, Step};
 
@@ -37,21 +37,19 @@ pub enum ImprintEnd {
 /// `imprint`: see the module docs. Stands still for `settle` ticks without sampling (the
 /// first frames after stopping may still be blurred by the motion), then feeds `frames`
 /// ticks' camera frames to the imprinter, and ends as `end` says.
-pub struct Imprint<M> {
+pub struct Imprint {
     name: String,
-    mem: Blackboard<M>,
     settle: u32,
     frames: u32,
     end: ImprintEnd,
     ticks: u32,
 }
 
-impl<M: DockingMemory> Imprint<M> {
+impl Imprint {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<M>, settle: u32, frames: u32, end: ImprintEnd) -> Self {
+    pub fn new(name: &str, settle: u32, frames: u32, end: ImprintEnd) -> Self {
         Self {
             name: name.into(),
-            mem,
             settle,
             frames,
             end,
@@ -60,17 +58,16 @@ impl<M: DockingMemory> Imprint<M> {
     }
 }
 
-impl<M: DockingMemory> Behavior for Imprint<M> {
+impl<M: DockingMemory> Behavior<M> for Imprint {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {
+    fn enter(&mut self, _mem: &mut M, _inputs: &Inputs<'_>) {
         self.ticks = 0;
     }
 
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
-        let mut m = self.mem.lock();
+    fn tick(&mut self, m: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
         if self.ticks >= self.settle
             && let Some(cam) = inputs.camera(0)
         {
@@ -98,26 +95,24 @@ impl<M: DockingMemory> Behavior for Imprint<M> {
 
 /// `dock_switch`: see the module docs. Released only when the dock's contact sensor reads
 /// closed.
-pub struct DockSwitch<M> {
+pub struct DockSwitch {
     name: String,
-    mem: Blackboard<M>,
 }
 
-impl<M: DockingMemory> DockSwitch<M> {
+impl DockSwitch {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<M>) -> Self {
-        Self { name: name.into(), mem }
+    pub fn new(name: &str) -> Self {
+        Self { name: name.into() }
     }
 }
 
-impl<M: DockingMemory> Behavior for DockSwitch<M> {
+impl<M: DockingMemory> Behavior<M> for DockSwitch {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn tick(&mut self, inputs: &Inputs<'_>) -> Option<Step> {
+    fn tick(&mut self, m: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
         inputs.docked_contact().then(|| {
-            let mut m = self.mem.lock();
             let aux = m.docked();
             Step::done(Outcome::Docked, MotorOutput::stop().with_aux(aux), m.feedback("docked"))
         })

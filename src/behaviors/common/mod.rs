@@ -12,8 +12,8 @@ pub mod median;
 use super::registry::{LeafArgs, Registry};
 
 /// Registers the common schemas (`avoid_obstacles`) in `registry`.
-pub fn register<C>(registry: &mut Registry<C>) {
-    registry.register("avoid_obstacles", |_: &C, a: &LeafArgs<'_>| {
+pub fn register<M: 'static>(registry: &mut Registry<M>) {
+    registry.register("avoid_obstacles", |_: &M, a: &LeafArgs<'_>| {
         Ok(Box::new(avoid::AvoidLeaf::from_args(a)?))
     });
 }

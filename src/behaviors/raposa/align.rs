@@ -6,31 +6,28 @@
 
 use super::memory::Memory;
 use super::region2::{plan, robot_in_ball_frame};
-use crate::arbiter::Blackboard;
 use crate::schemas::{Behavior, Inputs, Step};
 
 /// See the module docs.
 pub struct Align {
     name: String,
-    mem: Blackboard<Memory>,
 }
 
 impl Align {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<Memory>) -> Self {
-        Self { name: name.into(), mem }
+    pub fn new(name: &str) -> Self {
+        Self { name: name.into() }
     }
 }
 
-impl Behavior for Align {
+impl Behavior<Memory> for Align {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+    fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let mut m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let view = m.percept.view;
         let (Some(view), Some(alpha)) = (view, view.and_then(|v| v.alpha)) else {
             return Some(m.hold("state_2"));

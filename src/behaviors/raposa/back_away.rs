@@ -10,7 +10,6 @@
 
 use super::memory::Memory;
 use super::params::{LeaveDeadZoneParams, RetreatParams};
-use crate::arbiter::Blackboard;
 use crate::geometry::Pose2;
 use crate::schemas::{Behavior, Inputs, Step};
 
@@ -26,7 +25,6 @@ pub enum Distance {
 /// See the module docs.
 pub struct BackAway {
     name: String,
-    mem: Blackboard<Memory>,
     rule: Distance,
     mark: Pose2,
     distance: f64,
@@ -34,10 +32,9 @@ pub struct BackAway {
 
 impl BackAway {
     /// A leaf named `name` backing away by `rule`.
-    pub fn new(name: &str, mem: Blackboard<Memory>, rule: Distance) -> Self {
+    pub fn new(name: &str, rule: Distance) -> Self {
         Self {
             name: name.into(),
-            mem,
             rule,
             mark: Pose2::default(),
             distance: 0.0,
@@ -52,13 +49,12 @@ impl BackAway {
     }
 }
 
-impl Behavior for BackAway {
+impl Behavior<Memory> for BackAway {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {
-        let m = self.mem.lock();
+    fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         self.mark = m.odo;
         self.distance = match self.rule {
             Distance::DeadZone(p) => {
@@ -69,8 +65,7 @@ impl Behavior for BackAway {
         };
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let mut m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let phase = self.phase();
         if m.travelled(&self.mark) >= self.distance {
             m.source.reset();

@@ -9,14 +9,12 @@
 //! (the departure mission turns it off); only the imprint reads frames.
 
 use super::memory::Memory;
-use crate::arbiter::Blackboard;
 use crate::geometry::Pose2;
 use crate::schemas::{Behavior, Inputs, Step};
 
 /// `raposa.depart`: see the module docs.
 pub struct Depart {
     name: String,
-    mem: Blackboard<Memory>,
     /// Where to stop, straight ahead of where the departure began: m along the body.
     travel: f64,
     /// Odometry where the departure began (odometry is not reset between missions: on
@@ -25,35 +23,30 @@ pub struct Depart {
 }
 
 impl Depart {
-    /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<Memory>) -> Self {
+    /// A leaf named `name`, its travel read from `mem` (the robot's memory at build time).
+    pub fn new(name: &str, mem: &Memory) -> Self {
         // Docked, the camera is `docked_distance` from the target (the ball at the socket,
         // or the flap over the pouch the robot sits in), and the body's forward direction
         // leads away from it.
-        let travel = {
-            let m = mem.lock();
-            (m.source.imprint_distance() - m.docked_distance).max(0.0)
-        };
+        let travel = (mem.source.imprint_distance() - mem.docked_distance).max(0.0);
         Self {
             name: name.into(),
-            mem,
             travel,
             from: Pose2::default(),
         }
     }
 }
 
-impl Behavior for Depart {
+impl Behavior<Memory> for Depart {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {
-        self.from = self.mem.lock().odo;
+    fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
+        self.from = m.odo;
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let target = self.from.to_world(self.travel, 0.0);
         Some(match m.ctrl.travel(&m.odo, target, false) {
             Some(t) => m.drive(t, "depart"),

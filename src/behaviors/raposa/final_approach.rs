@@ -10,13 +10,11 @@
 
 use super::memory::Memory;
 use super::params::FinalParams;
-use crate::arbiter::Blackboard;
 use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, Posture, Step};
 
 /// See the module docs.
 pub struct FinalApproach {
     name: String,
-    mem: Blackboard<Memory>,
     max_retries: u32,
     params: FinalParams,
     start: f64,
@@ -25,10 +23,9 @@ pub struct FinalApproach {
 
 impl FinalApproach {
     /// A leaf named `name`, failing after `max_retries` retries, with the default params.
-    pub fn new(name: &str, mem: Blackboard<Memory>, max_retries: u32) -> Self {
+    pub fn new(name: &str, max_retries: u32) -> Self {
         Self {
             name: name.into(),
-            mem,
             max_retries,
             params: FinalParams::default(),
             start: 0.0,
@@ -44,13 +41,12 @@ impl FinalApproach {
     }
 }
 
-impl Behavior for FinalApproach {
+impl Behavior<Memory> for FinalApproach {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {
-        let mut m = self.mem.lock();
+    fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         let dev = m.percept.view.map_or(0.0, |v| v.dev_px[1]);
         m.aux.arm = Some(m.law.arm(dev));
         m.aux.lights = Some(true);
@@ -61,8 +57,7 @@ impl Behavior for FinalApproach {
         self.first = true;
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let mut m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         if std::mem::take(&mut self.first) {
             // The end of state 1: its law still runs on the tick state 6 is selected.
             return Some(m.approach(false, "state_6"));

@@ -6,7 +6,6 @@
 //! any of them tells the perception the robot looks away on purpose.
 
 use super::memory::Memory;
-use crate::arbiter::Blackboard;
 use crate::schemas::{Behavior, Inputs, Step};
 
 /// Which part of the manoeuvre a [`Manoeuvre`] leaf runs.
@@ -23,7 +22,6 @@ pub enum Part {
 /// See the module docs.
 pub struct Manoeuvre {
     name: String,
-    mem: Blackboard<Memory>,
     part: Part,
     /// Where the ball should be, odometry frame (rotate φ).
     ball: (f64, f64),
@@ -31,30 +29,27 @@ pub struct Manoeuvre {
 
 impl Manoeuvre {
     /// A leaf named `name` running `part`.
-    pub fn new(name: &str, mem: Blackboard<Memory>, part: Part) -> Self {
+    pub fn new(name: &str, part: Part) -> Self {
         Self {
             name: name.into(),
-            mem,
             part,
             ball: (0.0, 0.0),
         }
     }
 }
 
-impl Behavior for Manoeuvre {
+impl Behavior<Memory> for Manoeuvre {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {
-        let mut m = self.mem.lock();
+    fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         // The blind part of region II looks away from the pyramid on purpose.
         m.blind = true;
         self.ball = m.map.to_world(0.0, 0.0);
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let mut m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let Some(pl) = m.plan else {
             return Some(m.hold("state_2"));
         };

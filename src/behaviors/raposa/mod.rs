@@ -67,7 +67,6 @@ use super::agent::BuildError;
 use super::common::docking::{DockSwitch, Imprint, ImprintEnd};
 use super::composed::Composed;
 use super::registry::{LeafArgs, Registry};
-use crate::arbiter::Blackboard;
 use crate::profile::Profile;
 use back_away::{BackAway, Distance};
 use manoeuvre::{Manoeuvre, Part};
@@ -75,103 +74,78 @@ use manoeuvre::{Manoeuvre, Part};
 /// Registers RAPOSA's phase schemas (`raposa.approach`, `raposa.rotate_7`, ...) and the
 /// `raposa.seven_state` selector in `registry`; each schema takes its tuning from its
 /// node's `params` (see [`params`]) and the robot-wide `[robot.seven_state]`.
-pub fn register(registry: &mut Registry<Blackboard<Memory>>) {
-    type Ctx = Blackboard<Memory>;
+pub fn register(registry: &mut Registry<Memory>) {
+    type Ctx = Memory;
     let search_timeout = |a: &LeafArgs<'_>| a.profile.behavior.search_timeout_s;
     registry
         .register("raposa.depart", |m: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(departure::Depart::new(a.node, m.clone())))
+            Ok(Box::new(departure::Depart::new(a.node, m)))
         })
         .register("raposa.imprint", |m: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
             // The first frame after stopping is skipped (motion blur); the imprint's
             // result is the departure's.
-            let frames = m.lock().source.imprint_frames_wanted();
-            Ok(Box::new(Imprint::new(
-                a.node,
-                m.clone(),
-                1,
-                frames,
-                ImprintEnd::Outcome,
-            )))
+            let frames = m.source.imprint_frames_wanted();
+            Ok(Box::new(Imprint::new(a.node, 1, frames, ImprintEnd::Outcome)))
         })
-        .register("raposa.dock_switch", |m: &Ctx, a: &LeafArgs<'_>| {
+        .register("raposa.dock_switch", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(DockSwitch::new(a.node, m.clone())))
+            Ok(Box::new(DockSwitch::new(a.node)))
         })
-        .register("raposa.approach", |m: &Ctx, a: &LeafArgs<'_>| {
+        .register("raposa.approach", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(servo::Approach::new(a.node, m.clone())))
+            Ok(Box::new(servo::Approach::new(a.node)))
         })
-        .register("raposa.align", |m: &Ctx, a: &LeafArgs<'_>| {
+        .register("raposa.align", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(align::Align::new(a.node, m.clone())))
+            Ok(Box::new(align::Align::new(a.node)))
         })
-        .register("raposa.far_ellipse", |m: &Ctx, a: &LeafArgs<'_>| {
+        .register("raposa.far_ellipse", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(servo::FarEllipse::new(a.node, m.clone())))
+            Ok(Box::new(servo::FarEllipse::new(a.node)))
         })
-        .register("raposa.blue_only", |m: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(servo::BlueOnly::new(a.node, m.clone(), a.params()?)))
+        .register("raposa.blue_only", |_: &Ctx, a: &LeafArgs<'_>| {
+            Ok(Box::new(servo::BlueOnly::new(a.node, a.params()?)))
         })
-        .register("raposa.search", move |m: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(search::Search::new(
-                a.node,
-                m.clone(),
-                a.params()?,
-                search_timeout(a),
-            )))
+        .register("raposa.search", move |_: &Ctx, a: &LeafArgs<'_>| {
+            Ok(Box::new(search::Search::new(a.node, a.params()?, search_timeout(a))))
         })
-        .register("raposa.final", |m: &Ctx, a: &LeafArgs<'_>| {
+        .register("raposa.final", |_: &Ctx, a: &LeafArgs<'_>| {
             Ok(Box::new(
-                final_approach::FinalApproach::new(a.node, m.clone(), a.profile.behavior.max_retries)
-                    .with_params(a.params()?),
+                final_approach::FinalApproach::new(a.node, a.profile.behavior.max_retries).with_params(a.params()?),
             ))
         })
-        .register("raposa.leave_dead_zone", |m: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(BackAway::new(
-                a.node,
-                m.clone(),
-                Distance::DeadZone(a.params()?),
-            )))
+        .register("raposa.leave_dead_zone", |_: &Ctx, a: &LeafArgs<'_>| {
+            Ok(Box::new(BackAway::new(a.node, Distance::DeadZone(a.params()?))))
         })
-        .register("raposa.probe", |m: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(probe::Probe::new(a.node, m.clone(), a.params()?)))
+        .register("raposa.probe", |_: &Ctx, a: &LeafArgs<'_>| {
+            Ok(Box::new(probe::Probe::new(a.node, a.params()?)))
         })
-        .register("raposa.retreat", |m: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(BackAway::new(
-                a.node,
-                m.clone(),
-                Distance::Retreat(a.params()?),
-            )))
+        .register("raposa.retreat", |_: &Ctx, a: &LeafArgs<'_>| {
+            Ok(Box::new(BackAway::new(a.node, Distance::Retreat(a.params()?))))
         })
-        .register("raposa.rotate_7", |m: &Ctx, a: &LeafArgs<'_>| {
+        .register("raposa.rotate_7", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(rotate7::Rotate7::new(a.node, m.clone())))
+            Ok(Box::new(rotate7::Rotate7::new(a.node)))
         })
-        .register("raposa.rotate_odo", |m: &Ctx, a: &LeafArgs<'_>| {
+        .register("raposa.rotate_odo", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(Manoeuvre::new(a.node, m.clone(), Part::RotateOdo)))
+            Ok(Box::new(Manoeuvre::new(a.node, Part::RotateOdo)))
         })
-        .register("raposa.travel", |m: &Ctx, a: &LeafArgs<'_>| {
+        .register("raposa.travel", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(Manoeuvre::new(a.node, m.clone(), Part::Travel)))
+            Ok(Box::new(Manoeuvre::new(a.node, Part::Travel)))
         })
-        .register("raposa.rotate_phi", |m: &Ctx, a: &LeafArgs<'_>| {
+        .register("raposa.rotate_phi", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(Manoeuvre::new(a.node, m.clone(), Part::RotatePhi)))
+            Ok(Box::new(Manoeuvre::new(a.node, Part::RotatePhi)))
         })
-        .register("raposa.look", move |m: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(search::Look::new(
-                a.node,
-                m.clone(),
-                a.params()?,
-                search_timeout(a),
-            )))
+        .register("raposa.look", move |_: &Ctx, a: &LeafArgs<'_>| {
+            Ok(Box::new(search::Look::new(a.node, a.params()?, search_timeout(a))))
         })
-        .register_selector("raposa.seven_state", |m: &Ctx, a| {
-            Ok(Box::new(selector::SevenState::new(m.clone(), a)?))
+        .register_selector("raposa.seven_state", |_: &Ctx, a| {
+            Ok(Box::new(selector::SevenState::new(a)?))
         });
 }
 
@@ -186,8 +160,8 @@ pub type RaposaAgent = Composed<Memory>;
 ///
 /// # Errors
 /// [`BuildError`] when something it needs is missing or the tree does not build.
-pub fn agent_with(profile: &Profile, registry: &Registry<Blackboard<Memory>>) -> Result<RaposaAgent, BuildError> {
-    Composed::build(profile, registry, super::catalog::memory(&Raposa, profile)?)
+pub fn agent_with(profile: &Profile, registry: &Registry<Memory>) -> Result<RaposaAgent, BuildError> {
+    Composed::build(profile, registry, Memory::from_profile(profile)?)
 }
 
 /// Builds RAPOSA's robot with RAPOSA's own schemas (see [`agent_with`]).

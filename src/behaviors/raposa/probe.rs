@@ -17,22 +17,19 @@
 use super::memory::Memory;
 use super::params::ProbeParams;
 use super::region2::{plan_to, robot_in_ball_frame};
-use crate::arbiter::Blackboard;
 use crate::schemas::{Behavior, Inputs, Step};
 
 /// See the module docs.
 pub struct Probe {
     name: String,
-    mem: Blackboard<Memory>,
     params: ProbeParams,
 }
 
 impl Probe {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: ProbeParams) -> Self {
+    pub fn new(name: &str, params: ProbeParams) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
         }
     }
@@ -44,15 +41,14 @@ pub fn probe_angle(k: u32, step: f64) -> f64 {
     sign * f64::from(k + 1) * step
 }
 
-impl Behavior for Probe {
+impl Behavior<Memory> for Probe {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+    fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let mut m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let Some(view) = m.percept.view else {
             return Some(m.hold("probe"));
         };

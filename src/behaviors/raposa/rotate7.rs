@@ -7,14 +7,12 @@
 //! measured. The ellipse lost for `lost_frames` frames ends it with event `lost`.
 
 use super::memory::Memory;
-use crate::arbiter::Blackboard;
 use crate::geometry::Pose2;
 use crate::schemas::{Behavior, Inputs, Step};
 
 /// See the module docs.
 pub struct Rotate7 {
     name: String,
-    mem: Blackboard<Memory>,
     /// Angle turned so far toward −β, rad.
     rotated: f64,
     /// The ball's bearing in the last frame it was seen, rad.
@@ -27,10 +25,9 @@ pub struct Rotate7 {
 
 impl Rotate7 {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<Memory>) -> Self {
+    pub fn new(name: &str) -> Self {
         Self {
             name: name.into(),
-            mem,
             rotated: 0.0,
             last_bearing: 0.0,
             last_step: 0.0,
@@ -39,14 +36,13 @@ impl Rotate7 {
     }
 }
 
-impl Behavior for Rotate7 {
+impl Behavior<Memory> for Rotate7 {
     fn name(&self) -> &str {
         &self.name
     }
 
     /// Starts from this tick's view (the one the plan was made from).
-    fn enter(&mut self, _inputs: &Inputs<'_>) {
-        let mut m = self.mem.lock();
+    fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         m.blind = false;
         self.rotated = 0.0;
         self.last_bearing = m.percept.view.map_or(0.0, |v| v.bearing);
@@ -54,8 +50,7 @@ impl Behavior for Rotate7 {
         self.lost = 0;
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let mut m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let Some(pl) = m.plan else {
             return Some(m.hold("state_7").with_event("lost"));
         };

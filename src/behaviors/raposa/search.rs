@@ -5,7 +5,6 @@
 
 use super::memory::Memory;
 use super::params::{LookParams, SearchParams};
-use crate::arbiter::Blackboard;
 use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, SearchRotation, Step};
 
 /// `raposa.search`, state 5: after `grace_frames` frames with nothing seen, the doubling
@@ -14,32 +13,29 @@ use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, SearchRotation, S
 /// soon as anything is seen; the search clock restarts once the ellipse is seen.
 pub struct Search {
     name: String,
-    mem: Blackboard<Memory>,
     params: SearchParams,
     timeout: f64,
 }
 
 impl Search {
     /// A leaf named `name`, giving up after `timeout` s.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: SearchParams, timeout: f64) -> Self {
+    pub fn new(name: &str, params: SearchParams, timeout: f64) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             timeout,
         }
     }
 }
 
-impl Behavior for Search {
+impl Behavior<Memory> for Search {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+    fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let mut m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         m.unseen += 1;
         if m.unseen <= self.params.grace_frames {
             return Some(m.hold("state_5"));
@@ -64,7 +60,6 @@ impl Behavior for Search {
 /// (settling), as soon as the ellipse is seen.
 pub struct Look {
     name: String,
-    mem: Blackboard<Memory>,
     params: LookParams,
     timeout: f64,
     start: f64,
@@ -73,10 +68,9 @@ pub struct Look {
 
 impl Look {
     /// A leaf named `name`, giving up after `timeout` s.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: LookParams, timeout: f64) -> Self {
+    pub fn new(name: &str, params: LookParams, timeout: f64) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
             timeout,
             start: 0.0,
@@ -85,20 +79,18 @@ impl Look {
     }
 }
 
-impl Behavior for Look {
+impl Behavior<Memory> for Look {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, inputs: &Inputs<'_>) {
-        let mut m = self.mem.lock();
+    fn enter(&mut self, m: &mut Memory, inputs: &Inputs<'_>) {
         m.blind = false;
         self.start = inputs.now;
         self.first_dir = -m.last_turn;
     }
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let t = m.now - self.start;
         if t < self.params.settle_s {
             return Some(m.hold("state_2_look")); // let the image settle after stopping

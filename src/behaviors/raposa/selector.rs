@@ -8,13 +8,12 @@
 
 use super::memory::Memory;
 use super::states::{ServoState, probe_due, select_state};
-use crate::arbiter::{Blackboard, Selector};
+use crate::arbiter::Selector;
 use crate::behaviors::registry::SelectorArgs;
 use crate::schemas::Inputs;
 
 /// See the module docs.
 pub struct SevenState {
-    mem: Blackboard<Memory>,
     approach: usize,
     align: usize,
     far_ellipse: usize,
@@ -34,9 +33,8 @@ impl SevenState {
     ///
     /// # Errors
     /// A message naming a missing state.
-    pub fn new(mem: Blackboard<Memory>, args: &SelectorArgs<'_>) -> Result<Self, String> {
+    pub fn new(args: &SelectorArgs<'_>) -> Result<Self, String> {
         Ok(Self {
-            mem,
             approach: args.state("approach")?,
             align: args.state("align")?,
             far_ellipse: args.state("far_ellipse")?,
@@ -66,9 +64,8 @@ impl SevenState {
     }
 }
 
-impl Selector for SevenState {
-    fn select(&mut self, _inputs: &Inputs<'_>, current: usize) -> Option<usize> {
-        let mut m = self.mem.lock();
+impl Selector<Memory> for SevenState {
+    fn select(&mut self, m: &mut Memory, _inputs: &Inputs<'_>, current: usize) -> Option<usize> {
         let p = m.percept;
         if p.view.is_some() {
             m.search_start = None;

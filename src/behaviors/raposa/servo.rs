@@ -5,32 +5,30 @@
 
 use super::memory::Memory;
 use super::params::BlueOnlyParams;
-use crate::arbiter::Blackboard;
 use crate::schemas::{Behavior, Inputs, Step};
 
 /// `raposa.approach`, state 1 (region I): the servo law on the ellipse, constant speed
 /// beyond `far_distance_m`, v = K_lin·√(A₁/A) closer, ω = −K_ang·x_dev.
 pub struct Approach {
     name: String,
-    mem: Blackboard<Memory>,
 }
 
 impl Approach {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<Memory>) -> Self {
-        Self { name: name.into(), mem }
+    pub fn new(name: &str) -> Self {
+        Self { name: name.into() }
     }
 }
 
-impl Behavior for Approach {
+impl Behavior<Memory> for Approach {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+    fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        Some(self.mem.lock().approach(false, "state_1"))
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
+        Some(m.approach(false, "state_1"))
     }
 }
 
@@ -38,25 +36,24 @@ impl Behavior for Approach {
 /// speed until the blue edges join it (the paper does not say how).
 pub struct FarEllipse {
     name: String,
-    mem: Blackboard<Memory>,
 }
 
 impl FarEllipse {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<Memory>) -> Self {
-        Self { name: name.into(), mem }
+    pub fn new(name: &str) -> Self {
+        Self { name: name.into() }
     }
 }
 
-impl Behavior for FarEllipse {
+impl Behavior<Memory> for FarEllipse {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+    fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        Some(self.mem.lock().approach(true, "state_3"))
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
+        Some(m.approach(true, "state_3"))
     }
 }
 
@@ -65,30 +62,27 @@ impl Behavior for FarEllipse {
 /// within `centred_px` of the image centre.
 pub struct BlueOnly {
     name: String,
-    mem: Blackboard<Memory>,
     params: BlueOnlyParams,
 }
 
 impl BlueOnly {
     /// A leaf named `name`.
-    pub fn new(name: &str, mem: Blackboard<Memory>, params: BlueOnlyParams) -> Self {
+    pub fn new(name: &str, params: BlueOnlyParams) -> Self {
         Self {
             name: name.into(),
-            mem,
             params,
         }
     }
 }
 
-impl Behavior for BlueOnly {
+impl Behavior<Memory> for BlueOnly {
     fn name(&self) -> &str {
         &self.name
     }
 
-    fn enter(&mut self, _inputs: &Inputs<'_>) {}
+    fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
-    fn tick(&mut self, _inputs: &Inputs<'_>) -> Option<Step> {
-        let m = self.mem.lock();
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         let Some(b) = m.percept.detection.blue else {
             return Some(m.hold("state_4"));
         };
