@@ -238,6 +238,15 @@ pub struct Prepared {
 /// [`SimError`] when a backdrop cannot be read, the world cannot be built, or a start
 /// places the robot inside the dock's body (before any run, so no campaign stops midway).
 pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
+    prepare_with(loaded, &super::kinds::SimKinds::default())
+}
+
+/// [`prepare`] with `kinds` drawing the dock and simulating the devices (a crate's own
+/// fiducial and sensor kinds).
+///
+/// # Errors
+/// As [`prepare`].
+pub fn prepare_with(loaded: Loaded, kinds: &super::kinds::SimKinds) -> Result<Prepared, SimError> {
     let dir = loaded.file.parent().unwrap_or(Path::new(".")).to_path_buf();
     let backdrops: Vec<Arc<RgbImage>> = loaded
         .scenario
@@ -245,7 +254,7 @@ pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
         .iter()
         .map(|b| crate::image_io::load_rgb(&dir.join(b)).map(Arc::new))
         .collect::<Result<_, _>>()?;
-    let world = world::build(&loaded.profile, &loaded.scenario.clutter, &backdrops)?;
+    let world = world::build_with(&loaded.profile, &loaded.scenario.clutter, &backdrops, &kinds.painters)?;
     let painted = loaded
         .scenario
         .axes
@@ -254,7 +263,8 @@ pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
         .flatten()
         .map(|pair| {
             let profile = repainted(&loaded.profile, Some(*pair));
-            world::build(&profile, &loaded.scenario.clutter, &backdrops).map(|w| (*pair, Arc::new(w)))
+            world::build_with(&profile, &loaded.scenario.clutter, &backdrops, &kinds.painters)
+                .map(|w| (*pair, Arc::new(w)))
         })
         .collect::<Result<_, _>>()?;
     let runs = loaded.scenario.runs(&loaded.profile);
@@ -277,7 +287,7 @@ pub fn prepare(loaded: Loaded) -> Result<Prepared, SimError> {
         world: Arc::new(world),
         painted,
         runs,
-        devices: Arc::new(SimDevices::default()),
+        devices: Arc::new(kinds.devices.clone()),
     })
 }
 

@@ -49,6 +49,7 @@ pub mod dock;
 pub mod endurance;
 pub mod engine;
 pub mod faults;
+pub mod kinds;
 pub mod motion;
 pub mod obstacles;
 pub mod paper;

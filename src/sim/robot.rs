@@ -34,8 +34,9 @@ pub struct SimRobot(Arc<Mutex<Sim>>);
 pub type SensorFactory = dyn Fn(&SimRobot, &SensorSpec) -> Result<Box<dyn Sensor>, String> + Send + Sync;
 
 /// Simulated devices by kind (see the module docs).
+#[derive(Clone)]
 pub struct SimDevices {
-    sensors: BTreeMap<String, Box<SensorFactory>>,
+    sensors: BTreeMap<String, Arc<SensorFactory>>,
 }
 
 impl Default for SimDevices {
@@ -61,7 +62,7 @@ impl SimDevices {
         kind: impl Into<String>,
         factory: impl Fn(&SimRobot, &SensorSpec) -> Result<Box<dyn Sensor>, String> + Send + Sync + 'static,
     ) -> &mut Self {
-        self.sensors.insert(kind.into(), Box::new(factory));
+        self.sensors.insert(kind.into(), Arc::new(factory));
         self
     }
 }
