@@ -12,6 +12,7 @@
 //! * [`kinematics`]: differential, skid-steer (effective track), turn-or-drive and
 //!   double-Ackermann models, command realisation and odometry.
 //! * [`profile`]: one TOML file per platform, validated with precise errors.
+//! * `msgs` (feature `ros2` or `sim`): ROS 2 messages in CDR, for the bridge and replay.
 //! * `replay` (feature `sim`): a profile's perception or behavior on real logs (ROS 2 bags
 //!   and Foxglove files in MCAP), for `marsupial replay`.
 //!
@@ -50,6 +51,8 @@ pub mod geometry;
 #[cfg(feature = "image-io")]
 pub mod image_io;
 pub mod kinematics;
+#[cfg(any(feature = "ros2", feature = "sim"))]
+pub mod msgs;
 mod panics;
 pub mod perception;
 pub mod profile;
