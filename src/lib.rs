@@ -15,6 +15,7 @@
 //! * `msgs` (feature `ros2` or `sim`): ROS 2 messages in CDR, for the bridge and replay.
 //! * `replay` (feature `sim`): a profile's perception or behavior on real logs (ROS 2 bags
 //!   and Foxglove files in MCAP), for `marsupial replay`.
+//! * `report` (feature `sim`): a campaign's tables beside the papers and its plots.
 //!
 //! ## How the parts fit
 //!
@@ -58,6 +59,8 @@ pub mod perception;
 pub mod profile;
 #[cfg(feature = "sim")]
 pub mod replay;
+#[cfg(feature = "sim")]
+pub mod report;
 pub mod robot;
 #[cfg(feature = "ros2")]
 pub mod ros2;
