@@ -12,10 +12,15 @@
 //! * [`kinematics`]: differential, skid-steer (effective track), turn-or-drive and
 //!   double-Ackermann models, command realisation and odometry.
 //! * [`profile`]: one TOML file per platform, validated with precise errors.
-//! * `msgs` (feature `ros2` or `sim`): ROS 2 messages in CDR, for the bridge and replay.
-//! * `replay` (feature `sim`): a profile's perception or behavior on real logs (ROS 2 bags
-//!   and Foxglove files in MCAP), for `marsupial replay`.
-//! * `report` (feature `sim`): a campaign's tables beside the papers and its plots.
+//!
+//! Above the core, by feature (each layer builds without the ones beside it):
+//!
+//! * `msgs` (feature `ros2` or `sim`): ROS 2 messages in CDR, for the bridge and replay;
+//! * `ros2` (feature `ros2`): the behaviors as a ROS 2 node over Zenoh, no simulator;
+//! * `sim` (feature `sim`): the simulator, scenarios and campaigns writing run records;
+//!   `replay`: a profile's perception or behavior on real logs (ROS 2 bags and Foxglove
+//!   files in MCAP), for `marsupial replay`; `report`: a campaign's tables and plots;
+//! * `cli` (feature `cli`): the `marsupial` tool's commands; the campaign ones with `sim`.
 //!
 //! ## How the parts fit
 //!
