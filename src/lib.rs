@@ -14,8 +14,15 @@
 //! * [`kinematics`]: differential, skid-steer (effective track), turn-or-drive and
 //!   double-Ackermann models, command realisation and odometry.
 //! * [`profile`]: one TOML file per platform, validated with precise errors.
-//! * `replay` (feature `sim`): a profile's perception or behavior on real logs (ROS 2 bags
-//!   and Foxglove files in MCAP), for `marsupial replay`.
+//!
+//! Above the core, by feature (each layer builds without the ones beside it):
+//!
+//! * `msgs` (feature `ros2` or `sim`): ROS 2 messages in CDR, for the bridge and replay;
+//! * `ros2` (feature `ros2`): the behaviors as a ROS 2 node over Zenoh, no simulator;
+//! * `sim` (feature `sim`): the simulator, scenarios and campaigns writing run records;
+//!   `replay`: a profile's perception or behavior on real logs (ROS 2 bags and Foxglove
+//!   files in MCAP), for `marsupial replay`; `report`: a campaign's tables and plots;
+//! * `cli` (feature `cli`): the `marsupial` tool's commands; the campaign ones with `sim`.
 //!
 //! ## How the parts fit
 //!
@@ -53,11 +60,15 @@ pub mod geometry;
 #[cfg(feature = "image-io")]
 pub mod image_io;
 pub mod kinematics;
+#[cfg(any(feature = "ros2", feature = "sim"))]
+pub mod msgs;
 mod panics;
 pub mod perception;
 pub mod profile;
 #[cfg(feature = "sim")]
 pub mod replay;
+#[cfg(feature = "sim")]
+pub mod report;
 pub mod robot;
 #[cfg(feature = "ros2")]
 pub mod ros2;

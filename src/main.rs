@@ -1,4 +1,6 @@
-//! The `marsupial` command-line tool.
+//! The `marsupial` command-line tool. The campaign commands need feature `sim`, `ros2`
+//! needs feature `ros2`; `check`, `detect`, `calibrate-odometry` and `timeline` need
+//! neither.
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -21,6 +23,7 @@ enum Command {
     /// entrance errors, track …). With --out DIR, writes DIR/trajectory.csv and every Nth
     /// camera frame (the scenario's [record] frames_every) to DIR/frames/. With --trace
     /// FILE, writes each tick's decision (see `timeline`).
+    #[cfg(feature = "sim")]
     Dock(marsupial::cli::sim_cmds::DockOptions),
     /// Run a scenario's whole trial campaign in the simulator, in parallel.
     ///
@@ -28,6 +31,7 @@ enum Command {
     /// velocity, commands per metre, failures by reason). With --out DIR: DIR/runs.jsonl
     /// (one line per finished run, in run order), DIR/summary.json, DIR/trajectories.svg,
     /// DIR/success_map.svg and per-run trajectories.
+    #[cfg(feature = "sim")]
     Trials(marsupial::cli::sim_cmds::TrialsOptions),
     /// Run a perception campaign for circle fiducials (Axel) against the simulator's truth.
     ///
@@ -38,6 +42,7 @@ enum Command {
     /// the ablations (mono without the distortion model, labelling from 4 marks) and what
     /// happened per number of visible marks. `--json` prints one record per run instead;
     /// `--out DIR` writes DIR/runs.jsonl and DIR/tables.txt. Same seed, same bytes.
+    #[cfg(feature = "sim")]
     PoseTrials(marsupial::cli::pose_trials::PoseTrialsOptions),
     /// Join the output folders of a campaign's shards (`trials S --shard K/N --out DIR`).
     ///
@@ -45,6 +50,7 @@ enum Command {
     /// OUT/runs.jsonl (the shards' lines in campaign order) and OUT/summary.json, equal
     /// byte for byte to an unsharded `trials --out`; with --scenario, also the plots and
     /// paper comparison.
+    #[cfg(feature = "sim")]
     Merge(marsupial::cli::merge::MergeOptions),
     /// Validate profile and scenario files.
     ///
@@ -80,6 +86,7 @@ enum Command {
     /// (0 → +max → −max), takes each axle's tie-rod ratio x = d(B1,A1)/d(B2,A2) after
     /// ray-plane intersection, and fits λ = c0 + c1·(x−1) + c2·(x−1)² per axle. Prints
     /// the coefficients and residuals; `--write` puts them into the profile.
+    #[cfg(feature = "sim")]
     CalibrateSteering(marsupial::cli::calibrate_steering::CalibrateSteeringOptions),
     /// Run a profile's fiducial detection on image files: the two-block schema for a
     /// `two_block` fiducial profile, circle marks for a `circles` fiducial one.
@@ -108,6 +115,7 @@ enum Command {
     /// wheels' mean against the rear encoder) and per wheel, and the double-Ackermann
     /// odometry's drift with the estimated against the commanded steering. `--out DIR`
     /// writes frames.csv, odometry.csv, an SVG per degree of freedom and summary.json.
+    #[cfg(feature = "sim")]
     Estimate(marsupial::cli::estimate::EstimateOptions),
     /// Run a profile's perception, or its whole behavior open-loop, on a real log.
     ///
@@ -117,6 +125,7 @@ enum Command {
     /// Prints one line per frame (the percept, and with --behavior the command the robot
     /// would have sent), one per message that could not be used (bad CDR, Bayer or 16-bit
     /// encodings…), and a summary with the skipped counts by topic and reason.
+    #[cfg(feature = "sim")]
     Replay(marsupial::cli::replay::ReplayOptions),
     /// Run a profile's behaviors as a ROS 2 node over Zenoh (built with `--features ros2`).
     ///
@@ -164,6 +173,7 @@ fn main() -> ExitCode {
             json,
             &mut std::io::stdout(),
         )),
+        #[cfg(feature = "sim")]
         Command::CalibrateSteering(opts) => {
             exit_code(marsupial::cli::calibrate_steering::run(&opts, &mut std::io::stdout()))
         }
@@ -171,7 +181,9 @@ fn main() -> ExitCode {
             let bad = marsupial::cli::check::run(&files, &mut std::io::stdout(), &mut std::io::stderr());
             if bad == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE }
         }
+        #[cfg(feature = "sim")]
         Command::Dock(opts) => exit_code(marsupial::cli::sim_cmds::dock(&opts, &mut std::io::stdout())),
+        #[cfg(feature = "sim")]
         Command::Trials(mut opts) => {
             opts.progress = if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
                 marsupial::sim::campaign::Progress::Bar
@@ -180,10 +192,14 @@ fn main() -> ExitCode {
             };
             exit_code(marsupial::cli::sim_cmds::trials(&opts, &mut std::io::stdout()))
         }
+        #[cfg(feature = "sim")]
         Command::PoseTrials(opts) => exit_code(marsupial::cli::pose_trials::run(&opts, &mut std::io::stdout())),
+        #[cfg(feature = "sim")]
         Command::Merge(opts) => exit_code(marsupial::cli::merge::run(&opts, &mut std::io::stdout())),
         Command::Detect(opts) => exit_code(marsupial::cli::detect::run(&opts, &mut std::io::stdout())),
+        #[cfg(feature = "sim")]
         Command::Estimate(opts) => exit_code(marsupial::cli::estimate::run(&opts, &mut std::io::stdout())),
+        #[cfg(feature = "sim")]
         Command::Replay(opts) => exit_code(marsupial::cli::replay::run(&opts, &mut std::io::stdout())),
         #[cfg(feature = "ros2")]
         Command::Ros2(opts) => exit_code(marsupial::cli::ros2::run(&opts, &mut std::io::stdout())),

@@ -90,7 +90,7 @@ fn indexed_png(palette: &[u8]) -> Vec<u8> {
 
 #[test]
 fn a_palette_of_partial_entries_is_a_decode_error_not_a_decoder_panic() {
-    use marsupial::replay::pixels::{PixelError, rgb_from_compressed};
+    use marsupial::msgs::pixels::{PixelError, rgb_from_compressed};
     // Whole entries decode, through both decoders.
     let good = indexed_png(&[10, 20, 30, 200, 150, 100]);
     let im = decode_rgb(&good, Path::new("good.png"), DEFAULT_MAX_PIXELS).unwrap();
@@ -178,7 +178,7 @@ fn a_header_too_short_to_declare_a_size_is_a_decode_error() {
 
 #[test]
 fn a_compressed_frame_in_a_replayed_log_is_held_to_the_same_bound() {
-    use marsupial::replay::pixels::{PixelError, rgb_from_compressed};
+    use marsupial::msgs::pixels::{PixelError, rgb_from_compressed};
     // Within the side limit (16384) but over the pixel bound: refused from the header,
     // before the decoder allocates; as are sides over 16384.
     for (w, h) in [(8193, 8192), (16384, 16384), (20000, 1)] {

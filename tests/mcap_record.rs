@@ -178,7 +178,7 @@ fn a_run_records_every_channel_and_the_frames_byte_for_byte() {
     // Frames: CDR rgb8, equal to the PNG the simulator saved for that tick, decoded by
     // the replay's CDR reader (as a ROS 2 tool or Foxglove would read it).
     for k in [0, ticks / 2, ticks - 1] {
-        let im = marsupial::replay::cdr::decode_image(&topics["/cam0/image"].2[k]).unwrap();
+        let im = marsupial::msgs::cdr::decode_image(&topics["/cam0/image"].2[k]).unwrap();
         assert_eq!((im.encoding, im.is_bigendian, im.header.frame_id), ("rgb8", 0, "cam0"));
         let (w, h) = (u64::from(im.width), u64::from(im.height));
         assert_eq!(u64::from(im.step), w * 3);
@@ -190,7 +190,7 @@ fn a_run_records_every_channel_and_the_frames_byte_for_byte() {
         );
     }
     // Timestamps: the simulation clock, 0.1 s per tick.
-    let im = marsupial::replay::cdr::decode_image(&topics["/cam0/image"].2[3]).unwrap();
+    let im = marsupial::msgs::cdr::decode_image(&topics["/cam0/image"].2[3]).unwrap();
     assert_eq!(im.header.stamp.ns(), Some(300_000_000));
     // Calibration: the profile's pin-hole intrinsics.
     let cal = json(&topics["/cam0/calibration"].2[0]);

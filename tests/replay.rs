@@ -12,11 +12,12 @@
 mod common;
 
 use marsupial::cli::replay::{ReplayCliError, ReplayOptions, run};
+use marsupial::msgs::cdr;
 use marsupial::perception::RgbImage;
 use marsupial::profile::NamedColor;
+use marsupial::replay::ReplayError;
 use marsupial::replay::log::LogFault;
 use marsupial::replay::topics::TopicError;
-use marsupial::replay::{ReplayError, cdr};
 use marsupial::schemas::{ObservedPercept, TwoBlockSchema};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -11,8 +11,8 @@
 
 use marsupial::arbiter::runtime::StopHandle;
 use marsupial::behaviors::agent_for;
+use marsupial::msgs::cdr::CdrReader;
 use marsupial::perception::RgbImage;
-use marsupial::replay::cdr::CdrReader;
 use marsupial::robot::Camera;
 use marsupial::ros2::client::ActionClient;
 use marsupial::ros2::devices::command_of;

@@ -106,5 +106,8 @@ fn same_seed_same_runs_jsonl_whatever_the_job_count_and_resume_works() {
     ] {
         assert!(summary["groups"][0].get(key).is_some(), "{key}");
     }
+    // The plots are the report layer's, drawn from the records (`trials --out` does so).
+    let records = campaign::read_runs(&out2.join("runs.jsonl"));
+    marsupial::report::plot::write_plots(&out2, &p.world, &p.loaded.profile, &records).unwrap();
     assert!(out2.join("trajectories.svg").exists() && out2.join("success_map.svg").exists());
 }

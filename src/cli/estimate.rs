@@ -29,10 +29,10 @@ use crate::perception::krawler::{
     SteeringPoly,
 };
 use crate::profile::Profile;
+use crate::report::plot::{Series, paths_svg, time_series_svg};
 use crate::sim::camera::camera_pose;
 use crate::sim::krawler::{GearExtras, GroundPose, KrawlerState, build_with, expected_markers};
 use crate::sim::krawler_sequence::{LightChange, SequenceSpec, TruthFrame, drive_of, generate, odometry, shaken};
-use crate::sim::plot::{Series, paths_svg, time_series_svg};
 use crate::sim::render::{CameraPose, Renderer, SensorParams};
 use crate::sim::rng::Rng;
 use nalgebra::Point3;

@@ -70,10 +70,10 @@ pub fn run(opts: &MergeOptions, out: &mut dyn Write) -> Result<campaign::Summary
             path: p.display().to_string(),
             source,
         };
-        crate::sim::plot::write_plots(&opts.out, &prepared.world, &prepared.loaded.profile, &merged.records)
+        crate::report::plot::write_plots(&opts.out, &prepared.world, &prepared.loaded.profile, &merged.records)
             .map_err(|e| io(&opts.out, e))?;
         if let Some(t) = prepared.loaded.scenario.compare {
-            let c = crate::sim::paper::comparison(t, &merged.records);
+            let c = crate::report::paper::comparison(t, &merged.records);
             let p = opts.out.join("paper_comparison.txt");
             std::fs::write(&p, &c).map_err(|e| io(&p, e))?;
             comparison = Some(c);

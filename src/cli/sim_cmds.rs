@@ -1,9 +1,9 @@
 //! `marsupial dock` and `marsupial trials`: runs in the simulator.
 
 use crate::behaviors::agent_for;
+use crate::report::paper::cell;
 use crate::sim::SimError;
 use crate::sim::campaign::{self, CampaignOptions, GroupSummary, Recording, RunRecord, Summary};
-use crate::sim::paper::cell;
 use crate::sim::record::RecordOptions;
 use crate::sim::scenario::Scenario;
 use crate::sim::shard;
@@ -406,7 +406,7 @@ pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimE
     let bins = opts
         .bin
         .iter()
-        .map(|b| crate::sim::bins::parse_bin_arg(b))
+        .map(|b| crate::report::bins::parse_bin_arg(b))
         .collect::<Result<Vec<_>, _>>()
         .map_err(SimError::InvalidArgument)?;
     let loaded = Scenario::load(&opts.scenario)?;
@@ -459,11 +459,20 @@ pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimE
             }),
         },
     )?;
+    if let Some(dir) = &opts.out {
+        // From every record, resumed ones included (the campaign wrote summary.json).
+        crate::report::plot::write_plots(dir, &prepared.world, &prepared.loaded.profile, &records).map_err(
+            |source| SimError::Io {
+                path: dir.display().to_string(),
+                source,
+            },
+        )?;
+    }
     let comparison = prepared
         .loaded
         .scenario
         .compare
-        .map(|t| crate::sim::paper::comparison(t, &records));
+        .map(|t| crate::report::paper::comparison(t, &records));
     if let (Some(c), Some(dir)) = (&comparison, &opts.out) {
         let p = dir.join("paper_comparison.txt");
         std::fs::write(&p, c).map_err(|source| SimError::Io {
@@ -479,7 +488,7 @@ pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimE
             let _ = writeln!(out, "\n{c}");
         }
         for (param, n) in &bins {
-            let table = crate::sim::bins::bin_by(&records, param, *n).map_err(SimError::InvalidArgument)?;
+            let table = crate::report::bins::bin_by(&records, param, *n).map_err(SimError::InvalidArgument)?;
             let _ = writeln!(out, "\n{table}");
         }
         let _ = writeln!(

@@ -1,9 +1,10 @@
 //! One logged message to what perception and the loop take: a frame (RGB pixels and
 //! stamp) or an odometry reading, whatever the topic's schema.
 
+use super::foxglove;
 use super::topics::TopicKind;
-use super::{cdr, foxglove};
 use crate::geometry::Twist;
+use crate::msgs::cdr;
 use crate::perception::RgbImage;
 use crate::schemas::OdometryReading;
 use thiserror::Error;
@@ -19,7 +20,7 @@ pub enum DecodeError {
     Foxglove(#[from] foxglove::FoxgloveError),
     /// The pixels cannot become an RGB frame.
     #[error("{0}")]
-    Pixels(#[from] super::pixels::PixelError),
+    Pixels(#[from] crate::msgs::pixels::PixelError),
     /// An odometry message handed to the frame decoder or the reverse.
     #[error("a {0:?} message is not what was asked for")]
     Kind(TopicKind),
@@ -29,7 +30,7 @@ impl DecodeError {
     /// A short, stable name for the reason (`cdr`, `json`, `unsupported_encoding` …), to
     /// group skipped messages by.
     pub fn reason(&self) -> &'static str {
-        use super::pixels::PixelError as P;
+        use crate::msgs::pixels::PixelError as P;
         match self {
             DecodeError::Cdr(_) => "cdr",
             DecodeError::Foxglove(_) => "json",

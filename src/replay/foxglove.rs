@@ -5,9 +5,9 @@
 //!
 //! Pure functions over `&[u8]`, so they can be fuzzed directly.
 
-use super::pixels::{PixelError, rgb_from_compressed, rgb_from_raw};
-use super::ros::yaw_of;
 use crate::geometry::Pose2;
+use crate::msgs::pixels::{PixelError, rgb_from_compressed, rgb_from_raw};
+use crate::msgs::ros::yaw_of;
 use crate::perception::RgbImage;
 use serde::Deserialize;
 use thiserror::Error;

@@ -5,13 +5,14 @@
 //!
 //! * ROS 2 bags in MCAP, as rosbag2 writes them: schema encoding `ros2msg`, message
 //!   encoding `cdr`, topics of `sensor_msgs/msg/Image`, `sensor_msgs/msg/CompressedImage`
-//!   and `nav_msgs/msg/Odometry` ([`cdr`], [`ros`]);
+//!   and `nav_msgs/msg/Odometry` ([`crate::msgs::cdr`], [`crate::msgs::ros`]);
 //! * Foxglove-schema files with JSON messages (`foxglove.RawImage`,
 //!   `foxglove.CompressedImage`, `foxglove.PoseInFrame`), as `marsupial dock --record`
 //!   writes them ([`foxglove`]).
 //!
 //! Raw frames in `rgb8`, `bgr8`, `rgba8`, `bgra8` and `mono8`, and JPEG or PNG compressed
-//! frames, become RGB ([`pixels`]); Bayer mosaics and 16-bit depth are refused by name.
+//! frames, become RGB ([`crate::msgs::pixels`]); Bayer mosaics and 16-bit depth are
+//! refused by name.
 //!
 //! Errors come in two sizes. A fault of the file (not MCAP, truncated, compressed with a
 //! codec this build lacks: [`log::LogFault`]) or of the topics asked for
@@ -20,16 +21,13 @@
 //! topic and reason, so a half-readable topic still replays; only a topic with no usable
 //! message at all is an error ([`ReplayError::Unreadable`]).
 //!
-//! The decoders ([`cdr::decode_image`], [`foxglove::decode_raw_image`] …) are pure
-//! functions over `&[u8]` that never panic, for fuzzing.
+//! The decoders ([`crate::msgs::cdr::decode_image`], [`foxglove::decode_raw_image`] …)
+//! are pure functions over `&[u8]` that never panic, for fuzzing.
 
-pub mod cdr;
 pub mod decode;
 pub mod foxglove;
 pub mod log;
-pub mod pixels;
 pub mod preflight;
-pub mod ros;
 pub mod session;
 pub mod topics;
 

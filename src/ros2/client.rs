@@ -8,7 +8,7 @@ use super::messages::{
     Goal, GoalFeedback, GoalId, GoalResult, decode_cancel_response, decode_feedback, decode_result,
     decode_send_goal_response, decode_status, encode_cancel_request, encode_goal_id, encode_send_goal,
 };
-use crate::replay::ros::Time;
+use crate::msgs::ros::Time;
 use std::sync::atomic::{AtomicI64, Ordering};
 use std::time::Duration;
 use thiserror::Error;

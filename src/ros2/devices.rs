@@ -12,9 +12,9 @@
 
 use super::keys::{RmwPublisher, now_ns};
 use crate::kinematics::DriveCommand;
+use crate::msgs::cdr::{decode_compressed_image, decode_image, decode_odometry};
+use crate::msgs::pixels::rgb_into_raw;
 use crate::perception::RgbImage;
-use crate::replay::cdr::{decode_compressed_image, decode_image, decode_odometry};
-use crate::replay::pixels::rgb_into_raw;
 use crate::robot::{Camera, Drive, Exposure, HardwareError, Odometer};
 use crate::schemas::OdometryReading;
 use std::sync::{Arc, Condvar, Mutex};

@@ -1,5 +1,5 @@
 //! CDR payloads of the messages the bridge writes and reads, beyond the camera and
-//! odometry messages [`crate::replay::cdr`] already decodes: `geometry_msgs/msg/Twist`,
+//! odometry messages [`crate::msgs::cdr`] already decodes: `geometry_msgs/msg/Twist`,
 //! the encoders of `sensor_msgs/msg/Image` and `nav_msgs/msg/Odometry` (for a simulator
 //! or a test publishing to the node), and the action protocol's requests, replies and
 //! messages for `marsupial_msgs/action/Dock` and `…/Undock`.
@@ -7,8 +7,8 @@
 //! Every decoder is total: a short or malformed payload is a [`CdrError`], never a panic.
 
 use crate::geometry::Pose2;
-use crate::replay::cdr::{CdrError, CdrReader, CdrWriter};
-use crate::replay::ros::Time;
+use crate::msgs::cdr::{CdrError, CdrReader, CdrWriter};
+use crate::msgs::ros::Time;
 
 /// A goal's id, `unique_identifier_msgs/msg/UUID`.
 pub type GoalId = [u8; 16];
@@ -338,7 +338,7 @@ pub fn decode_cancel_response(buf: &[u8]) -> Result<i8, CdrError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::replay::cdr::{decode_image, decode_odometry};
+    use crate::msgs::cdr::{decode_image, decode_odometry};
 
     #[test]
     fn goal_status_arrays_read_back() {

@@ -13,7 +13,7 @@
 //! the hashes are tested against those ROS 2 prints for `std_msgs/msg/String`,
 //! `geometry_msgs/msg/Twist`, `sensor_msgs/msg/Image`, `nav_msgs/msg/Odometry` and the
 //! service `example_interfaces/srv/AddTwoInts`; the CDR layouts against the XCDR1 rules
-//! ([`crate::replay::cdr`]). `tests/ros2_bridge.rs` docks the simulated Bujold through
+//! ([`crate::msgs::cdr`]). `tests/ros2_bridge.rs` docks the simulated Bujold through
 //! the bridge, with the simulator as a second Zenoh participant. No live ROS 2
 //! installation was run against it.
 

@@ -30,8 +30,8 @@ use crate::arbiter::ReactiveLoop;
 use crate::arbiter::reactive_loop::LoopStatus;
 use crate::arbiter::runtime::{RuntimeConfig, RuntimeEvent, RuntimeReport, StopHandle, run_missions_observed};
 use crate::behaviors::agent_for;
+use crate::msgs::ros::Time;
 use crate::profile::Profile;
-use crate::replay::ros::Time;
 use crate::robot::{BodyPosture, DockGuides, DockSensor, HardwareError, Lights, Robot};
 use crate::schemas::{Agent, FailureReason, Guides, Mission, Outcome, Posture};
 use crossbeam::channel::{Receiver, RecvTimeoutError, Sender, unbounded};
@@ -703,14 +703,14 @@ impl AuxTopic {
 /// A `std_msgs/msg/String`.
 pub fn encode_string(s: &str) -> Vec<u8> {
     let mut buf = Vec::new();
-    crate::replay::cdr::CdrWriter::new(&mut buf).string(s);
+    crate::msgs::cdr::CdrWriter::new(&mut buf).string(s);
     buf
 }
 
 /// A `std_msgs/msg/Bool`.
 pub fn encode_bool(b: bool) -> Vec<u8> {
     let mut buf = Vec::new();
-    crate::replay::cdr::CdrWriter::new(&mut buf).u8(u8::from(b));
+    crate::msgs::cdr::CdrWriter::new(&mut buf).u8(u8::from(b));
     buf
 }
 
@@ -752,7 +752,7 @@ impl DockSensor for TopicSwitch {
             return Err(HardwareError::NotReady);
         };
         let p = p.to_bytes();
-        let mut r = crate::replay::cdr::CdrReader::new(&p).map_err(|e| self.fault(e))?;
+        let mut r = crate::msgs::cdr::CdrReader::new(&p).map_err(|e| self.fault(e))?;
         Ok(r.u8("data").map_err(|e| self.fault(e))? != 0)
     }
 }

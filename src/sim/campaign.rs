@@ -18,8 +18,8 @@
 //! `--jobs` on either side (`tests/campaign_resume.rs` kills campaigns at random instants
 //! and mid-write). Any other damage (a bad line before the last, a run out of place, a
 //! file from another scenario or seed) is an error naming the line, not silently
-//! dropped. `summary.json` and the plots are written from every record, resumed ones
-//! included, at the end; `summary.json` is replaced atomically. The guarantee is for
+//! dropped. `summary.json` is written from every record, resumed ones included, at the
+//! end, and replaced atomically (the plots, `report::plot`, are the CLI's, drawn after). The guarantee is for
 //! the process being killed; after a power loss the operating system may not have
 //! written the file's last pages.
 
@@ -165,7 +165,7 @@ impl RunRecord {
 /// Options for [`run_campaign`].
 #[derive(Debug, Clone, Default)]
 pub struct CampaignOptions {
-    /// Output folder (runs.jsonl, summary.json, plots, per-run files).
+    /// Output folder (runs.jsonl, summary.json, per-run files; `trials` adds the plots).
     pub out: Option<PathBuf>,
     /// Worker threads (0: all cores).
     pub jobs: usize,
@@ -863,7 +863,6 @@ pub fn run_campaign(
             serde_json::to_string_pretty(&summary).unwrap_or_default().as_bytes(),
         )
         .map_err(io(&path))?;
-        super::plot::write_plots(dir, &p.world, &p.loaded.profile, &records).map_err(io(dir))?;
     }
     Ok((records, summary))
 }

@@ -492,7 +492,6 @@ pub fn run_campaign(
     if let Some(dir) = &opts.out {
         let path = dir.join("summary.json");
         std::fs::write(&path, serde_json::to_string_pretty(&summary).unwrap_or_default()).map_err(io(&path))?;
-        super::plot::write_plots(dir, &p.world, &p.loaded.profile, &records).map_err(io(dir))?;
     }
     Ok((records, summary))
 }

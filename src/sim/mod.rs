@@ -43,7 +43,6 @@ pub enum SimError {
         source: std::io::Error,
     },
 }
-pub mod bins;
 pub mod campaign;
 pub mod dock;
 pub mod endurance;
@@ -52,8 +51,6 @@ pub mod faults;
 pub mod kinds;
 pub mod motion;
 pub mod obstacles;
-pub mod paper;
-pub mod plot;
 pub mod range;
 pub mod record;
 pub mod robot;

@@ -484,7 +484,7 @@ pub struct Scenario {
     pub record: RecordSpec,
     /// A published table to print beside the results.
     #[serde(default)]
-    pub compare: Option<super::paper::PaperTable>,
+    pub compare: Option<PaperTable>,
     /// Faults injected into the docking runs, one per run: an axis ([`super::faults`]).
     /// Empty: no faults, and the campaign is what it was without the table.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -493,6 +493,36 @@ pub struct Scenario {
     /// campaign is what it was without the table.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub endurance: Option<EnduranceSpec>,
+}
+
+/// Which published table a scenario reproduces (`compare = "bujold-table1"`): the
+/// campaign's results are printed beside it (`report::paper::comparison`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PaperTable {
+    /// Seed 004 Table Ia (mean time to dock by symmetric start group) and §VI.A totals.
+    BujoldTable1,
+    /// Seed 004 Table II (time and success by lighting and segmentation).
+    BujoldTable2,
+    /// Seed 001 Table I (mean time, σ, v_mean and success by start group).
+    RaposaTable1,
+    /// Seed 001 §III: success against distance at 0°.
+    RaposaRange,
+    /// Seed 001 §III: 80°, 90° and 110° starts at about 1.5 m.
+    RaposaWide,
+    /// Seed 000 §V-B: 29 of 40 field runs docked, 20 of 24 away from the workspace
+    /// boundary. Starts labelled `b…` are boundary starts (7 m, or beyond 40°), reported
+    /// apart; every other start is away from the boundary (`fig10` among them).
+    AxelField,
+    /// Seed 000 §V-C: pure reeling docks only for |α| < 5° and tolerates |h| < 90°.
+    /// Starts are labelled `r<m>/a<α°>/h<h°>` (α of the arm's tip about the module's axis,
+    /// h the rover's heading from it); the table has one cell per (α, h), over every
+    /// distance and terrain, beside the paper's limit.
+    AxelReelOnly,
+    /// Seed 000 §V-E: docked under uniform light and under an intense uneven shadow on
+    /// the module's face, with the paper's fixed thresholds. Lighting programmes named
+    /// `uniform` and `shadow` are set beside those figures.
+    AxelLighting,
 }
 
 fn one() -> u32 {

@@ -36,9 +36,9 @@ mod uncached;
 
 use super::run::TraceLine;
 use crate::geometry::Pose2;
+use crate::msgs::cdr::CdrWriter;
 use crate::perception::RgbImage;
 use crate::profile::CameraSpec;
-use crate::replay::cdr::CdrWriter;
 use crate::schemas::{MotorOutput, Observation};
 use messages::{CameraCalibration, FrameTransform, Log, PoseInFrame, Quaternion, Time, Vector3};
 use serde::Serialize;

@@ -1,9 +1,9 @@
 //! SVG plots of a campaign: trajectories on a top view of the dock with the starts
 //! marked (like seed 004 Fig. 8/9), and a success map.
 
-use super::campaign::RunRecord;
-use super::world::World;
 use crate::profile::Profile;
+use crate::sim::campaign::RunRecord;
+use crate::sim::world::World;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;

@@ -2,8 +2,8 @@
 //! weak regions of a randomized campaign show: success against beacon power, shadow speed,
 //! sun elevation, and so on, per segmentation mode.
 
-use super::campaign::RunRecord;
-use super::lighting_random::LightingDraw;
+use crate::sim::campaign::RunRecord;
+use crate::sim::lighting_random::LightingDraw;
 use std::collections::BTreeMap;
 use std::fmt;
 

@@ -99,7 +99,7 @@ fn refusal(encoding: &str) -> &'static str {
 /// # Example
 ///
 /// ```
-/// use marsupial::replay::pixels::rgb_from_raw;
+/// use marsupial::msgs::pixels::rgb_from_raw;
 ///
 /// // 2×1 bgr8 with a 2-byte row pad: blue then red.
 /// let im = rgb_from_raw(2, 1, "bgr8", 8, &[255, 0, 0, 0, 0, 255, 9, 9]).unwrap();
@@ -125,7 +125,7 @@ pub fn rgb_from_raw(width: u32, height: u32, encoding: &str, step: u32, data: &[
 ///
 /// ```
 /// use marsupial::perception::RgbImage;
-/// use marsupial::replay::pixels::rgb_into_raw;
+/// use marsupial::msgs::pixels::rgb_into_raw;
 ///
 /// let mut frame = RgbImage::new(1, 1);
 /// rgb_into_raw(1, 1, "mono8", 1, &[7], &mut frame).unwrap();

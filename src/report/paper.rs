@@ -3,38 +3,9 @@
 //! `"raposa-table1"`, `"raposa-range"`, `"raposa-wide"`, `"axel-field"`,
 //! `"axel-reel-only"`, `"axel-lighting"`).
 
-use super::campaign::{RunRecord, summarise};
-use serde::{Deserialize, Serialize};
+use crate::sim::campaign::{RunRecord, summarise};
+use crate::sim::scenario::PaperTable;
 use std::fmt::Write as _;
-
-/// Which published table a scenario reproduces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum PaperTable {
-    /// Seed 004 Table Ia (mean time to dock by symmetric start group) and §VI.A totals.
-    BujoldTable1,
-    /// Seed 004 Table II (time and success by lighting and segmentation).
-    BujoldTable2,
-    /// Seed 001 Table I (mean time, σ, v_mean and success by start group).
-    RaposaTable1,
-    /// Seed 001 §III: success against distance at 0°.
-    RaposaRange,
-    /// Seed 001 §III: 80°, 90° and 110° starts at about 1.5 m.
-    RaposaWide,
-    /// Seed 000 §V-B: 29 of 40 field runs docked, 20 of 24 away from the workspace
-    /// boundary. Starts labelled `b…` are boundary starts (7 m, or beyond 40°), reported
-    /// apart; every other start is away from the boundary (`fig10` among them).
-    AxelField,
-    /// Seed 000 §V-C: pure reeling docks only for |α| < 5° and tolerates |h| < 90°.
-    /// Starts are labelled `r<m>/a<α°>/h<h°>` (α of the arm's tip about the module's axis,
-    /// h the rover's heading from it); the table has one cell per (α, h), over every
-    /// distance and terrain, beside the paper's limit.
-    AxelReelOnly,
-    /// Seed 000 §V-E: docked under uniform light and under an intense uneven shadow on
-    /// the module's face, with the paper's fixed thresholds. Lighting programmes named
-    /// `uniform` and `shadow` are set beside those figures.
-    AxelLighting,
-}
 
 /// Seed 000 §V-B: (docked, runs) overall and away from the workspace boundary.
 pub const AXEL_FIELD: [(&str, usize, usize); 2] = [("all starts", 29, 40), ("away from the boundary", 20, 24)];

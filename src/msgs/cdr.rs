@@ -1,5 +1,6 @@
-//! CDR (OMG XCDR version 1, "plain CDR") decoding of the three ROS 2 messages a replay
-//! reads: `sensor_msgs/msg/Image`, `sensor_msgs/msg/CompressedImage` and
+//! CDR (OMG XCDR version 1, "plain CDR"): [`CdrReader`] and [`CdrWriter`], which the
+//! bridge's messages are written with, and decoding of the three ROS 2 messages the bridge
+//! and a replay read: `sensor_msgs/msg/Image`, `sensor_msgs/msg/CompressedImage` and
 //! `nav_msgs/msg/Odometry`, as rosbag2 stores them in MCAP (message encoding `cdr`).
 //!
 //! A serialised message starts with a 4-byte encapsulation header: two bytes of

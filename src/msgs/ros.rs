@@ -1,5 +1,6 @@
-//! The ROS 2 messages a replay reads, as decoded from CDR ([`super::cdr`]) with their
-//! bytes borrowed, and their conversion to the packed RGB frames perception takes.
+//! The ROS 2 messages the bridge and a replay read, as decoded from CDR ([`super::cdr`])
+//! with their bytes borrowed, and their conversion to the packed RGB frames perception
+//! takes.
 
 use super::pixels::{PixelError, rgb_from_compressed, rgb_from_raw};
 use crate::geometry::{Pose2, Twist};
