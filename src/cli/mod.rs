@@ -10,6 +10,7 @@ pub mod calibrate;
 #[cfg(feature = "sim")]
 pub mod calibrate_steering;
 pub mod check;
+pub mod command;
 pub mod detect;
 #[cfg(feature = "sim")]
 pub mod estimate;
@@ -24,6 +25,8 @@ pub mod ros2;
 #[cfg(feature = "sim")]
 pub mod sim_cmds;
 pub mod timeline;
+
+pub use command::{Plugins, run, run_with};
 
 /// Writes `v` as one line of JSON (the `--json` output of the subcommands that print a
 /// record per item).

@@ -4,7 +4,7 @@
 use super::json_line;
 use crate::config::ConfigError;
 use crate::perception::RgbImage;
-use crate::profile::{CameraSpec, Profile};
+use crate::profile::CameraSpec;
 use crate::replay::decode::{self, DecodeError};
 use crate::replay::log::Log;
 use crate::replay::session::{FrameOutput, Session};
@@ -208,7 +208,19 @@ fn record_spec(spec: &CameraSpec, size: (usize, usize)) -> CameraSpec {
 /// before a fault in the file (a truncated log) are written before the error, and so is
 /// the summary.
 pub fn run(opts: &ReplayOptions, out: &mut dyn Write) -> Result<Summary, ReplayCliError> {
-    let profile = Profile::load(&opts.profile)?;
+    run_with(opts, crate::behaviors::catalog::shipped(), out)
+}
+
+/// [`run`] with the robot built from `catalog` (a crate's own robot kinds).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_with(
+    opts: &ReplayOptions,
+    catalog: &crate::behaviors::Catalog,
+    out: &mut dyn Write,
+) -> Result<Summary, ReplayCliError> {
+    let profile = catalog.load_profile(&opts.profile)?;
     let log = Log::open(&opts.log)?;
     let topic_err = |error: TopicError| ReplayError::Topic {
         path: opts.log.clone(),
@@ -220,7 +232,7 @@ pub fn run(opts: &ReplayOptions, out: &mut dyn Write) -> Result<Summary, ReplayC
         return Err(ReplayError::Setup("no image topic".into()).into());
     };
     let odom = choose(log.topics(), opts.odom_topic.as_deref(), true, true).map_err(topic_err)?;
-    let mut session = Session::new(&profile, opts.behavior, odom.is_some())?;
+    let mut session = Session::new_with(&profile, catalog, opts.behavior, odom.is_some())?;
 
     let mut wanted = vec![image_topic.as_str()];
     if let Some((t, _)) = &odom {

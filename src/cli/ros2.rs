@@ -133,9 +133,17 @@ pub fn config(opts: &Ros2Options, profile: &Profile) -> Result<BridgeConfig, Ros
 /// # Errors
 /// [`Ros2CliError`].
 pub fn run(opts: &Ros2Options, out: &mut dyn Write) -> Result<(), Ros2CliError> {
-    let profile = Profile::load(&opts.profile)?;
+    run_with(opts, crate::behaviors::catalog::shipped(), out)
+}
+
+/// [`run`] with the robot built from `catalog` (a crate's own robot kinds).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_with(opts: &Ros2Options, catalog: &crate::behaviors::Catalog, out: &mut dyn Write) -> Result<(), Ros2CliError> {
+    let profile = catalog.load_profile(&opts.profile)?;
     let config = config(opts, &profile)?;
-    let node = Ros2Node::start(&profile, config.clone())?;
+    let node = Ros2Node::start_with(&profile, catalog, config.clone())?;
     writeln!(
         out,
         "node `{}` of `{}` in domain {}; listening on [{}], connecting to [{}]",

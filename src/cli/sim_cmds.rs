@@ -1,6 +1,6 @@
 //! `marsupial dock` and `marsupial trials`: runs in the simulator.
 
-use crate::behaviors::agent_for;
+use super::Plugins;
 use crate::report::paper::cell;
 use crate::sim::SimError;
 use crate::sim::campaign::{self, CampaignOptions, GroupSummary, Recording, RunRecord, Summary};
@@ -73,12 +73,24 @@ pub fn parse_at(s: &str) -> Result<(f64, f64, f64), String> {
     }
 }
 
-/// Runs one docking run.
+/// Runs one docking run of the crate's robots (see [`dock_with`]).
+///
+/// # Errors
+/// As [`dock_with`].
+pub fn dock(opts: &DockOptions, out: &mut dyn Write) -> Result<RunRecord, SimError> {
+    dock_with(opts, &Plugins::default(), out)
+}
+
+/// Runs one docking run, its robot built from `plugins`' catalog and its dock drawn by
+/// `plugins`' painters.
 ///
 /// # Errors
 /// [`SimError`] for bad scenarios, missing behaviors or unwritable output.
-pub fn dock(opts: &DockOptions, out: &mut dyn Write) -> Result<RunRecord, SimError> {
-    let mut loaded = Scenario::load(&opts.scenario)?;
+pub fn dock_with(opts: &DockOptions, plugins: &Plugins, out: &mut dyn Write) -> Result<RunRecord, SimError> {
+    // The factory runs on the campaign's worker threads: it owns its catalog (a few Arcs).
+    let catalog = plugins.catalog.clone();
+    let agent = move |p: &crate::profile::Profile| catalog.agent(p);
+    let mut loaded = Scenario::load_with(&opts.scenario, plugins.catalog.fiducials())?;
     if let Some(s) = opts.seed {
         loaded.scenario.seed = s;
     }
@@ -93,7 +105,7 @@ pub fn dock(opts: &DockOptions, out: &mut dyn Write) -> Result<RunRecord, SimErr
             label: Some("at".into()),
         }];
     }
-    let prepared = campaign::prepare(loaded)?;
+    let prepared = campaign::prepare_with(loaded, &plugins.sim)?;
     let spec = match (&opts.start, opts.index) {
         (_, Some(i)) => Some(prepared.runs.get(i).ok_or_else(|| {
             SimError::Unsupported(format!(
@@ -154,7 +166,7 @@ pub fn dock(opts: &DockOptions, out: &mut dyn Write) -> Result<RunRecord, SimErr
         let mut found = None;
         crate::sim::endurance::run_outing(
             &prepared,
-            &agent_for,
+            &agent,
             spec.index,
             crate::sim::endurance::OutingRecording {
                 traced: Some(spec.index),
@@ -170,7 +182,7 @@ pub fn dock(opts: &DockOptions, out: &mut dyn Write) -> Result<RunRecord, SimErr
         )?;
         found.ok_or_else(|| SimError::Unsupported(format!("the outing ended before cycle {}", spec.index)))?
     } else {
-        campaign::run_one(&prepared, &spec, &agent_for, &mut recording)?
+        campaign::run_one(&prepared, &spec, &agent, &mut recording)?
     };
     if let (Some(w), Some(path)) = (trace.as_mut(), &opts.trace) {
         w.flush().map_err(|source| SimError::Io {
@@ -398,18 +410,30 @@ fn print_groups(groups: &[GroupSummary], overall: Option<&GroupSummary>, out: &m
     Ok(())
 }
 
-/// Runs a campaign and prints its table (or JSON).
+/// Runs a campaign of the crate's robots (see [`trials_with`]).
+///
+/// # Errors
+/// As [`trials_with`].
+pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimError> {
+    trials_with(opts, &Plugins::default(), out)
+}
+
+/// Runs a campaign and prints its table (or JSON), its robot built from `plugins`'
+/// catalog and its dock drawn by `plugins`' painters.
 ///
 /// # Errors
 /// [`SimError`].
-pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimError> {
+pub fn trials_with(opts: &TrialsOptions, plugins: &Plugins, out: &mut dyn Write) -> Result<Summary, SimError> {
+    // The factory runs on the campaign's worker threads: it owns its catalog (a few Arcs).
+    let catalog = plugins.catalog.clone();
+    let agent = move |p: &crate::profile::Profile| catalog.agent(p);
     let bins = opts
         .bin
         .iter()
         .map(|b| crate::report::bins::parse_bin_arg(b))
         .collect::<Result<Vec<_>, _>>()
         .map_err(SimError::InvalidArgument)?;
-    let loaded = Scenario::load(&opts.scenario)?;
+    let loaded = Scenario::load_with(&opts.scenario, plugins.catalog.fiducials())?;
     let sc = &loaded.scenario;
     if !bins.is_empty() && !sc.axes.lighting.iter().any(|l| sc.lighting_random.contains_key(l)) {
         return Err(SimError::InvalidArgument(format!(
@@ -423,7 +447,7 @@ pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimE
             opts.scenario.display()
         )));
     }
-    let mut prepared = campaign::prepare(loaded)?;
+    let mut prepared = campaign::prepare_with(loaded, &plugins.sim)?;
     if let Some(shard) = opts.shard {
         let campaign_runs = prepared.runs.len();
         prepared.runs = shard.select(&prepared.runs);
@@ -442,7 +466,7 @@ pub fn trials(opts: &TrialsOptions, out: &mut dyn Write) -> Result<Summary, SimE
     let started = std::time::Instant::now();
     let (records, summary) = campaign::run_campaign(
         &prepared,
-        &agent_for,
+        &agent,
         &CampaignOptions {
             out: opts.out.clone(),
             jobs: opts.jobs,

@@ -3,7 +3,6 @@
 
 use super::ReplayError;
 use crate::arbiter::{LoopStatus, ReactiveLoop};
-use crate::behaviors::agent_for;
 use crate::perception::{RgbImage, VisionError};
 use crate::profile::Profile;
 use crate::schemas::{
@@ -51,13 +50,26 @@ impl Session {
     /// [`ReplayError::Setup`] when the profile has no perception a replay runs, or no
     /// behavior.
     pub fn new(profile: &Profile, behavior: bool, odometry: bool) -> Result<Self, ReplayError> {
+        Self::new_with(profile, crate::behaviors::catalog::shipped(), behavior, odometry)
+    }
+
+    /// [`Session::new`], the agent built from `catalog` (a crate's own robot kinds).
+    ///
+    /// # Errors
+    /// As [`Session::new`].
+    pub fn new_with(
+        profile: &Profile,
+        catalog: &crate::behaviors::Catalog,
+        behavior: bool,
+        odometry: bool,
+    ) -> Result<Self, ReplayError> {
         let cam = profile
             .cameras
             .first()
             .ok_or_else(|| setup("the profile has no [[cameras]]"))?;
         let camera_size = (cam.width_px, cam.height_px);
         let runner = if behavior {
-            let agent = agent_for(profile).map_err(|e| setup(&e.to_string()))?;
+            let agent = catalog.agent(profile).map_err(|e| setup(&e.to_string()))?;
             let mut config = profile.loop_config();
             config.staleness.tether = None;
             config.staleness.dock_switch = None;

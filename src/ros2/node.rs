@@ -29,7 +29,6 @@ use super::messages::{
 use crate::arbiter::ReactiveLoop;
 use crate::arbiter::reactive_loop::LoopStatus;
 use crate::arbiter::runtime::{RuntimeConfig, RuntimeEvent, RuntimeReport, StopHandle, run_missions_observed};
-use crate::behaviors::agent_for;
 use crate::msgs::ros::Time;
 use crate::profile::Profile;
 use crate::robot::{BodyPosture, DockGuides, DockSensor, HardwareError, Lights, Robot};
@@ -301,6 +300,18 @@ impl Ros2Node {
     /// [`BridgeError`] when the behavior cannot be built, the topics do not match the
     /// profile's cameras, or Zenoh refuses a declaration.
     pub fn start(profile: &Profile, config: BridgeConfig) -> Result<Self, BridgeError> {
+        Self::start_with(profile, crate::behaviors::catalog::shipped(), config)
+    }
+
+    /// [`Ros2Node::start`], the agent built from `catalog` (a crate's own robot kinds).
+    ///
+    /// # Errors
+    /// As [`Ros2Node::start`].
+    pub fn start_with(
+        profile: &Profile,
+        catalog: &crate::behaviors::Catalog,
+        config: BridgeConfig,
+    ) -> Result<Self, BridgeError> {
         if config.cameras.len() != profile.cameras.len() {
             return Err(BridgeError::Config(format!(
                 "the profile has {} camera(s) but {} image topic(s) were given",
@@ -308,7 +319,7 @@ impl Ros2Node {
                 config.cameras.len()
             )));
         }
-        let agent = agent_for(profile).map_err(|e| BridgeError::Behavior(e.to_string()))?;
+        let agent = catalog.agent(profile).map_err(|e| BridgeError::Behavior(e.to_string()))?;
         let lp: ReactiveLoop<dyn Agent> = ReactiveLoop::new(agent, profile.loop_config());
         let session = zenoh::open(zenoh_config(&config.listen, &config.connect)?)
             .wait()
