@@ -160,7 +160,6 @@ fn exit_code<T, E: std::fmt::Display>(result: Result<T, E>) -> ExitCode {
     }
 }
 
-
 /// What a `marsupial` command serves: the robot catalog (robot kinds, fiducial kinds,
 /// device kinds) and, with the simulator, how it draws each fiducial kind's dock and
 /// simulates each device kind. [`Plugins::default`] is the crate's own; a crate adds its
@@ -200,9 +199,7 @@ pub fn run_with(plugins: Plugins) -> ExitCode {
             &mut std::io::stdout(),
         )),
         #[cfg(feature = "sim")]
-        Command::CalibrateSteering(opts) => {
-            exit_code(super::calibrate_steering::run(&opts, &mut std::io::stdout()))
-        }
+        Command::CalibrateSteering(opts) => exit_code(super::calibrate_steering::run(&opts, &mut std::io::stdout())),
         Command::Check { files } => {
             let bad = super::check::run_with(&files, &plugins.catalog, &mut std::io::stdout(), &mut std::io::stderr());
             if bad == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE }

@@ -140,7 +140,11 @@ pub fn run(opts: &Ros2Options, out: &mut dyn Write) -> Result<(), Ros2CliError> 
 ///
 /// # Errors
 /// As [`run`].
-pub fn run_with(opts: &Ros2Options, catalog: &crate::behaviors::Catalog, out: &mut dyn Write) -> Result<(), Ros2CliError> {
+pub fn run_with(
+    opts: &Ros2Options,
+    catalog: &crate::behaviors::Catalog,
+    out: &mut dyn Write,
+) -> Result<(), Ros2CliError> {
     let profile = catalog.load_profile(&opts.profile)?;
     let config = config(opts, &profile)?;
     let node = Ros2Node::start_with(&profile, catalog, config.clone())?;

@@ -319,7 +319,9 @@ impl Ros2Node {
                 config.cameras.len()
             )));
         }
-        let agent = catalog.agent(profile).map_err(|e| BridgeError::Behavior(e.to_string()))?;
+        let agent = catalog
+            .agent(profile)
+            .map_err(|e| BridgeError::Behavior(e.to_string()))?;
         let lp: ReactiveLoop<dyn Agent> = ReactiveLoop::new(agent, profile.loop_config());
         let session = zenoh::open(zenoh_config(&config.listen, &config.connect)?)
             .wait()
