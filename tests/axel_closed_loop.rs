@@ -9,7 +9,7 @@
 //! the acquisition. (About 90 s of wall time per run, the three run in parallel: every
 //! tick renders two 1024×768 fish-eye frames.)
 
-mod common;
+use crate::common;
 
 use marsupial::behaviors::agent_for;
 use marsupial::sim::campaign;

@@ -3,7 +3,7 @@
 //! to either side. Each must dock within the profile's tolerance (±2 cm, ±5°), measured
 //! from the robot's true pose as it reached the entrance, not from the judge's record.
 
-mod common;
+use crate::common;
 
 use marsupial::arbiter::Blackboard;
 use marsupial::behaviors::BuildError;
