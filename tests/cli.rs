@@ -3,6 +3,9 @@
 //! per file beside this one.
 
 mod common;
+// Configuration-text mutations for the loaders' no-panic tests (profile_errors, scenario_errors).
+#[path = "common/mutate.rs"]
+mod mutate;
 
 mod axel_pose_campaign;
 mod campaign_resume;
