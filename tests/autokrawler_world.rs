@@ -3,7 +3,7 @@
 //! the tie-rod markers against the plate markers as the paper's ratio reads it, and the
 //! white correction face shows on top of a wheel and hides under it.
 
-mod common;
+use crate::common;
 
 use marsupial::geometry::Pose2;
 use marsupial::perception::RgbImage;

@@ -1,25 +1,27 @@
 //! Axel's composed docking (`profiles/axel.toml` `[behavior.tree]`) closed in the
-//! simulator from three different starts in the alignment region's edge: 3 m at α −20°
-//! turned 10° from the axis, 3 m at α 20° turned 40° the other way (the module 60° off the
-//! heading, outside the cameras' view: the acquisition must turn to find it), and 3.5 m
-//! at α 5°, h 15°. Each must seat the arm in the cone by the simulator's judge, on loose
-//! sand, through at least one arc step of the sense-plan-act cycle. The first start is
-//! the one that used to lose the module (the planner's plans now keep it 5° inside the
-//! view and within the detection range, and a lost look recentres it); the second needs
-//! the acquisition. (About 90 s of wall time per run, the three run in parallel: every
-//! tick renders two 1024×768 fish-eye frames.)
+//! simulator from two starts in the alignment region's edge: 3 m at α −20° turned 10°
+//! from the axis, and 3 m at α 20° turned 40° the other way (the module 60° off the
+//! heading, outside the cameras' view: the acquisition must turn to find it). Each must
+//! seat the arm in the cone by the simulator's judge, on loose sand, through at least one
+//! arc step of the sense-plan-act cycle. The first start is the one that used to lose the
+//! module (the planner's plans now keep it 5° inside the view and within the detection
+//! range, and a lost look recentres it); the second needs the acquisition. Plain starts
+//! (4 m at α 15°, 3 m at α −30°) are the golden campaigns' (`scripts/golden axel-field
+//! axel-lighting`, which check the same outcome and tether figures). (About 90 s of wall
+//! time per run, the two run in parallel: every tick renders two 1024×768 fish-eye
+//! frames.)
 
-mod common;
+use crate::common;
 
 use marsupial::behaviors::agent_for;
 use marsupial::sim::campaign;
 use marsupial::sim::scenario::Scenario;
 
 #[test]
-fn docks_from_three_starts() {
+fn docks_from_two_starts() {
     let dir = std::env::temp_dir().join(format!("marsupial-axel-loop-{}", std::process::id()));
     // (r m, α°, h°), the axle from the cone's mouth, h from the module's axis.
-    let starts: [(f64, f64, f64); 3] = [(3.0, -20.0, 10.0), (3.0, 20.0, -40.0), (3.5, 5.0, 15.0)];
+    let starts: [(f64, f64, f64); 2] = [(3.0, -20.0, 10.0), (3.0, 20.0, -40.0)];
     let points: Vec<String> = starts
         .iter()
         .map(|&(r, a, h): &(f64, f64, f64)| {

@@ -6,7 +6,7 @@
 //! `reel_only`), h the rover's heading from that axis (h = 0: facing the module's face
 //! squarely, whatever α).
 
-mod common;
+use crate::common;
 
 use marsupial::geometry::Pose2;
 use marsupial::profile::Profile;

@@ -3,7 +3,7 @@
 //! core, white ring, black rim) and their bars turned as the profile places them; the
 //! module stands outdoors.
 
-mod common;
+use crate::common;
 
 use marsupial::geometry::Pose2;
 use marsupial::perception::RgbImage;

@@ -1,7 +1,7 @@
 //! Bujold's phase schemas driven one by one with scripted memory and inputs, without the
 //! renderer: each ends with the event its profile transition expects, and only then.
 
-mod common;
+use crate::common;
 
 use marsupial::behaviors::bujold::memory::{Memory, RepositionPlan};
 use marsupial::behaviors::bujold::params::*;

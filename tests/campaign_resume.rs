@@ -18,7 +18,7 @@
 //! The reader `--resume` uses is also tested on hand-made files: torn tails of every kind
 //! are dropped, and anything else is an error naming its line.
 
-mod common;
+use crate::common;
 
 use marsupial::sim::campaign::{self, TEST_SLOW_WRITE_ENV, read_resumable};
 use marsupial::sim::rng::Rng;

@@ -13,7 +13,7 @@
 //! estimated and true module origin (x, y on the ground), heading = the module's yaw, and
 //! rotation = the angle of R̂ᵀR (all three axes).
 
-mod common;
+use crate::common;
 use common::axel::{facing, render};
 
 use marsupial::geometry::Pose2;

@@ -8,7 +8,7 @@
 //! 0.2 of the radius, is under 2 px and foreshortened, anti-aliasing leaves it mid-grey,
 //! and some marks are missed: short of the paper's "discernable from 5 m".
 
-mod common;
+use crate::common;
 use common::axel::{facing, render as render_frame, render_lit};
 
 use marsupial::geometry::Pose2;

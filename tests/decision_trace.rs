@@ -2,7 +2,7 @@
 //! and why each transition fired; and every arbiter choice a profile makes shows in them:
 //! flip one and the trace changes.
 
-mod common;
+use crate::common;
 
 use marsupial::arbiter::{NodeTrace, Strategy};
 use marsupial::behaviors::agent_for;

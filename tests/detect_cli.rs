@@ -4,7 +4,7 @@
 //! simulator renders from known poses, none on real photos, the overlay, and clean
 //! failures with fewer than 5 marks.
 
-mod common;
+use crate::common;
 use common::axel::{facing, render};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

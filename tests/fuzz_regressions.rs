@@ -11,7 +11,7 @@
 //!   limit, reported as a decode error), so a 68-byte PNG declaring 8193 × 8192 pixels
 //!   (200 MB as RGB8) went to the decoder.
 
-mod common;
+use crate::common;
 
 use common::TempDir;
 use marsupial::image_io::{DEFAULT_MAX_PIXELS, ImageFileError, decode_rgb, load_rgb, save_png};

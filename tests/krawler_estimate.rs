@@ -3,7 +3,7 @@
 //! seed gives the same summary bit for bit, and the error knobs degrade what they
 //! should.
 
-mod common;
+use crate::common;
 
 use marsupial::cli::estimate::{DOF_NAMES, EstimateOptions, estimate, run};
 use marsupial::sim::krawler_sequence::SequenceSpec;

@@ -5,7 +5,7 @@
 //! occluder reported missing; and the spurious magenta blobs of real photographs counted
 //! and refused an identity.
 
-mod common;
+use crate::common;
 
 use marsupial::geometry::Pose2;
 use marsupial::image_io::load_rgb;

@@ -5,7 +5,7 @@
 //! estimates bit for bit; and the camera's shake on its mount is measured from the plate
 //! markers and compensated.
 
-mod common;
+use crate::common;
 
 use common::krawler::{Rig, axles, draw};
 use marsupial::perception::RgbImage;

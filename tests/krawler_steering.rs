@@ -5,7 +5,7 @@
 //! rendered, noisy frames at random axle states the estimate is within the figures the
 //! README states.
 
-mod common;
+use crate::common;
 
 use marsupial::cli::calibrate_steering::{CalibrateSteeringOptions, calibrate, run};
 use marsupial::geometry::Pose2;

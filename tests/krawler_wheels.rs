@@ -4,7 +4,7 @@
 //! several roll, drop and steering states; and the white correction marker snapping θ
 //! back after an error of either sign, whichever way the wheels turn.
 
-mod common;
+use crate::common;
 
 use common::krawler::{Rig, axles, draw};
 use marsupial::perception::RgbImage;

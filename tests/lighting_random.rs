@@ -4,7 +4,7 @@
 //! --index` replays a run's draw and whole record, `trials --bin` groups by a drawn
 //! parameter, and bad distributions and bin arguments are named errors.
 
-mod common;
+use crate::common;
 
 use marsupial::cli::sim_cmds::{DockOptions, TrialsOptions, dock, trials};
 use marsupial::sim::SimError;

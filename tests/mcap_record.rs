@@ -4,7 +4,7 @@
 //! same file for the same run, an unchanged run record, and `--record-failed` keeping only
 //! the failed runs' files.
 
-mod common;
+use crate::common;
 
 use base64::Engine as _;
 use marsupial::behaviors::agent_for;

@@ -16,7 +16,7 @@
 //! A counting global allocator, gated to the test's own thread, proves it. (The threaded
 //! runtime builds the same per-tick lists as the lockstep; its threads are not counted.)
 
-mod common;
+use crate::common;
 
 use marsupial::perception::{ColorMode, RgbImage};
 use marsupial::profile::{Profile, SegmentationMode};

@@ -6,7 +6,7 @@
 //! `cargo test --release --test paint_sct -- --nocapture` prints the table the README
 //! quotes.
 
-mod common;
+use crate::common;
 
 use marsupial::geometry::Pose2;
 use marsupial::perception::camera_model::CameraModel;

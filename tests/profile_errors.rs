@@ -7,8 +7,7 @@ use marsupial::profile::{DriveKind, Profile};
 use std::path::Path;
 use std::process::Command;
 
-#[path = "common/mutate.rs"]
-mod mutate;
+use crate::mutate;
 
 /// (fixture, expected field path, expected line (None when the parser cannot give one),
 /// text the message must contain)

@@ -5,7 +5,7 @@
 //! the bands, keeps the pair from other poses and falls back to the table when the
 //! pyramid is gone; a failed departure imprint is recorded as failed.
 
-mod common;
+use crate::common;
 
 use common::pose_seeing_origin;
 use marsupial::geometry::Pose2;

@@ -2,7 +2,7 @@
 //! from the blue height and α from the quadratic against the true pose, across the angles
 //! and distances of the paper's experiments, and the sign of α on either side.
 
-mod common;
+use crate::common;
 
 use common::{pose_seeing_origin, render_lab, renderer, shipped_profile};
 use marsupial::schemas::PyramidSchema;

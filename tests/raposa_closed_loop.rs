@@ -5,7 +5,7 @@
 //! paper's dead zone (0.33 m, far off the axis, where only the ball is in view), which
 //! the paper never docked: by probing around the ball until the pair shows its side.
 
-mod common;
+use crate::common;
 
 use marsupial::behaviors::agent_for;
 use marsupial::sim::campaign;

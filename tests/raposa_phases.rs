@@ -3,7 +3,7 @@
 //! transition expects, and only then; the seven-state selector maps percepts to the
 //! servo's states, with the look special case.
 
-mod common;
+use crate::common;
 
 use marsupial::arbiter::Selector;
 use marsupial::behaviors::SharedMemory;

@@ -9,7 +9,7 @@
 //! decoded pixels. Every error the docs promise is provoked: Bayer and 16-bit encodings,
 //! a missing topic, a truncated file, bad CDR, a half-readable topic, two image topics.
 
-mod common;
+use crate::common;
 
 use marsupial::cli::replay::{ReplayCliError, ReplayOptions, run};
 use marsupial::msgs::cdr;

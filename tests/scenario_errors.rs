@@ -6,8 +6,7 @@ use marsupial::config::ConfigError;
 use marsupial::sim::scenario::Scenario;
 use std::path::{Path, PathBuf};
 
-#[path = "common/mutate.rs"]
-mod mutate;
+use crate::mutate;
 
 fn write(name: &str, body: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("marsupial-scenario-errors-{}", std::process::id()));

@@ -3,7 +3,7 @@
 //! for byte, whatever N and `--jobs`; and merge refuses folders that do not make one
 //! whole campaign, naming what is wrong.
 
-mod common;
+use crate::common;
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};

@@ -4,7 +4,7 @@
 //! lighting presets move colour statistics in the intended direction, a glossy highlight
 //! peaks at a dielectric's Fresnel reflection, and auto-exposure protects highlights.
 
-mod common;
+use crate::common;
 
 use marsupial::geometry::Pose2;
 use marsupial::perception::RgbImage;

@@ -1,7 +1,7 @@
 //! The simulator end to end with a trivial scripted driver (no behavior logic in the
 //! simulator): dock and trials, determinism across job counts, resume, contact failures.
 
-mod common;
+use crate::common;
 
 use marsupial::sim::campaign::{self, CampaignOptions, Prepared};
 use marsupial::sim::scenario::Scenario;

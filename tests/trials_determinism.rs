@@ -5,7 +5,7 @@
 //! parallel with `--jobs 2`. (`tests/sim_scripted.rs`
 //! checks the same with a scripted driver that has no perception and no imprint.)
 
-mod common;
+use crate::common;
 
 use marsupial::cli::sim_cmds::{TrialsOptions, trials};
 use marsupial::sim::campaign::{self, RunRecord};

@@ -1,6 +1,6 @@
 //! The two-block detector's rules and the perceptual schema built from a profile.
 
-mod common;
+use crate::common;
 use common::*;
 use marsupial::perception::{ColorMode, PairLimits, TwoBlockDetector};
 use marsupial::profile::Profile;

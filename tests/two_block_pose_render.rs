@@ -2,7 +2,7 @@
 //! pose, across the distances and angles of the close dock, with the robot turned off the
 //! line of sight as the approach leaves it.
 
-mod common;
+use crate::common;
 
 use common::{pose_seeing_origin, render_lab, renderer, shipped_profile};
 use marsupial::perception::two_block_pose::{FiducialView, TwoBlockGeometry};
