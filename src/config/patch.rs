@@ -77,14 +77,14 @@ mod tests {
         let base = "# Bujold\nname = \"a\"\n\n[drive]\nkind = \"x\" # why\nspeed = 1.0\n\n[[cameras]]\nw = 1\n";
         let out = patched(
             base,
-            &table("name = \"b\"\n[drive]\nspeed = 2.0\n`two_block` fiducial\nright = \"yellow\"\n"),
+            &table("name = \"b\"\n[drive]\nspeed = 2.0\n[fiducial]\nright = \"yellow\"\n"),
         )
         .unwrap();
         let v: toml::Table = out.parse().unwrap();
         assert_eq!(v["name"].as_str(), Some("b"));
         assert_eq!(v["drive"]["kind"].as_str(), Some("x"), "untouched keys stay");
         assert_eq!(v["drive"]["speed"].as_float(), Some(2.0));
-        assert_eq!(v["fiducial"]["two_block"]["right"].as_str(), Some("yellow"));
+        assert_eq!(v["fiducial"]["right"].as_str(), Some("yellow"));
         assert_eq!(v["cameras"][0]["w"].as_integer(), Some(1));
         assert!(
             out.contains("# Bujold") && out.contains("# why"),

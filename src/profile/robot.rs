@@ -95,7 +95,7 @@ mod tests {
             .try_into()
             .unwrap();
         let (path, message) = bad.tuning::<Gains>().unwrap_err();
-        assert_eq!(path, "robot");
+        assert_eq!(path, "robot.gian", "the path names the field, so its line is found");
         assert!(message.contains("gian"), "{message}");
     }
 }
