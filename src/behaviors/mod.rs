@@ -9,6 +9,11 @@
 //! [`Behavior`](crate::schemas::Behavior), so the reactive loop, the threaded runtime and
 //! the simulator all drive it the same way. `examples/compose.rs` composes a user's robot
 //! from its own schemas and the crate's.
+//!
+//! Which robot a profile builds is its `[robot] kind`, looked up in a [`Catalog`]: each
+//! [`RobotKind`] brings its typed tuning, its memory and its leaves ([`bujold::Bujold`],
+//! [`raposa::Raposa`], [`axel::Axel`] are the shipped ones), and a user's crate registers
+//! its own beside them (`examples/plugin_robot.rs`).
 
 pub mod agent;
 pub mod axel;
