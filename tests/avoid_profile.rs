@@ -36,7 +36,7 @@ fn bujold_avoid_is_bujold_but_for_the_listed_keys() {
     let mut plain = read_table("profiles/bujold.toml");
     let mut avoid = read_table("profiles/bujold-avoid.toml");
     // The header's list, key by key.
-    for key in ["name", "description", "behavior.approach"] {
+    for key in ["name", "description", "robot.approach"] {
         assert!(take(&mut plain, key).is_some(), "bujold.toml lacks {key}");
         assert!(take(&mut avoid, key).is_some(), "bujold-avoid.toml lacks {key}");
     }
