@@ -4,7 +4,7 @@
 //! camera with at least 5 visible marks is labelled and posed right while one with fewer
 //! fails with a typed error and never gives a pose, with or without a false mark beside
 //! the module (which may also cost a 5-mark labelling, but never makes a wrong one).
-//! `cargo test --release --test axel_pose_campaign -- --nocapture` prints the tables.
+//! `cargo test --release --test cli axel_pose_campaign:: -- --nocapture` prints the tables.
 
 use marsupial::cli::pose_trials::{self, PoseCampaign, PoseRun, is_wrong};
 use std::path::Path;

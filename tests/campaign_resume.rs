@@ -13,7 +13,7 @@
 //! the resume's own truncation, while `summary.json` is written, or after the end. Each
 //! invocation draws `--jobs 1` or `--jobs 2`. `cargo test` runs 5 kills per test; the
 //! 20-kill campaigns of the figure are `#[ignore]`d and run by
-//! `scripts/resume-kills` (or `cargo test --test campaign_resume -- --ignored`).
+//! `scripts/resume-kills` (or `cargo test --test cli campaign_resume:: -- --ignored`).
 //!
 //! The reader `--resume` uses is also tested on hand-made files: torn tails of every kind
 //! are dropped, and anything else is an error naming its line.

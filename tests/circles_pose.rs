@@ -7,7 +7,7 @@
 //!   detection works, at several angles; detect → correspond → pose against the
 //!   simulator's ground truth. Stereo must beat the paper (2.56 cm / 2.5° at 1 m,
 //!   4.12 cm / 4.58° at 2 m); mono is reported. `cargo test --release --features sim
-//!   --test circles_pose -- --nocapture` prints the table.
+//!   --test sim circles_pose:: -- --nocapture` prints the table.
 //!
 //! Errors are of the module's pose in the rover frame: position = distance between the
 //! estimated and true module origin (x, y on the ground), heading = the module's yaw, and

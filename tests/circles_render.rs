@@ -239,7 +239,7 @@ fn a_shadow_across_the_face_defeats_fixed_levels_but_not_the_adaptive_threshold(
 /// finds in even light. Nearer than 1.4 m the shaded rims are pitted with pinholes (the
 /// camera's gamma stretches dark noise), and without filling them
 /// ([`CircleParams::max_pinhole_px`] 0) the Euler filter loses marks there: the README's
-/// figures (`cargo test --release --test circles_render under_the_shadow -- --nocapture`).
+/// figures (`cargo test --release --test sim circles_render::under_the_shadow -- --nocapture`).
 #[test]
 fn under_the_shadow_every_mark_is_found_once_pinholes_are_filled() {
     let p = common::shipped_profile("axel");

@@ -3,7 +3,7 @@
 //! white-balance switch of the Bujold campaigns) from the starts a docking sees, under lab
 //! and dusk light; and which pairs of them are opposite in SCT space.
 //!
-//! `cargo test --release --test paint_sct -- --nocapture` prints the table the README
+//! `cargo test --release --test sim paint_sct:: -- --nocapture` prints the table the README
 //! quotes.
 
 use crate::common;
