@@ -40,9 +40,9 @@ use marsupial::profile::{FiducialKind, Profile};
 use marsupial::schemas::{Behavior, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Outcome, Step};
 use marsupial::sim::SimError;
 use marsupial::sim::kinds::SimKinds;
-use marsupial::sim::scene::{Material, Prim, Shape, Tag, albedo, boxed};
+use marsupial::sim::scene::{Material, Tag, albedo, boxed, face_rect};
 use marsupial::sim::world::DockCanvas;
-use nalgebra::{Point3, Vector3};
+use nalgebra::Point3;
 use red_beacon::RedBeacon;
 use serde::{Deserialize, Serialize};
 
@@ -93,16 +93,7 @@ fn paint_beacon_dock(c: &mut DockCanvas<'_>) -> Result<(), SimError> {
     body.remove(0);
     c.prims.extend(body);
     let front = |y0: f64, y1: f64, z0: f64, z1: f64, material: Material| {
-        Prim::new(
-            Shape::Rect {
-                centre: Point3::new(0.0, (y0 + y1) / 2.0, (z0 + z1) / 2.0),
-                u: Vector3::y(),
-                v: Vector3::z(),
-                half: [(y1 - y0) / 2.0, (z1 - z0) / 2.0],
-            },
-            material,
-            Tag::Body,
-        )
+        face_rect(0.0, [y0, y1], [z0, z1], material, Tag::Body)
     };
     // The front is built of pieces round the opening and the panel: the renderer orders
     // primitives by their centres' distance, so a panel laid over a wider face could be
@@ -124,22 +115,13 @@ fn paint_beacon_dock(c: &mut DockCanvas<'_>) -> Result<(), SimError> {
         c.prims.push(front(y0, y1, za, zb, grey.clone()));
     }
     // The dark pouch behind the opening.
-    let mut pouch = front(
-        -half,
-        half,
-        0.0,
-        opening_top,
-        Material::Solid(albedo([20, 20, 22], 1.0)),
-    );
-    if let Shape::Rect { centre, .. } = &mut pouch.shape {
-        centre.x = -0.01;
-    }
-    c.prims.push(pouch);
+    let dark = Material::Solid(albedo([20, 20, 22], 1.0));
+    c.prims
+        .push(face_rect(-0.01, [-half, half], [0.0, opening_top], dark, Tag::Body));
     // The beacon, in its gap in the face.
     c.target_prims.push(c.prims.len());
-    let mut panel = front(-pw, pw, z0, z1, Material::Solid(albedo([220, 30, 25], 1.0)));
-    panel.tag = Tag::Target;
-    c.prims.push(panel);
+    let red = Material::Solid(albedo([220, 30, 25], 1.0));
+    c.prims.push(face_rect(0.0, [-pw, pw], [z0, z1], red, Tag::Target));
     Ok(())
 }
 

@@ -308,6 +308,19 @@ pub fn parse_table<T: DeserializeOwned>(table: &toml::Table) -> Result<T, (Strin
     })
 }
 
+/// Takes the `kind` string out of a kind-tagged table (`[fiducial]`, `[robot]`); `what`
+/// says what it names, for the error.
+pub(crate) fn take_kind<E: serde::de::Error>(table: &mut toml::Table, what: &str) -> Result<String, E> {
+    match table.remove("kind") {
+        Some(toml::Value::String(k)) => Ok(k),
+        Some(other) => Err(E::custom(format!(
+            "expected `kind` to be a string naming {what}, got {}",
+            other.type_str()
+        ))),
+        None => Err(E::custom(format!("missing field `kind`: {what}"))),
+    }
+}
+
 /// The fiducial kinds a profile may name, by name (see the module docs).
 #[derive(Clone)]
 pub struct FiducialKinds {
@@ -482,20 +495,10 @@ impl Serialize for FiducialSpec {
 impl<'de> Deserialize<'de> for FiducialSpec {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let mut params = toml::Table::deserialize(d)?;
-        let kind = match params.remove("kind") {
-            Some(toml::Value::String(k)) => k,
-            Some(other) => {
-                return Err(serde::de::Error::custom(format!(
-                    "expected `kind` to be a string naming the fiducial's kind, got {}",
-                    other.type_str()
-                )));
-            }
-            None => {
-                return Err(serde::de::Error::custom(
-                    "missing field `kind`: the fiducial's kind (two_block, pyramid, circles, markers, or one a crate registers)",
-                ));
-            }
-        };
+        let kind = take_kind(
+            &mut params,
+            "the fiducial's kind (two_block, pyramid, circles, markers, or one a crate registers)",
+        )?;
         Ok(Self {
             kind,
             params,

@@ -13,7 +13,7 @@
 //! or foreign field is an error naming its line (`behaviors::catalog`). A profile without
 //! `[robot]` describes a platform that runs no behavior (perception only).
 
-use super::fiducial::parse_table;
+use super::fiducial::{parse_table, take_kind};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
@@ -56,16 +56,7 @@ impl Serialize for RobotSpec {
 impl<'de> Deserialize<'de> for RobotSpec {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let mut tuning = toml::Table::deserialize(d)?;
-        let kind = match tuning.remove("kind") {
-            Some(toml::Value::String(k)) => k,
-            Some(other) => {
-                return Err(serde::de::Error::custom(format!(
-                    "expected `kind` to be a string naming a robot kind, got {}",
-                    other.type_str()
-                )));
-            }
-            None => return Err(serde::de::Error::custom("missing field `kind`: the robot kind")),
-        };
+        let kind = take_kind(&mut tuning, "the robot kind (one a catalog registers)")?;
         Ok(Self { kind, tuning })
     }
 }

@@ -282,6 +282,24 @@ impl Corners {
     }
 }
 
+/// A rectangle in the plane x = `x` facing +x (a dock's face, as the dock frame has it),
+/// spanning `y` = [y0, y1] across and `z` = [z0, z1] up: helper for faces built in pieces
+/// round an opening or a fiducial (the renderer orders primitives by their centres'
+/// distance, so a rectangle laid over a wider one could be drawn behind it).
+pub fn face_rect(x: f64, y: [f64; 2], z: [f64; 2], material: Material, tag: Tag) -> Prim {
+    let ([y0, y1], [z0, z1]) = (y, z);
+    Prim::new(
+        Shape::Rect {
+            centre: Point3::new(x, (y0 + y1) / 2.0, (z0 + z1) / 2.0),
+            u: Vector3::y(),
+            v: Vector3::z(),
+            half: [(y1 - y0) / 2.0, (z1 - z0) / 2.0],
+        },
+        material,
+        tag,
+    )
+}
+
 /// Axis-aligned box as five visible faces (no bottom): helper for bodies and clutter.
 pub fn boxed(min: Point3<f64>, max: Point3<f64>, material: Material, tag: Tag) -> Vec<Prim> {
     let c = Point3::from((min.coords + max.coords) / 2.0);

@@ -6,7 +6,7 @@
 use super::SimError;
 use super::dock::Cone;
 use super::obstacles::{Footprint, Obstacles};
-use super::scene::{CircleMark, Material, Prim, Scene, Shape, Tag, albedo, boxed};
+use super::scene::{CircleMark, Material, Prim, Scene, Shape, Tag, albedo, boxed, face_rect};
 use crate::perception::RgbImage;
 use crate::profile::{CirclePlacement, CirclesSpec, FiducialKind, NamedColor, Profile, PyramidSpec, TwoBlockSpec};
 use nalgebra::{Point3, Vector3};
@@ -437,18 +437,8 @@ fn paint_two_block(c: &mut DockCanvas<'_>) -> Result<(), SimError> {
     );
     body.remove(0); // the rear face is rebuilt around the opening
     prims.extend(body);
-    let rear = |y0: f64, y1: f64, z0: f64, z1: f64| {
-        Prim::new(
-            Shape::Rect {
-                centre: Point3::new(0.0, (y0 + y1) / 2.0, (z0 + z1) / 2.0),
-                u: y_axis(),
-                v: z_axis(),
-                half: [(y1 - y0) / 2.0, (z1 - z0) / 2.0],
-            },
-            Material::Solid(body_grey),
-            Tag::Body,
-        )
-    };
+    let rear =
+        |y0: f64, y1: f64, z0: f64, z1: f64| face_rect(0.0, [y0, y1], [z0, z1], Material::Solid(body_grey), Tag::Body);
     prims.push(rear(-w2, -entrance_half, 0.05, h));
     prims.push(rear(entrance_half, w2, 0.05, h));
     prims.push(rear(-entrance_half, entrance_half, top, h));
@@ -666,13 +656,10 @@ fn build_central_module(
     let (lo, hi) = (axis - e, axis + e);
     for (y0, y1, z0, z1) in [(-w2, -e, lo, hi), (e, w2, lo, hi), (-w2, w2, 0.0, lo)] {
         if y1 - y0 > 1e-6 && z1 - z0 > 1e-6 {
-            prims.push(Prim::new(
-                Shape::Rect {
-                    centre: Point3::new(0.0, (y0 + y1) / 2.0, (z0 + z1) / 2.0),
-                    u: y_axis(),
-                    v: z_axis(),
-                    half: [(y1 - y0) / 2.0, (z1 - z0) / 2.0],
-                },
+            prims.push(face_rect(
+                0.0,
+                [y0, y1],
+                [z0, z1],
                 Material::Solid(body_grey),
                 Tag::Body,
             ));
