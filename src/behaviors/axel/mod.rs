@@ -23,6 +23,7 @@ pub mod acquire;
 pub mod align;
 pub mod approach;
 pub mod cycle;
+pub mod geometry;
 pub mod mate;
 pub mod memory;
 pub mod reel;
