@@ -5,18 +5,42 @@ use crate::common;
 
 use marsupial::behaviors::bujold::memory::{Memory, RepositionPlan};
 use marsupial::behaviors::bujold::params::*;
-use marsupial::behaviors::bujold::{approach, back_in, decide, departure, move_away, reposition, search};
+use marsupial::behaviors::bujold::{approach, back_in, decide, departure};
 use marsupial::behaviors::common::docking::{DockSwitch, Imprint, ImprintEnd};
+use marsupial::behaviors::registry::Registry;
 use marsupial::geometry::Pose2;
 use marsupial::perception::RgbImage;
 use marsupial::perception::two_block_pose::FiducialView;
 use marsupial::schemas::{
-    Behavior, CameraInput, DriveCommand, FailureReason, Inputs, OdometryReading, Outcome, Posture, SearchRotation,
-    Stamped, Status, Step,
+    Behavior, CameraInput, DriveCommand, FailureReason, Inputs, OdometryReading, Outcome, Posture, Stamped, Status,
+    Step,
 };
 
 fn memory() -> Memory {
     Memory::from_profile(&common::shipped_profile("bujold")).unwrap()
+}
+
+/// The shipped profile's node `name` (a leaf or a whole phase), as the robot builds it.
+fn node(name: &str) -> Box<dyn Behavior<Memory>> {
+    let profile = common::shipped_profile("bujold");
+    let mut registry = Registry::new();
+    marsupial::behaviors::bujold::register(&mut registry);
+    registry.build_node(&profile, name, &memory_of(&profile)).unwrap()
+}
+
+fn memory_of(profile: &marsupial::profile::Profile) -> Memory {
+    Memory::from_profile(profile).unwrap()
+}
+
+/// The shipped search, turning at 0.4 rad/s and giving up after 40 s.
+fn search() -> Box<dyn Behavior<Memory>> {
+    let mut profile = common::shipped_profile("bujold");
+    profile.behavior.search_timeout_s = 40.0;
+    let mut m = memory_of(&profile);
+    m.approach.steering.turn_rate = 0.4;
+    let mut registry = Registry::new();
+    marsupial::behaviors::bujold::register(&mut registry);
+    registry.build_node(&profile, "search", &m).unwrap()
 }
 
 /// A view `d` m out, `alpha_deg` off the axis, with `px` pixels in both blocks.
@@ -68,19 +92,14 @@ fn at(x: f64) -> Pose2 {
 #[test]
 fn search_turns_toward_the_last_side_acquires_and_times_out_by_what_it_saw() {
     let mut mem = memory();
-    let rot = SearchRotation {
-        rate: 0.4,
-        first_sweep: 0.0,
-        doubling: false,
-    };
-    let mut s = search::Search::new("search", SearchParams::default(), rot, 40.0);
-    enter(&mut s, &mut mem, 0.0, at(1.0));
-    mem.last_side = -1.0;
-    let step = tick(&mut s, &mut mem, 0.1, at(1.0), None);
+    let mut s = search();
+    mem.last_side = -1.0; // the side is chosen as the search is entered
+    enter(&mut *s, &mut mem, 0.0, at(1.0));
+    let step = tick(&mut *s, &mut mem, 0.1, at(1.0), None);
     assert_eq!(step.status, Status::Running);
     assert_eq!(step.output.drive, DriveCommand::Turn { omega: -0.4 });
     // Acquisition hands over with the approach motor schema's command this very tick.
-    let step = tick(&mut s, &mut mem, 0.2, at(1.0), Some(view(1.0, 0.0, 800)));
+    let step = tick(&mut *s, &mut mem, 0.2, at(1.0), Some(view(1.0, 0.0, 800)));
     assert_eq!(step.status, Status::Event("acquired"));
     assert!(
         matches!(step.output.drive, DriveCommand::Straight { v } if v != 0.0),
@@ -88,27 +107,22 @@ fn search_turns_toward_the_last_side_acquires_and_times_out_by_what_it_saw() {
     );
     // Never seen: the timeout says so; seen before: the target was lost.
     let mut fresh = memory();
-    let mut s = search::Search::new("search", SearchParams::default(), rot, 40.0);
-    enter(&mut s, &mut fresh, 0.0, at(1.0));
-    assert_eq!(tick(&mut s, &mut fresh, 39.9, at(1.0), None).status, Status::Running);
-    let end = tick(&mut s, &mut fresh, 40.1, at(1.0), None).status;
+    let mut s = search();
+    enter(&mut *s, &mut fresh, 0.0, at(1.0));
+    assert_eq!(tick(&mut *s, &mut fresh, 39.9, at(1.0), None).status, Status::Running);
+    let end = tick(&mut *s, &mut fresh, 40.1, at(1.0), None).status;
     assert_eq!(end, Status::Done(Outcome::Failed(FailureReason::TargetNeverDetected)));
-    let mut s = search::Search::new("search", SearchParams::default(), rot, 40.0);
-    enter(&mut s, &mut mem, 50.0, at(1.0));
-    let end = tick(&mut s, &mut mem, 90.1, at(1.0), None).status;
+    let mut s = search();
+    enter(&mut *s, &mut mem, 50.0, at(1.0));
+    let end = tick(&mut *s, &mut mem, 90.1, at(1.0), None).status;
     assert_eq!(end, Status::Done(Outcome::Failed(FailureReason::TargetLost)));
 }
 
 #[test]
 fn search_is_jammed_when_turning_does_not_change_the_view() {
     let mut mem = memory();
-    let rot = SearchRotation {
-        rate: 0.4,
-        first_sweep: 0.0,
-        doubling: false,
-    };
-    let mut s = search::Search::new("search", SearchParams::default(), rot, 40.0);
-    enter(&mut s, &mut mem, 0.0, at(1.0));
+    let mut s = search();
+    enter(&mut *s, &mut mem, 0.0, at(1.0));
     let still = RgbImage::new(256, 240);
     let mut events = Vec::new();
     for k in 1..=30 {
@@ -223,33 +237,38 @@ fn reposition_turns_drives_and_turns_to_the_staging_pose() {
         clear_first: false,
     });
     mem.alpha_window.push(0.3);
-    let mut r = reposition::Reposition::new("reposition", RepositionParams::default(), reposition::PlanFrom::Memory);
+    let mut r = node("reposition");
+    let r = &mut *r;
     let start = Pose2::new(0.75, 0.4, 0.0);
-    enter(&mut r, &mut mem, 0.0, start);
+    enter(r, &mut mem, 0.0, start);
     // Facing along x with the target to the right: turn first.
-    let s = tick(&mut r, &mut mem, 0.1, start, None);
+    let s = tick(r, &mut mem, 0.1, start, None);
     assert!(
         matches!(s.output.drive, DriveCommand::Turn { omega } if omega < 0.0),
         "{s:?}"
     );
     // Facing it: the stage changes, then it drives.
     let facing = Pose2::new(0.75, 0.4, -std::f64::consts::FRAC_PI_2);
-    assert_eq!(tick(&mut r, &mut mem, 0.2, facing, None).status, Status::Running);
-    let s = tick(&mut r, &mut mem, 0.3, facing, None);
+    assert_eq!(tick(r, &mut mem, 0.2, facing, None).status, Status::Running);
+    let s = tick(r, &mut mem, 0.3, facing, None);
     assert!(
         matches!(s.output.drive, DriveCommand::Straight { v } if v > 0.0),
         "{s:?}"
     );
     // Arrived, facing the wrong way: turn to the staging heading, then done.
     let there = Pose2::new(0.75, 0.0, -std::f64::consts::FRAC_PI_2);
-    tick(&mut r, &mut mem, 0.4, there, None);
-    let s = tick(&mut r, &mut mem, 0.5, there, None);
+    tick(r, &mut mem, 0.4, there, None);
+    let s = tick(r, &mut mem, 0.5, there, None);
     assert!(
         matches!(s.output.drive, DriveCommand::Turn { omega } if omega > 0.0),
         "{s:?}"
     );
-    let s = tick(&mut r, &mut mem, 0.6, target, None);
-    assert_eq!(s.status, Status::Event("aligned"));
+    let s = tick(r, &mut mem, 0.6, target, None);
+    assert_eq!(
+        s.status,
+        Status::Event("aligned"),
+        "the sequence hands `aligned` to the close dock"
+    );
     assert!(!mem.alpha_window.is_full() && mem.alpha_window.median().is_none());
 }
 
@@ -266,10 +285,10 @@ fn move_away_retries_and_give_up_fails_with_the_reason_left_in_memory() {
         ),
     ] {
         mem.failing = failing;
-        let mut m = move_away::MoveAway::new("away", MoveAwayParams::default(), give_up);
-        enter(&mut m, &mut mem, 0.0, at(0.4));
-        assert_eq!(tick(&mut m, &mut mem, 0.1, at(0.5), None).status, Status::Running);
-        assert_eq!(tick(&mut m, &mut mem, 6.0, at(0.76), None).status, expected);
+        let mut m = node(if give_up { "give_up" } else { "move_away" });
+        enter(&mut *m, &mut mem, 0.0, at(0.4));
+        assert_eq!(tick(&mut *m, &mut mem, 0.1, at(0.5), None).status, Status::Running);
+        assert_eq!(tick(&mut *m, &mut mem, 6.0, at(0.76), None).status, expected);
     }
 }
 

@@ -8,14 +8,12 @@ use crate::common;
 use marsupial::arbiter::Selector;
 use marsupial::behaviors::SharedMemory;
 use marsupial::behaviors::common::docking::{DockSwitch, Imprint, ImprintEnd};
-use marsupial::behaviors::raposa::back_away::{BackAway, Distance};
-use marsupial::behaviors::raposa::manoeuvre::{Manoeuvre, Part};
 use marsupial::behaviors::raposa::memory::Memory;
 use marsupial::behaviors::raposa::params::*;
 use marsupial::behaviors::raposa::region2::{plan, robot_in_ball_frame};
 use marsupial::behaviors::raposa::selector::SevenState;
-use marsupial::behaviors::raposa::{ServoState, align, departure, final_approach, rotate7, search, servo};
-use marsupial::behaviors::registry::SelectorArgs;
+use marsupial::behaviors::raposa::{ServoState, align, departure, final_approach, rotate7, servo};
+use marsupial::behaviors::registry::{Registry, SelectorArgs};
 use marsupial::geometry::{Pose2, Twist};
 use marsupial::perception::{BlueRegion, Ellipse, PyramidDetection, PyramidPercept, PyramidView};
 use marsupial::profile::tree::NodeSpec;
@@ -31,6 +29,24 @@ fn profile() -> Profile {
 
 fn memory() -> Memory {
     Memory::from_profile(&profile()).unwrap()
+}
+
+/// The shipped profile's leaf `name` as the robot builds it, with `params` replaced and
+/// a 60 s search timeout.
+fn node(name: &str, params: &[(&str, toml::Value)]) -> Box<dyn Behavior<Memory>> {
+    let mut p = profile();
+    p.behavior.search_timeout_s = 60.0;
+    let tree = p.behavior.tree.as_mut().unwrap();
+    if let Some(NodeSpec::Leaf { params: table, .. }) = tree.nodes.get_mut(name) {
+        for (k, v) in params {
+            table.insert((*k).into(), v.clone());
+        }
+    }
+    let mut registry = Registry::new();
+    marsupial::behaviors::raposa::register(&mut registry);
+    registry
+        .build_node(&p, name, &Memory::from_profile(&p).unwrap())
+        .unwrap()
 }
 
 /// What the pyramid schema would report: an ellipse `d` m away (with a pair when
@@ -177,25 +193,27 @@ fn servo_states_steer_on_what_they_see() {
 #[test]
 fn search_waits_its_grace_frames_turns_away_from_the_last_turn_and_times_out() {
     let mut mem = memory();
-    let mut s = search::Search::new("search", SearchParams::default(), 60.0);
+    let mut s = node("search", &[]);
+    let s = &mut *s;
     mem.last_turn = 1.0;
+    enter(s, &mut mem, 0.0, at(1.0), nothing());
     for k in 1..=3 {
-        let step = tick(&mut s, &mut mem, k as f64 * 0.1, at(1.0), nothing());
+        let step = tick(s, &mut mem, k as f64 * 0.1, at(1.0), nothing());
         assert_eq!(step.output.drive, DriveCommand::Stop, "grace frame {k}");
     }
-    let step = tick(&mut s, &mut mem, 0.4, at(1.0), nothing());
+    let step = tick(s, &mut mem, 0.4, at(1.0), nothing());
     assert!(turn_rate(&step) < 0.0, "away from the last (left) turn: {step:?}");
     assert_eq!(mem.search_start, Some(0.4));
-    assert_eq!(tick(&mut s, &mut mem, 60.4, at(1.0), nothing()).status, Status::Running);
+    assert_eq!(tick(s, &mut mem, 60.4, at(1.0), nothing()).status, Status::Running);
     assert_eq!(
-        tick(&mut s, &mut mem, 60.5, at(1.0), nothing()).status,
+        tick(s, &mut mem, 60.5, at(1.0), nothing()).status,
         Status::Done(Outcome::Failed(FailureReason::TargetLost))
     );
     // Five grace frames: still standing on the fourth.
     let mut mem = memory();
-    let mut s = search::Search::new("search", SearchParams { grace_frames: 5 }, 60.0);
+    let mut s = node("search", &[("grace_frames", 5.into())]);
     for k in 1..=4 {
-        tick(&mut s, &mut mem, k as f64 * 0.1, at(1.0), nothing());
+        tick(&mut *s, &mut mem, k as f64 * 0.1, at(1.0), nothing());
     }
     assert_eq!(mem.unseen, 4);
     assert_eq!(mem.search_start, None);
@@ -308,31 +326,34 @@ fn the_blind_manoeuvre_turns_travels_and_faces_the_ball_by_odometry() {
     let pl = plan(Pose2::new(1.5, 0.8, 0.0), 0.9, 0.4);
     mem.plan = Some(pl);
     mem.map = Pose2::default();
-    let mut rot = Manoeuvre::new("rotate_odo", Part::RotateOdo);
-    enter(&mut rot, &mut mem, 0.0, Pose2::new(1.5, 0.8, 0.0), nothing());
+    let mut rot = node("rotate_odo", &[]);
+    let rot = &mut *rot;
+    enter(rot, &mut mem, 0.0, Pose2::new(1.5, 0.8, 0.0), nothing());
     assert!(mem.blind, "entering the blind part tells the perception");
-    let step = tick(&mut rot, &mut mem, 0.1, Pose2::new(1.5, 0.8, 0.0), nothing());
+    let step = tick(rot, &mut mem, 0.1, Pose2::new(1.5, 0.8, 0.0), nothing());
     assert_eq!(step.status, Status::Running);
     assert_eq!(turn_rate(&step).signum(), pl.rotation.signum());
     let facing = Pose2::new(1.5, 0.8, pl.travel_heading);
     assert_eq!(
-        tick(&mut rot, &mut mem, 0.2, facing, nothing()).status,
+        tick(rot, &mut mem, 0.2, facing, nothing()).status,
         Status::Event("rotated")
     );
-    let mut travel = Manoeuvre::new("travel", Part::Travel);
-    enter(&mut travel, &mut mem, 0.2, facing, nothing());
-    let step = tick(&mut travel, &mut mem, 0.3, facing, nothing());
+    let mut travel = node("travel", &[]);
+    let travel = &mut *travel;
+    enter(travel, &mut mem, 0.2, facing, nothing());
+    let step = tick(travel, &mut mem, 0.3, facing, nothing());
     assert!(twist(&step).v != 0.0, "{step:?}");
     let arrived = Pose2::new(pl.target.0, pl.target.1, pl.travel_heading);
     assert_eq!(
-        tick(&mut travel, &mut mem, 0.4, arrived, nothing()).status,
+        tick(travel, &mut mem, 0.4, arrived, nothing()).status,
         Status::Event("arrived")
     );
     // φ: the ball is at the frame's origin; the camera looks back, so the body faces +x.
-    let mut phi = Manoeuvre::new("rotate_phi", Part::RotatePhi);
-    enter(&mut phi, &mut mem, 0.4, arrived, nothing());
-    assert!(turn_rate(&tick(&mut phi, &mut mem, 0.5, arrived, nothing())) != 0.0);
-    let done = tick(&mut phi, &mut mem, 0.6, Pose2::new(pl.target.0, 0.0, 0.01), nothing());
+    let mut phi = node("rotate_phi", &[]);
+    let phi = &mut *phi;
+    enter(phi, &mut mem, 0.4, arrived, nothing());
+    assert!(turn_rate(&tick(phi, &mut mem, 0.5, arrived, nothing())) != 0.0);
+    let done = tick(phi, &mut mem, 0.6, Pose2::new(pl.target.0, 0.0, 0.01), nothing());
     assert_eq!(done.status, Status::Event("facing"));
     assert_eq!(done.output.drive, DriveCommand::Stop);
 }
@@ -342,23 +363,25 @@ fn look_clears_blind_settles_then_searches_away_from_the_last_turn() {
     let mut mem = memory();
     mem.blind = true;
     mem.last_turn = 1.0;
-    let mut look = search::Look::new("look", LookParams::default(), 60.0);
-    enter(&mut look, &mut mem, 10.0, at(1.0), nothing());
+    let mut look = node("look", &[]);
+    let look = &mut *look;
+    enter(look, &mut mem, 10.0, at(1.0), nothing());
     assert!(!mem.blind);
     mem.last_turn = -1.0; // later turns do not change the first direction
     assert_eq!(
-        tick(&mut look, &mut mem, 10.4, at(1.0), nothing()).output.drive,
+        tick(look, &mut mem, 10.4, at(1.0), nothing()).output.drive,
         DriveCommand::Stop
     );
-    assert!(turn_rate(&tick(&mut look, &mut mem, 10.6, at(1.0), nothing())) < 0.0);
+    assert!(turn_rate(&tick(look, &mut mem, 10.6, at(1.0), nothing())) < 0.0);
     assert_eq!(
-        tick(&mut look, &mut mem, 70.1, at(1.0), nothing()).status,
+        tick(look, &mut mem, 70.1, at(1.0), nothing()).status,
         Status::Done(Outcome::Failed(FailureReason::TargetLost))
     );
-    let mut slow = search::Look::new("look", LookParams { settle_s: 2.0 }, 60.0);
-    enter(&mut slow, &mut mem, 0.0, at(1.0), nothing());
+    let mut slow = node("look", &[("settle_s", 2.0.into())]);
+    let slow = &mut *slow;
+    enter(slow, &mut mem, 0.0, at(1.0), nothing());
     assert_eq!(
-        tick(&mut slow, &mut mem, 1.9, at(1.0), nothing()).output.drive,
+        tick(slow, &mut mem, 1.9, at(1.0), nothing()).output.drive,
         DriveCommand::Stop
     );
 }
@@ -403,35 +426,35 @@ fn back_aways_leave_by_their_distance_then_clear() {
     let g = marsupial::behaviors::catalog::tuning::<marsupial::behaviors::raposa::Raposa>(&profile())
         .unwrap()
         .seven_state;
-    let mut retreat = BackAway::new("retreat", Distance::Retreat(RetreatParams::default()));
-    enter(&mut retreat, &mut mem, 0.0, at(0.5), nothing());
-    let step = tick(&mut retreat, &mut mem, 0.1, at(0.6), nothing());
+    let mut retreat = node("retreat", &[]);
+    let retreat = &mut *retreat;
+    enter(retreat, &mut mem, 0.0, at(0.5), nothing());
+    let step = tick(retreat, &mut mem, 0.1, at(0.6), nothing());
     assert_eq!(twist(&step).v, g.far_speed_mps, "body forward, away from the pyramid");
     assert_eq!(
-        tick(&mut retreat, &mut mem, 0.2, at(0.89), nothing()).status,
+        tick(retreat, &mut mem, 0.2, at(0.89), nothing()).status,
         Status::Running
     );
     assert_eq!(
-        tick(&mut retreat, &mut mem, 0.3, at(0.91), nothing()).status,
+        tick(retreat, &mut mem, 0.3, at(0.91), nothing()).status,
         Status::Event("cleared")
     );
     // The dead zone: the socket is 0.43 − 0.1 = 0.33 m from the ball; out to 0.6 m.
-    let mut dz = BackAway::new("leave_dead_zone", Distance::DeadZone(LeaveDeadZoneParams::default()));
+    let mut dz = node("leave_dead_zone", &[]);
     let close = seen(0.43, Some(60.0), [0.0, 0.0], true);
-    enter(&mut dz, &mut mem, 0.0, at(0.5), close);
-    assert_eq!(tick(&mut dz, &mut mem, 0.1, at(0.76), close).status, Status::Running);
+    enter(&mut *dz, &mut mem, 0.0, at(0.5), close);
+    assert_eq!(tick(&mut *dz, &mut mem, 0.1, at(0.76), close).status, Status::Running);
     assert_eq!(
-        tick(&mut dz, &mut mem, 0.2, at(0.78), close).status,
+        tick(&mut *dz, &mut mem, 0.2, at(0.78), close).status,
         Status::Event("cleared")
     );
     // Already past the exit distance: the shortest back-away still runs.
     let out = seen(1.0, Some(60.0), [0.0, 0.0], true);
-    let p = LeaveDeadZoneParams { min_distance_m: 0.2 };
-    let mut dz = BackAway::new("leave_dead_zone", Distance::DeadZone(p));
-    enter(&mut dz, &mut mem, 0.0, at(0.5), out);
-    assert_eq!(tick(&mut dz, &mut mem, 0.1, at(0.69), out).status, Status::Running);
+    let mut dz = node("leave_dead_zone", &[("min_distance_m", 0.2.into())]);
+    enter(&mut *dz, &mut mem, 0.0, at(0.5), out);
+    assert_eq!(tick(&mut *dz, &mut mem, 0.1, at(0.69), out).status, Status::Running);
     assert_eq!(
-        tick(&mut dz, &mut mem, 0.2, at(0.71), out).status,
+        tick(&mut *dz, &mut mem, 0.2, at(0.71), out).status,
         Status::Event("cleared")
     );
 }

@@ -125,7 +125,10 @@ fn a_child_that_does_not_exist_and_a_node_outside_the_tree_are_named() {
 
 #[test]
 fn a_leaf_with_a_sequencers_field_is_refused_at_its_line() {
-    let (src, line) = edited("schema = \"bujold.unjam\"", "schema = \"bujold.unjam\"\nstates = []");
+    let (src, line) = edited(
+        "schema = \"bujold.unjam_turn\"",
+        "schema = \"bujold.unjam_turn\"\nstates = []",
+    );
     let e = load_error(&src);
     let (_, at, msg) = only_problem(&e);
     assert!(msg.contains("unknown field `states`"), "{msg}");

@@ -48,6 +48,14 @@ pub enum Next {
 pub trait Selector<M: ?Sized = ()>: Send {
     /// Returns the state to run this tick, or `None` to keep the current one.
     fn select(&mut self, mem: &mut M, inputs: &Inputs<'_>, current: usize) -> Option<usize>;
+
+    /// The state the sequence starts in when it is entered (as a state of an enclosing
+    /// sequencer, or by [`Behavior::enter`]); `None`, the default: its first. A
+    /// manoeuvre whose first leg depends on the plan (Bujold's repositioning drives out
+    /// of the gate first only when it must) picks it here, in the tick it is entered.
+    fn entry(&mut self, _mem: &mut M, _inputs: &Inputs<'_>) -> Option<usize> {
+        None
+    }
 }
 
 impl<M: ?Sized, F> Selector<M> for F
@@ -388,7 +396,13 @@ impl<M: ?Sized> Behavior<M> for Sequencer<M> {
 
     fn enter(&mut self, mem: &mut M, inputs: &Inputs<'_>) {
         self.reset();
-        self.enter(0, mem, inputs, "started");
+        let first = self
+            .selector
+            .as_mut()
+            .and_then(|s| s.entry(mem, inputs))
+            .filter(|&i| i < self.states.len())
+            .unwrap_or(0);
+        self.enter(first, mem, inputs, "started");
     }
 
     fn explain(&self, out: &mut Vec<super::NodeTrace>) {

@@ -90,6 +90,13 @@ impl LeafArgs<'_> {
             .map_err(|e: toml::de::Error| format!("params: {}", e.message().trim()))
     }
 
+    /// The node's name as a phase for [`Feedback`](crate::schemas::Feedback): interned,
+    /// one copy per distinct name in the process, so a leaf shared by several phases
+    /// (the legs of a manoeuvre) reports the node it runs as.
+    pub fn phase(&self) -> &'static str {
+        intern(self.node)
+    }
+
     /// Refuses params for a schema that takes none.
     ///
     /// # Errors
@@ -239,6 +246,30 @@ impl<M: 'static> Registry<M> {
         }
     }
 
+    /// Builds the node `name` of the profile's `[behavior.tree]` and everything under
+    /// it, as [`Registry::build`] builds the root: one phase of a shipped robot, with the
+    /// profile's own params, to drive on its own (tests, tools).
+    ///
+    /// # Errors
+    /// As [`Registry::build`].
+    pub fn build_node(&self, profile: &Profile, name: &str, memory: &M) -> Result<Box<dyn Behavior<M>>, ConfigError> {
+        let mut problems = Vec::new();
+        let built = match &profile.behavior.tree {
+            Some(tree) => self.node(tree, name, profile, memory, &mut problems, 0),
+            None => {
+                problems.push((
+                    "behavior".into(),
+                    "this robot's behavior needs a [behavior.tree] table".into(),
+                ));
+                None
+            }
+        };
+        match built {
+            Some(b) if problems.is_empty() => Ok(b),
+            _ => Err(profile.problems(problems)),
+        }
+    }
+
     fn node(
         &self,
         tree: &TreeSpec,
@@ -376,6 +407,23 @@ impl<M: 'static> Registry<M> {
 
 /// Checks a profile's `[[sensors]]` or `[[actuators]]` (`table`) against the registered
 /// kinds: an unknown kind at `table[i].kind`, params the kind refuses at `table[i].params`.
+/// One `&'static` copy of `name` per distinct name (node names are few and built once).
+fn intern(name: &str) -> &'static str {
+    use std::collections::BTreeSet;
+    use std::sync::{Mutex, OnceLock};
+    static NAMES: OnceLock<Mutex<BTreeSet<&'static str>>> = OnceLock::new();
+    let mut names = NAMES
+        .get_or_init(|| Mutex::new(BTreeSet::new()))
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if let Some(n) = names.get(name) {
+        return n;
+    }
+    let n: &'static str = Box::leak(name.to_owned().into_boxed_str());
+    names.insert(n);
+    n
+}
+
 fn check_devices<'p>(
     table: &str,
     what: &str,

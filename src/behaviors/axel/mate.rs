@@ -1,4 +1,5 @@
-//! `axel.mate`: the mating (seed 000 §II, §IV). Committed at the look pose
+//! `axel.mate_close` and `axel.mate_reel`, the two states of the profile's `mate`
+//! sequence: the mating (seed 000 §II, §IV). Committed at the look pose
 //! ([`Memory::commit`]), the markers now too close to identify, the rover drives blind
 //! by odometry straight in until its arm's tip is `standoff_m` from the cone's mouth,
 //! reeling in to the exposed length at its end (by the reel's reading); then it puts its
@@ -17,7 +18,7 @@ use crate::kinematics::two_arc::Arc;
 use crate::schemas::{Behavior, DriveCommand, FailureReason, Inputs, Outcome, Step};
 use serde::Deserialize;
 
-/// `axel.mate`'s params.
+/// `axel.mate_close`'s params.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MateParams {
@@ -36,31 +37,31 @@ impl Default for MateParams {
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Phase {
-    Close { left: f64, last: Pose2, reel: f64 },
-    Reel { until: f64 },
-}
-
-/// See the module docs.
-pub struct Mate {
+/// `axel.mate_close`: the blind drive (see the module docs); event `closed` with the tip
+/// at the standoff, or the docking failed without a committed pose to mate from.
+pub struct Close {
     name: String,
     params: MateParams,
-    phase: Phase,
+    /// Path left to drive, m, and the odometry pose it was measured at.
+    left: f64,
+    last: Pose2,
+    reel: f64,
 }
 
-impl Mate {
+impl Close {
     /// A leaf named `name`.
     pub fn new(name: &str, params: MateParams) -> Self {
         Self {
             name: name.into(),
             params,
-            phase: Phase::Reel { until: f64::INFINITY },
+            left: 0.0,
+            last: Pose2::default(),
+            reel: 0.0,
         }
     }
 }
 
-impl Behavior<Memory> for Mate {
+impl Behavior<Memory> for Close {
     fn name(&self) -> &str {
         &self.name
     }
@@ -68,61 +69,78 @@ impl Behavior<Memory> for Mate {
     fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         let g = m.geometry;
         let Some(at) = m.commit else {
-            self.phase = Phase::Reel { until: f64::INFINITY };
             return;
         };
-        let left = (at.x - g.tether.arm - self.params.standoff_m).max(0.0);
+        self.left = (at.x - g.tether.arm - self.params.standoff_m).max(0.0);
         let arc = Arc {
             curvature: 0.0,
-            length: left,
+            length: self.left,
         };
-        self.phase = Phase::Close {
-            left,
-            last: m.odo,
-            reel: g
-                .tether
-                .reel_rate(m.reel.map(|r| r.length), &at, &arc, self.params.speed_mps),
-        };
+        self.last = m.odo;
+        self.reel = g
+            .tether
+            .reel_rate(m.reel.map(|r| r.length), &at, &arc, self.params.speed_mps);
     }
 
     fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
-        let g = m.geometry;
-        match self.phase {
-            Phase::Close { left, last, reel } => {
-                let left = left - m.odo.distance(&last);
-                if left > 0.0 {
-                    self.phase = Phase::Close {
-                        left,
-                        last: m.odo,
-                        reel,
-                    };
-                    return Some(m.drive(
-                        DriveCommand::Straight {
-                            v: self.params.speed_mps,
-                        },
-                        reel,
-                        "mate_close",
-                    ));
-                }
-                // The exposed length with the tip at the mouth, less the reel-in.
-                let mouth = Pose2::new(g.tether.arm, 0.0, std::f64::consts::PI);
-                self.phase = Phase::Reel {
-                    until: (g.tether.length_at(&mouth) - g.reel_in).max(0.0),
-                };
-                Some(m.hold("mate_close"))
-            }
-            Phase::Reel { until } => {
-                if m.commit.is_none() {
-                    // Entered without a committed pose: nothing aligned to mate.
-                    return Some(
-                        m.hold("mate")
-                            .finishing(Outcome::Failed(FailureReason::FailedToControl)),
-                    );
-                }
-                let reeled = m.reel.is_some_and(|r| r.length <= until);
-                let step = m.free_reel("mate_reel");
-                Some(if reeled { step.finishing(Outcome::Docked) } else { step })
-            }
+        if m.commit.is_none() {
+            // Entered without a committed pose: nothing aligned to mate.
+            return Some(
+                m.hold("mate")
+                    .finishing(Outcome::Failed(FailureReason::FailedToControl)),
+            );
         }
+        self.left -= m.odo.distance(&self.last);
+        if self.left <= 0.0 {
+            return Some(m.hold("mate_close").with_event("closed"));
+        }
+        self.last = m.odo;
+        let drive = DriveCommand::Straight {
+            v: self.params.speed_mps,
+        };
+        Some(m.drive(drive, self.reel, "mate_close"))
+    }
+}
+
+/// `axel.mate_reel`: wheels free, reel in until the reel's paid-out length is
+/// `robot.two_arc.reel_in_m` short of the exposed length with the tip at the mouth; then
+/// docked (see the module docs).
+pub struct Reel {
+    name: String,
+    until: f64,
+}
+
+impl Reel {
+    /// A leaf named `name`.
+    pub fn new(name: &str) -> Self {
+        Self {
+            name: name.into(),
+            until: f64::INFINITY,
+        }
+    }
+}
+
+impl Behavior<Memory> for Reel {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
+        // The exposed length with the tip at the mouth, less the reel-in.
+        let g = m.geometry;
+        let mouth = Pose2::new(g.tether.arm, 0.0, std::f64::consts::PI);
+        self.until = (g.tether.length_at(&mouth) - g.reel_in).max(0.0);
+    }
+
+    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
+        if m.commit.is_none() {
+            return Some(
+                m.hold("mate")
+                    .finishing(Outcome::Failed(FailureReason::FailedToControl)),
+            );
+        }
+        let reeled = m.reel.is_some_and(|r| r.length <= self.until);
+        let step = m.free_reel("mate_reel");
+        Some(if reeled { step.finishing(Outcome::Docked) } else { step })
     }
 }

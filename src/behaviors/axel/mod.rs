@@ -37,7 +37,7 @@ use super::registry::{LeafArgs, Registry};
 use crate::profile::Profile;
 pub use memory::Memory;
 
-/// Registers Axel's schemas (`axel.acquire`, `axel.approach`, `axel.align`, `axel.mate`,
+/// Registers Axel's schemas (`axel.acquire`, `axel.approach`, `axel.align`, `axel.mate_close`, `axel.mate_reel`,
 /// `axel.stall`, and `axel.reel`, the paper's pure-reeling baseline) in `registry`; each
 /// takes its tuning from its node's `params`.
 pub fn register(registry: &mut Registry<Memory>) {
@@ -55,8 +55,12 @@ pub fn register(registry: &mut Registry<Memory>) {
         .register("axel.align", |_: &Memory, a: &LeafArgs<'_>| {
             Ok(Box::new(align::Align::new(a.node, a.params()?)))
         })
-        .register("axel.mate", |_: &Memory, a: &LeafArgs<'_>| {
-            Ok(Box::new(mate::Mate::new(a.node, a.params()?)))
+        .register("axel.mate_close", |_: &Memory, a: &LeafArgs<'_>| {
+            Ok(Box::new(mate::Close::new(a.node, a.params()?)))
+        })
+        .register("axel.mate_reel", |_: &Memory, a: &LeafArgs<'_>| {
+            a.no_params()?;
+            Ok(Box::new(mate::Reel::new(a.node)))
         })
         .register("axel.stall", |_: &Memory, a: &LeafArgs<'_>| {
             Ok(Box::new(stall::Stall::new(a.node, a.params()?)))

@@ -95,6 +95,9 @@ pub struct Memory {
     pub samples_distance: f64,
     /// The plan for the next repositioning.
     pub plan: Option<RepositionPlan>,
+    /// The staging pose the running repositioning drives to, odometry frame (set as it
+    /// is entered, from the plan or the dock hint).
+    pub staging: Option<Pose2>,
     /// Why the run is being abandoned (the give-up phase reports it; timeout when unset).
     pub failing: Option<crate::schemas::FailureReason>,
     /// Distance from the camera back to the robot's rear, m.
@@ -183,6 +186,7 @@ impl Memory {
             imprinted: false,
             samples_distance: 0.0,
             plan: None,
+            staging: None,
             failing: None,
             rear_behind_camera: super::rear_behind_camera(profile, &geometry).unwrap_or(0.0),
             docking_first_tick: false,
@@ -333,6 +337,7 @@ impl SharedMemory for Memory {
                 self.dock_in_odometry = None;
                 self.failing = None;
                 self.plan = None;
+                self.staging = None;
                 self.dock_hint = *dock_hint;
                 // Ballistic region: the drive by odometry ends facing along the axis at the
                 // staging point; unjamming turns back to that heading.

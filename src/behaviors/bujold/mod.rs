@@ -22,24 +22,23 @@ pub mod departure;
 pub mod docking;
 pub mod memory;
 pub mod motor;
-pub mod move_away;
 pub mod params;
 pub mod reposition;
 pub mod search;
 pub mod tuning;
-pub mod unjam;
 
 pub use decide::{Decision, at_dock_decision};
 
 use super::agent::BuildError;
 use super::common::docking::{DockSwitch, Imprint, ImprintEnd};
+use super::common::motion::{Aim, AimFn, BackOff, BackOffParams, Distance, End, Hooks, TurnParams, TurnTo};
+use super::common::search::{Search, SearchParams};
 use super::composed::Composed;
 use super::registry::{LeafArgs, Registry};
 use crate::perception::two_block_pose::TwoBlockGeometry;
 use crate::profile::Profile;
-use crate::schemas::SearchRotation;
+use crate::schemas::FailureReason;
 pub use memory::Memory;
-use reposition::PlanFrom;
 
 /// Registers Bujold's phase schemas (`bujold.undock`, `bujold.search`, ...) in `registry`;
 /// each takes its tuning from its node's `params` (see [`params`]).
@@ -64,17 +63,41 @@ pub fn register(registry: &mut Registry<Memory>) {
             )))
         })
         .register("bujold.search", |m: &Memory, a: &LeafArgs<'_>| {
-            let rate = m.approach.steering.turn_rate;
-            let rotation = SearchRotation {
-                rate,
+            let params = SearchParams {
+                rate: m.approach.steering.turn_rate,
                 first_sweep: 0.0,
                 doubling: false,
+                grace_frames: 0,
+                settle_s: 0.0,
+                resume_clock: false,
+                timeout_s: a.profile.behavior.search_timeout_s,
             };
-            let timeout = a.profile.behavior.search_timeout_s;
-            Ok(Box::new(search::Search::new(a.node, a.params()?, rotation, timeout)))
+            let watch = search::JamWatch::new(a.params()?);
+            Ok(Box::new(Search::new(a.node, "search", params, watch)))
         })
-        .register("bujold.unjam", |_: &Memory, a: &LeafArgs<'_>| {
-            Ok(Box::new(unjam::Unjam::new(a.node, a.params()?)))
+        // Unjamming: turn back to the heading the close dock began with (turning back
+        // over the ground just swept is free), then drive out front first; the search
+        // then turns the other way, which swings the caught corner off the body. Both
+        // keep the frame-change cue running, so the search that follows compares its
+        // first frame with the one just before it.
+        .register("bujold.unjam_turn", |_: &Memory, a: &LeafArgs<'_>| {
+            let p: TurnParams = a.params()?;
+            let aim: AimFn<Memory> = Box::new(|m| Aim::Heading(m.start_heading.unwrap_or(m.odo.theta)));
+            let tol = Some(p.heading_tolerance_deg.to_radians());
+            let leg = TurnTo::new(a.node, a.phase(), aim, tol, "turned").timeout(p.timeout_s);
+            Ok(Box::new(leg.hooks(observing())))
+        })
+        .register("bujold.unjam_out", |_: &Memory, a: &LeafArgs<'_>| {
+            let p: BackOffParams = a.params()?;
+            let leg = BackOff::new(
+                a.node,
+                a.phase(),
+                Distance::Fixed(p.distance_m),
+                p.speed_mps,
+                End::Event("cleared"),
+            );
+            let timeout = p.timeout_s.unwrap_or(2.0 * p.distance_m / p.speed_mps);
+            Ok(Box::new(leg.timeout(timeout).hooks(observing())))
         })
         .register("bujold.approach", |m: &Memory, a: &LeafArgs<'_>| {
             let dock_total = m.approach.steering.dock_total_px;
@@ -100,30 +123,41 @@ pub fn register(registry: &mut Registry<Memory>) {
         .register("bujold.back_in", move |_: &Memory, a: &LeafArgs<'_>| {
             Ok(Box::new(back_in::BackIn::new(a.node, a.params()?, depth(a)?)))
         })
-        .register("bujold.reposition", |_: &Memory, a: &LeafArgs<'_>| {
-            Ok(Box::new(reposition::Reposition::new(
-                a.node,
-                a.params()?,
-                PlanFrom::Memory,
-            )))
-        })
-        .register("bujold.ballistic", |_: &Memory, a: &LeafArgs<'_>| {
-            Ok(Box::new(reposition::Reposition::new(
-                a.node,
-                a.params()?,
-                PlanFrom::DockHint,
-            )))
-        })
+        // "Move away and retry" (seed 004 §V), and giving up: every failure close to
+        // the dock first backs off the entrance, then stops, failed with the reason the
+        // phase that gave up left in memory (a timeout when none did).
         .register("bujold.move_away", |_: &Memory, a: &LeafArgs<'_>| {
-            Ok(Box::new(move_away::MoveAway::new(a.node, a.params()?, false)))
+            let p: BackOffParams = a.params()?;
+            let leg = BackOff::new(
+                a.node,
+                "move_away",
+                Distance::Fixed(p.distance_m),
+                p.speed_mps,
+                End::Event("done"),
+            );
+            Ok(Box::new(leg.timeout(p.timeout_s.unwrap_or(20.0))))
         })
         .register("bujold.give_up", |_: &Memory, a: &LeafArgs<'_>| {
-            Ok(Box::new(move_away::MoveAway::new(a.node, a.params()?, true)))
+            let p: BackOffParams = a.params()?;
+            let why = End::Fail(|m: &Memory| m.failing.unwrap_or(FailureReason::Timeout));
+            let leg = BackOff::new(a.node, "give_up", Distance::Fixed(p.distance_m), p.speed_mps, why);
+            Ok(Box::new(leg.timeout(p.timeout_s.unwrap_or(20.0))))
         })
         .register("bujold.dock_switch", |_: &Memory, a: &LeafArgs<'_>| {
             a.no_params()?;
             Ok(Box::new(DockSwitch::new(a.node)))
         });
+    reposition::register(registry);
+}
+
+/// Hooks that keep the frame-change cue running while a leg runs.
+fn observing() -> Hooks<Memory> {
+    Hooks {
+        each: |m: &mut Memory, inputs| {
+            m.observe_change(inputs);
+        },
+        ..Hooks::default()
+    }
 }
 
 /// Distance from the camera back to the robot's rear, m.

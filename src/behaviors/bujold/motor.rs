@@ -3,7 +3,8 @@
 //! in place, drive away) that several phases step with.
 
 use super::memory::Memory;
-use crate::geometry::Pose2;
+use crate::behaviors::common::motion::Motion;
+use crate::geometry::{Pose2, wrap_angle};
 use crate::perception::two_block_pose::FiducialView;
 use crate::schemas::{
     Auxiliary, DriveCommand, MotionVector, MotorOutput, Posture, PotentialField, RatioSteering, Step,
@@ -77,6 +78,39 @@ impl Memory {
             MotorOutput::drive(DriveCommand::Straight { v }).with_aux(raised()),
             self.feedback(phase),
         )
+    }
+}
+
+/// The manoeuvre legs' motions, raised; turns within a heading tolerance (3° when the
+/// leg names none).
+impl Motion for Memory {
+    fn now(&self) -> f64 {
+        self.now
+    }
+
+    fn odo(&self) -> Pose2 {
+        self.odo
+    }
+
+    fn hold(&mut self, phase: &'static str) -> Step {
+        Memory::hold(self, phase)
+    }
+
+    fn turn_toward(&mut self, heading: f64, tolerance: Option<f64>, phase: &'static str) -> Option<Step> {
+        let err = wrap_angle(heading - self.odo.theta);
+        let tolerance = tolerance.unwrap_or(3f64.to_radians());
+        (err.abs() >= tolerance).then(|| self.turn_by(err, phase))
+    }
+
+    fn straight(&mut self, v: f64, phase: &'static str) -> Step {
+        Step::running(
+            MotorOutput::drive(DriveCommand::Straight { v }).with_aux(raised()),
+            self.feedback(phase),
+        )
+    }
+
+    fn back_off(&mut self, speed: f64, phase: &'static str) -> Step {
+        self.drive_away(speed, phase)
     }
 }
 

@@ -70,31 +70,6 @@ impl Default for SearchParams {
     }
 }
 
-/// `unjam`: turn back to the heading docking began with, drive out, search the other way.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct UnjamParams {
-    /// Close enough to the start heading, degrees.
-    pub heading_tolerance_deg: f64,
-    /// Longest turn back, s.
-    pub turn_timeout_s: f64,
-    /// How far to drive out, front first, m.
-    pub distance_m: f64,
-    /// Speed driving out, m/s.
-    pub speed_mps: f64,
-}
-
-impl Default for UnjamParams {
-    fn default() -> Self {
-        Self {
-            heading_tolerance_deg: 5.0,
-            turn_timeout_s: 20.0,
-            distance_m: 0.2,
-            speed_mps: 0.06,
-        }
-    }
-}
-
 /// `approach`: steer on the fiducial; reposition when clearly off the axis.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -188,53 +163,6 @@ impl Default for BackInParams {
             margin_m: 0.15,
             min_distance_m: 0.1,
             max_yaw_drift_deg: 5.0,
-        }
-    }
-}
-
-/// `reposition` and `ballistic`: turn, drive and turn by odometry to a staging pose.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct RepositionParams {
-    /// Heading tolerance of the turns, degrees.
-    pub heading_tolerance_deg: f64,
-    /// Close enough to the staging point to skip the drive, m.
-    pub arrive_m: f64,
-    /// The drive ends when the target is this close to abeam, m.
-    pub abeam_m: f64,
-    /// Beside the gate, drive straight out this far before turning, m.
-    pub clear_m: f64,
-}
-
-impl Default for RepositionParams {
-    fn default() -> Self {
-        Self {
-            heading_tolerance_deg: 3.0,
-            arrive_m: 0.03,
-            abeam_m: 0.02,
-            clear_m: 0.3,
-        }
-    }
-}
-
-/// `move_away` and `give_up`: back off from the entrance, front first.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct MoveAwayParams {
-    /// How far, m.
-    pub distance_m: f64,
-    /// Speed, m/s.
-    pub speed_mps: f64,
-    /// Longest time, s (a blocked robot still ends the phase).
-    pub timeout_s: f64,
-}
-
-impl Default for MoveAwayParams {
-    fn default() -> Self {
-        Self {
-            distance_m: 0.35,
-            speed_mps: 0.06,
-            timeout_s: 20.0,
         }
     }
 }

@@ -1,18 +1,31 @@
-//! `bujold.reposition` and `bujold.ballistic`: turn, drive and turn by odometry to a
-//! staging pose on the dock axis, facing along it; event `aligned` (then the approach
-//! starts afresh, its viewing-angle memory cleared).
+//! Repositioning (`reposition`) and the ballistic region (`ballistic`): turn, drive and
+//! turn by odometry to a staging pose on the dock axis, facing along it. Each is a
+//! sequencer in the profile whose states are the common manoeuvre legs
+//! ([`crate::behaviors::common::motion`]), registered here over Bujold's memory:
 //!
-//! The reposition phase takes the plan the approach or the decision left in memory
-//! (beside the gate, where the body's corners sweep a circle of half the diagonal, it
-//! first drives straight out, front first). The ballistic phase (the ballistic region,
-//! seed 004 Fig. 1) plans from the a-priori dock pose instead: `ballistic_staging_m` out
-//! on the dock axis.
+//! * `bujold.clear`: beside the gate, where the body's corners sweep a circle of half
+//!   the diagonal, drive straight out first, front first (event `cleared`);
+//! * `bujold.face`: turn so that the end leading toward the staging point faces it
+//!   (`faced`, or `arrived` when already there);
+//! * `bujold.drive`: drive until the staging point is abeam (`abeam` or `arrived`);
+//! * `bujold.align`: turn to the staging heading; event `aligned`, with the viewing-angle
+//!   memory cleared, so the approach starts afresh.
+//!
+//! The sequencer's selector ([`Staging`], `bujold.reposition` or `bujold.ballistic`)
+//! sets the staging pose on entry and picks the first leg: the reposition takes the plan
+//! the approach or the decision left in memory (and starts with `bujold.clear` when the
+//! plan says so); the ballistic region (seed 004 Fig. 1) plans from the a-priori dock
+//! pose instead, `ballistic_staging_m` out on the dock axis.
 
-use super::memory::{Memory, RepositionPlan, raised};
-use super::params::RepositionParams;
-use crate::geometry::{Pose2, wrap_angle};
-use crate::schemas::{Behavior, DriveCommand, Inputs, MotorOutput, Step};
-use std::f64::consts::FRAC_PI_2;
+use super::memory::{Memory, RepositionPlan};
+use crate::arbiter::Selector;
+use crate::behaviors::common::motion::{
+    Aim, AimFn, BackOff, BackOffParams, Distance, DriveAbeam, DriveParams, End, FaceParams, Hooks, TurnParams, TurnTo,
+    face,
+};
+use crate::behaviors::registry::{LeafArgs, Registry, SelectorArgs};
+use crate::geometry::Pose2;
+use crate::schemas::Inputs;
 
 /// Where the staging pose comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -23,56 +36,37 @@ pub enum PlanFrom {
     DockHint,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Stage {
-    /// Drive straight out, front first.
-    Clear,
-    /// Face the staging point with the end that leads toward it.
-    Face,
-    /// Drive until the staging point is abeam.
-    Drive,
-    /// Turn to the staging heading.
-    Align,
-}
-
-/// See the module docs.
-pub struct Reposition {
-    name: String,
-    params: RepositionParams,
+/// The selector of a repositioning sequencer (see the module docs).
+pub struct Staging {
     from: PlanFrom,
-    stage: Stage,
-    target: Pose2,
-    mark: Pose2,
+    /// The `bujold.clear` state, if the sequence has one.
+    clear: Option<usize>,
 }
 
-impl Reposition {
-    /// A leaf named `name` taking its plan `from` memory or the dock hint.
-    pub fn new(name: &str, params: RepositionParams, from: PlanFrom) -> Self {
-        Self {
-            name: name.into(),
-            params,
-            from,
-            stage: Stage::Face,
-            target: Pose2::default(),
-            mark: Pose2::default(),
-        }
-    }
-
-    fn phase(&self) -> &'static str {
-        match self.from {
-            PlanFrom::Memory => "reposition",
-            PlanFrom::DockHint => "ballistic",
-        }
+impl Staging {
+    /// The selector of the sequencer `args` describes, planning `from`.
+    pub fn new(args: &SelectorArgs<'_>, from: PlanFrom) -> Self {
+        let schema = |state: &String| {
+            let tree = args.profile.behavior.tree.as_ref()?;
+            match tree.nodes.get(state)? {
+                crate::profile::tree::NodeSpec::Leaf { schema, .. } => Some(schema.clone()),
+                _ => None,
+            }
+        };
+        let clear = args
+            .states
+            .iter()
+            .position(|s| schema(s).as_deref() == Some("bujold.clear"));
+        Self { from, clear }
     }
 }
 
-impl Behavior<Memory> for Reposition {
-    fn name(&self) -> &str {
-        &self.name
+impl Selector<Memory> for Staging {
+    fn select(&mut self, _m: &mut Memory, _inputs: &Inputs<'_>, _current: usize) -> Option<usize> {
+        None
     }
 
-    fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
-        self.mark = m.odo;
+    fn entry(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<usize> {
         let plan = match self.from {
             PlanFrom::Memory => m.plan.take(),
             PlanFrom::DockHint => m.dock_hint.map(|dock| RepositionPlan {
@@ -85,81 +79,65 @@ impl Behavior<Memory> for Reposition {
             target: m.odo,
             clear_first: false,
         });
-        self.target = plan.target;
-        self.stage = if plan.clear_first { Stage::Clear } else { Stage::Face };
+        m.staging = Some(plan.target);
+        match self.clear {
+            Some(c) if plan.clear_first => Some(c),
+            Some(c) => Some(c + 1),
+            None => Some(0),
+        }
     }
+}
 
-    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
-        let phase = self.phase();
-        let p = self.params;
-        let odo = m.odo;
-        let target = self.target;
-        let (dx, dy) = (target.x - odo.x, target.y - odo.y);
-        let dist = dx.hypot(dy);
-        let tol = p.heading_tolerance_deg.to_radians();
-        let speed = m.approach.steering.speed;
-        let step = match self.stage {
-            Stage::Clear => {
-                if m.travelled(&self.mark) >= p.clear_m {
-                    self.stage = Stage::Face;
-                    m.hold(phase)
-                } else {
-                    let v = -m.geometry.drive_dir * speed;
-                    Step::running(
-                        MotorOutput::drive(DriveCommand::Straight { v }).with_aux(raised()),
-                        m.feedback(phase),
-                    )
-                }
-            }
-            Stage::Face | Stage::Drive if dist < p.arrive_m => {
-                self.stage = Stage::Align;
-                m.hold(phase)
-            }
-            Stage::Face => {
-                let bearing = dy.atan2(dx);
-                let forward = wrap_angle(bearing - odo.theta).abs() <= FRAC_PI_2;
-                let want = if forward {
-                    bearing
-                } else {
-                    bearing + std::f64::consts::PI
-                };
-                let err = wrap_angle(want - odo.theta);
-                if err.abs() < tol {
-                    self.stage = Stage::Drive;
-                    m.hold(phase)
-                } else {
-                    m.turn_by(err, phase)
-                }
-            }
-            Stage::Drive => {
-                // Drive along the heading until the target is abeam: the signed distance
-                // to it along the heading crosses zero (a target off the line of travel
-                // is never reached exactly).
-                let along = dx * odo.theta.cos() + dy * odo.theta.sin();
-                if along.abs() < p.abeam_m {
-                    self.stage = Stage::Align;
-                    m.hold(phase)
-                } else {
-                    let tick_s = m.approach.steering.tick_s;
-                    let v = speed.min(along.abs() / tick_s).copysign(along);
-                    Step::running(
-                        MotorOutput::drive(DriveCommand::Straight { v }).with_aux(raised()),
-                        m.feedback(phase),
-                    )
-                }
-            }
-            Stage::Align => {
-                let err = wrap_angle(target.theta - odo.theta);
-                if err.abs() < tol {
+/// Registers the legs and the two selectors in `registry`.
+pub fn register(registry: &mut Registry<Memory>) {
+    registry
+        .register_selector("bujold.reposition", |_: &Memory, a: &SelectorArgs<'_>| {
+            Ok(Box::new(Staging::new(a, PlanFrom::Memory)))
+        })
+        .register_selector("bujold.ballistic", |_: &Memory, a: &SelectorArgs<'_>| {
+            Ok(Box::new(Staging::new(a, PlanFrom::DockHint)))
+        })
+        .register("bujold.clear", |m: &Memory, a: &LeafArgs<'_>| {
+            let p: BackOffParams = a.params()?;
+            let speed = m.approach.steering.speed;
+            let leg = BackOff::new(
+                a.node,
+                a.phase(),
+                Distance::Fixed(p.distance_m),
+                speed,
+                End::Event("cleared"),
+            );
+            Ok(Box::new(leg.timeout(p.timeout_s.unwrap_or(f64::INFINITY))))
+        })
+        .register("bujold.face", |_: &Memory, a: &LeafArgs<'_>| {
+            let p: FaceParams = a.params()?;
+            let aim: AimFn<Memory> = Box::new(move |m| m.staging.map_or(Aim::Hold, |s| face(&m.odo, &s, p.arrive_m)));
+            let tol = Some(p.heading_tolerance_deg.to_radians());
+            Ok(Box::new(TurnTo::new(a.node, a.phase(), aim, tol, "faced")))
+        })
+        .register("bujold.drive", |m: &Memory, a: &LeafArgs<'_>| {
+            let d: DriveParams = a.params()?;
+            let s = &m.approach.steering;
+            let target = Box::new(|m: &Memory| m.staging);
+            let leg = DriveAbeam::new(a.node, a.phase(), target, s.speed, s.tick_s, d.arrive_m, d.abeam_m);
+            Ok(Box::new(leg))
+        })
+        .register("bujold.align", |_: &Memory, a: &LeafArgs<'_>| {
+            let t: TurnParams = a.params()?;
+            let aim: AimFn<Memory> = Box::new(|m| m.staging.map_or(Aim::Hold, |s| Aim::Heading(s.theta)));
+            let forget = Hooks {
+                end: |m: &mut Memory| {
                     m.alpha_filtered = None;
                     m.alpha_window.clear();
                     m.ratio_gate.reset();
-                    m.hold(phase).with_event("aligned")
-                } else {
-                    m.turn_by(err, phase)
-                }
-            }
-        };
-        Some(step)
-    }
+                },
+                ..Hooks::default()
+            };
+            let tol = Some(t.heading_tolerance_deg.to_radians());
+            Ok(Box::new(
+                TurnTo::new(a.node, a.phase(), aim, tol, "aligned")
+                    .timeout(t.timeout_s)
+                    .hooks(forget),
+            ))
+        });
 }

@@ -8,6 +8,8 @@
 pub mod avoid;
 pub mod docking;
 pub mod median;
+pub mod motion;
+pub mod search;
 
 use super::registry::{LeafArgs, Registry};
 

@@ -41,7 +41,6 @@
 //! lights are issued but do not change what the camera sees.
 
 pub mod align;
-pub mod back_away;
 pub mod departure;
 pub mod docking;
 pub mod final_approach;
@@ -65,18 +64,17 @@ pub use states::{ServoState, select_state};
 
 use super::agent::BuildError;
 use super::common::docking::{DockSwitch, Imprint, ImprintEnd};
+use super::common::motion::{AimFn, BackOff, Distance, End, Hooks, TurnTo};
+use super::common::search::{Search, SearchParams};
 use super::composed::Composed;
 use super::registry::{LeafArgs, Registry};
 use crate::profile::Profile;
-use back_away::{BackAway, Distance};
-use manoeuvre::{Manoeuvre, Part};
 
 /// Registers RAPOSA's phase schemas (`raposa.approach`, `raposa.rotate_7`, ...) and the
 /// `raposa.seven_state` selector in `registry`; each schema takes its tuning from its
 /// node's `params` (see [`params`]) and the robot-wide `[robot.seven_state]`.
 pub fn register(registry: &mut Registry<Memory>) {
     type Ctx = Memory;
-    let search_timeout = |a: &LeafArgs<'_>| a.profile.behavior.search_timeout_s;
     registry
         .register("raposa.depart", |m: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
@@ -108,22 +106,42 @@ pub fn register(registry: &mut Registry<Memory>) {
         .register("raposa.blue_only", |_: &Ctx, a: &LeafArgs<'_>| {
             Ok(Box::new(servo::BlueOnly::new(a.node, a.params()?)))
         })
-        .register("raposa.search", move |_: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(search::Search::new(a.node, a.params()?, search_timeout(a))))
+        .register("raposa.search", move |m: &Ctx, a: &LeafArgs<'_>| {
+            let p: params::SearchParams = a.params()?;
+            let search = SearchParams {
+                grace_frames: p.grace_frames,
+                resume_clock: true,
+                ..slow_search(m, a)
+            };
+            Ok(Box::new(Search::new(a.node, "state_5", search, ())))
         })
         .register("raposa.final", |_: &Ctx, a: &LeafArgs<'_>| {
             Ok(Box::new(
                 final_approach::FinalApproach::new(a.node, a.profile.behavior.max_retries).with_params(a.params()?),
             ))
         })
-        .register("raposa.leave_dead_zone", |_: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(BackAway::new(a.node, Distance::DeadZone(a.params()?))))
+        // The back-aways (latched): body forward for the backward camera at the far
+        // speed, keeping the ellipse centred; then event `cleared` with the detector's
+        // tracking forgotten (the servo selects again). Out of the dead zone (ours): a
+        // pair closer than `distance_threshold_m` shows misalignment, where α is
+        // unreliable and region II cannot run, so back off until the socket is
+        // `dead_zone_exit_m` from the ball (at least `min_distance_m`), measured from
+        // the view on entry. The retreat: a final approach ended without the dock
+        // switch backs off `distance_m`.
+        .register("raposa.leave_dead_zone", |m: &Ctx, a: &LeafArgs<'_>| {
+            let p: params::LeaveDeadZoneParams = a.params()?;
+            let exit = Distance::AtEntry(Box::new(move |m: &Ctx| {
+                let socket = m.percept.view.map_or(0.0, |v| v.ball_distance_m - m.socket_inset);
+                (m.gains.dead_zone_exit_m - socket).max(p.min_distance_m)
+            }));
+            Ok(Box::new(back_away(a.node, "leave_dead_zone", exit, m)))
         })
         .register("raposa.probe", |_: &Ctx, a: &LeafArgs<'_>| {
             Ok(Box::new(probe::Probe::new(a.node, a.params()?)))
         })
-        .register("raposa.retreat", |_: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(BackAway::new(a.node, Distance::Retreat(a.params()?))))
+        .register("raposa.retreat", |m: &Ctx, a: &LeafArgs<'_>| {
+            let p: params::RetreatParams = a.params()?;
+            Ok(Box::new(back_away(a.node, "retreat", Distance::Fixed(p.distance_m), m)))
         })
         .register("raposa.rotate_7", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
@@ -131,18 +149,45 @@ pub fn register(registry: &mut Registry<Memory>) {
         })
         .register("raposa.rotate_odo", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(Manoeuvre::new(a.node, Part::RotateOdo)))
+            let aim: AimFn<Ctx> = Box::new(manoeuvre::rotate_odo);
+            let hooks = Hooks {
+                enter: manoeuvre::look_away,
+                ..Hooks::default()
+            };
+            Ok(Box::new(
+                TurnTo::new(a.node, "state_2_rotate", aim, None, "rotated").hooks(hooks),
+            ))
         })
         .register("raposa.travel", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(Manoeuvre::new(a.node, Part::Travel)))
+            Ok(Box::new(manoeuvre::Travel::new(a.node)))
         })
         .register("raposa.rotate_phi", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(Manoeuvre::new(a.node, Part::RotatePhi)))
+            let aim: AimFn<Ctx> = Box::new(manoeuvre::rotate_phi);
+            let hooks = Hooks {
+                enter: manoeuvre::look_away,
+                end: |m: &mut Ctx| m.source.reset(),
+                ..Hooks::default()
+            };
+            Ok(Box::new(
+                TurnTo::new(a.node, "state_2_rotate_phi", aim, None, "facing").hooks(hooks),
+            ))
         })
-        .register("raposa.look", move |_: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(search::Look::new(a.node, a.params()?, search_timeout(a))))
+        // After the region-II manoeuvre, which ends facing where the pyramid should be:
+        // stand still `settle_s` for the image to settle, then the slow search, first
+        // opposite to the manoeuvre's last turn. The selector leaves it, with the angle
+        // threshold widened (settling), as soon as the ellipse is seen.
+        .register("raposa.look", move |m: &Ctx, a: &LeafArgs<'_>| {
+            let p: params::LookParams = a.params()?;
+            let look = SearchParams {
+                settle_s: p.settle_s,
+                ..slow_search(m, a)
+            };
+            let see_again = |m: &mut Ctx| m.blind = false;
+            Ok(Box::new(
+                Search::new(a.node, "state_2_look", look, ()).on_enter(see_again),
+            ))
         })
         .register_selector("raposa.seven_state", |_: &Ctx, a| {
             Ok(Box::new(selector::SevenState::new(a)?))
@@ -152,6 +197,29 @@ pub fn register(registry: &mut Registry<Memory>) {
 /// RAPOSA's robot: the perception source (the pyramid schema, or the two-block adapter)
 /// in the shared [`Memory`] and the tree of `[behavior.tree]`.
 pub type RaposaAgent = Composed<Memory>;
+
+/// RAPOSA's slow search: the doubling sweep at `[robot.seven_state]`'s rate and first
+/// sweep, failing after the profile's `behavior.search_timeout_s`.
+fn slow_search(m: &Memory, a: &LeafArgs<'_>) -> SearchParams {
+    SearchParams {
+        rate: m.gains.search_rate_dps.to_radians(),
+        first_sweep: m.gains.search_sweep_deg.to_radians(),
+        doubling: true,
+        grace_frames: 0,
+        settle_s: 0.0,
+        resume_clock: false,
+        timeout_s: a.profile.behavior.search_timeout_s,
+    }
+}
+
+/// A back-away leg at the far speed, ending with `cleared` and the tracking forgotten.
+fn back_away(node: &str, phase: &'static str, distance: Distance<Memory>, m: &Memory) -> BackOff<Memory> {
+    let forget = Hooks {
+        end: |m: &mut Memory| m.source.reset(),
+        ..Hooks::default()
+    };
+    BackOff::new(node, phase, distance, m.gains.far_speed_mps, End::Event("cleared")).hooks(forget)
+}
 
 /// Builds RAPOSA's robot from a profile with a `pyramid` fiducial (or a
 /// `two_block` fiducial, read through [`source::TwoBlockCues`]), a pin-hole back

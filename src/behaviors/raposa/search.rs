@@ -1,111 +1,72 @@
-//! The two slow searches (seed 001 §II.E: "rotate slowly until it finds it again",
-//! alternating sides and doubling the sweep below 360°): `raposa.search` (state 5, nothing
-//! seen) and `raposa.look` (after the region-II manoeuvre, which ends facing where the
-//! pyramid should be).
+//! RAPOSA's memory as the common leaves see it: its [`Motion`] (the guides, arm and
+//! lights carried on every command; turns by the [`PointController`](crate::schemas::PointController)'s
+//! rotation, remembering the side) and its [`Searching`] (seed 001 §II.E: "rotate slowly
+//! until it finds it again", alternating sides and doubling the sweep below 360°, first
+//! away from the side of the last turn). The seven-state selector leaves the search as
+//! soon as anything is seen, so the search itself never reports an acquisition; the
+//! search clock it keeps across the selector's glimpses restarts once the ellipse is
+//! seen, and a timeout is a target lost.
 
 use super::memory::Memory;
-use super::params::{LookParams, SearchParams};
-use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, SearchRotation, Step};
+use crate::behaviors::common::motion::Motion;
+use crate::behaviors::common::search::Searching;
+use crate::geometry::{Pose2, Twist};
+use crate::schemas::{DriveCommand, FailureReason, Step};
 
-/// `raposa.search`, state 5: after `grace_frames` frames with nothing seen, the doubling
-/// search, first away from the side of the last turn; the docking fails (target lost)
-/// after the profile's `behavior.search_timeout_s` of searching. The selector leaves it as
-/// soon as anything is seen; the search clock restarts once the ellipse is seen.
-pub struct Search {
-    name: String,
-    params: SearchParams,
-    timeout: f64,
-}
+impl Motion for Memory {
+    fn now(&self) -> f64 {
+        self.now
+    }
 
-impl Search {
-    /// A leaf named `name`, giving up after `timeout` s.
-    pub fn new(name: &str, params: SearchParams, timeout: f64) -> Self {
-        Self {
-            name: name.into(),
-            params,
-            timeout,
-        }
+    fn odo(&self) -> Pose2 {
+        self.odo
+    }
+
+    fn hold(&mut self, phase: &'static str) -> Step {
+        Memory::hold(self, phase)
+    }
+
+    /// By the point controller's rotation, within its own `rotation_tolerance`.
+    fn turn_toward(&mut self, heading: f64, _tolerance: Option<f64>, phase: &'static str) -> Option<Step> {
+        let odo = self.odo;
+        let t = self.ctrl.rotate(&odo, heading)?;
+        Some(self.turn(t.omega, phase))
+    }
+
+    fn straight(&mut self, v: f64, phase: &'static str) -> Step {
+        self.drive(Twist::new(v, 0.0), phase)
+    }
+
+    /// Body forward for the backward camera, keeping the ellipse centred when it is seen.
+    fn back_off(&mut self, speed: f64, phase: &'static str) -> Step {
+        let omega = self.percept.view.map_or(0.0, |v| self.law.turn(v.dev_px[0]));
+        self.drive(self.law.twist(-speed, omega), phase)
     }
 }
 
-impl Behavior<Memory> for Search {
-    fn name(&self) -> &str {
-        &self.name
+impl Searching for Memory {
+    fn acquired(&mut self, _phase: &'static str) -> Option<Step> {
+        None
     }
 
-    fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
-
-    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
-        m.unseen += 1;
-        if m.unseen <= self.params.grace_frames {
-            return Some(m.hold("state_5"));
-        }
-        let now = m.now;
-        let start = *m.search_start.get_or_insert(now);
-        if now - start > self.timeout {
-            return Some(m.hold("state_5").finishing(Outcome::Failed(FailureReason::TargetLost)));
-        }
-        let search = SearchRotation {
-            rate: m.gains.search_rate_dps.to_radians() * -m.last_turn,
-            first_sweep: m.gains.search_sweep_deg.to_radians(),
-            doubling: true,
-        };
-        Some(m.command(search.act(now - start), "state_5"))
-    }
-}
-
-/// `raposa.look`: stand still `settle_s`, then the doubling search, first opposite to the
-/// manoeuvre's last turn; the docking fails (target lost) after the profile's
-/// `behavior.search_timeout_s`. The selector leaves it, with the angle threshold widened
-/// (settling), as soon as the ellipse is seen.
-pub struct Look {
-    name: String,
-    params: LookParams,
-    timeout: f64,
-    start: f64,
-    first_dir: f64,
-}
-
-impl Look {
-    /// A leaf named `name`, giving up after `timeout` s.
-    pub fn new(name: &str, params: LookParams, timeout: f64) -> Self {
-        Self {
-            name: name.into(),
-            params,
-            timeout,
-            start: 0.0,
-            first_dir: 1.0,
-        }
-    }
-}
-
-impl Behavior<Memory> for Look {
-    fn name(&self) -> &str {
-        &self.name
+    fn search_side(&self) -> f64 {
+        -self.last_turn
     }
 
-    fn enter(&mut self, m: &mut Memory, inputs: &Inputs<'_>) {
-        m.blind = false;
-        self.start = inputs.now;
-        self.first_dir = -m.last_turn;
+    fn lost_reason(&self) -> FailureReason {
+        FailureReason::TargetLost
     }
 
-    fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
-        let t = m.now - self.start;
-        if t < self.params.settle_s {
-            return Some(m.hold("state_2_look")); // let the image settle after stopping
-        }
-        if t > self.timeout {
-            return Some(
-                m.hold("state_2_look")
-                    .finishing(Outcome::Failed(FailureReason::TargetLost)),
-            );
-        }
-        let search = SearchRotation {
-            rate: m.gains.search_rate_dps.to_radians() * self.first_dir,
-            first_sweep: m.gains.search_sweep_deg.to_radians(),
-            doubling: true,
-        };
-        Some(m.command(search.act(t - self.params.settle_s), "state_2_look"))
+    fn search_turn(&mut self, turn: DriveCommand, phase: &'static str) -> Step {
+        self.command(turn, phase)
+    }
+
+    fn count_unseen(&mut self) -> u32 {
+        self.unseen += 1;
+        self.unseen
+    }
+
+    fn search_clock(&mut self) -> Option<&mut Option<f64>> {
+        Some(&mut self.search_start)
     }
 }

@@ -1,0 +1,564 @@
+//! The legs of a manoeuvre by odometry, written once for every robot: turn to a heading
+//! ([`TurnTo`]), back off a distance ([`BackOff`]) and drive straight until a point is
+//! abeam ([`DriveAbeam`]). A multi-step manoeuvre (Bujold's turn–drive–turn to a staging
+//! pose, its unjamming, RAPOSA's region-II rotations) is a sequencer of these legs in the
+//! robot's profile, each leg a state that ends with an event; no leaf keeps a stage
+//! counter.
+//!
+//! The legs reach the robot through its memory's [`Motion`]: the tick's clock and
+//! odometry pose, and the robot's own way to stand, turn and drive (its posture or
+//! guides, its turn controller, its feedback). What a leg aims at (a heading, a point,
+//! a distance) is a function of the memory that the robot's registration supplies, so
+//! a leg reads the plan another phase left there.
+
+use crate::geometry::{Pose2, wrap_angle};
+use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, Step};
+use serde::Deserialize;
+
+/// A turn leg's node params.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TurnParams {
+    /// Close enough to the heading, degrees.
+    pub heading_tolerance_deg: f64,
+    /// Longest turn, s (then the leg ends with its event anyway).
+    pub timeout_s: f64,
+}
+
+impl Default for TurnParams {
+    fn default() -> Self {
+        Self {
+            heading_tolerance_deg: 3.0,
+            timeout_s: f64::INFINITY,
+        }
+    }
+}
+
+/// A face leg's node params ([`face`]).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FaceParams {
+    /// Close enough to the heading, degrees.
+    pub heading_tolerance_deg: f64,
+    /// Close enough to the point to need no turn, m.
+    pub arrive_m: f64,
+}
+
+impl Default for FaceParams {
+    fn default() -> Self {
+        Self {
+            heading_tolerance_deg: 3.0,
+            arrive_m: 0.03,
+        }
+    }
+}
+
+/// A back-off leg's node params.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BackOffParams {
+    /// How far, m.
+    pub distance_m: f64,
+    /// Speed, m/s.
+    pub speed_mps: f64,
+    /// Longest time, s (a blocked robot still ends the leg); unset, the leg's own
+    /// default (none, or twice the time the distance needs).
+    pub timeout_s: Option<f64>,
+}
+
+impl Default for BackOffParams {
+    fn default() -> Self {
+        Self {
+            distance_m: 0.35,
+            speed_mps: 0.06,
+            timeout_s: None,
+        }
+    }
+}
+
+/// A drive leg's node params ([`DriveAbeam`]).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DriveParams {
+    /// Close enough to the point to end, m.
+    pub arrive_m: f64,
+    /// The drive ends when the point is this close to abeam, m.
+    pub abeam_m: f64,
+}
+
+impl Default for DriveParams {
+    fn default() -> Self {
+        Self {
+            arrive_m: 0.03,
+            abeam_m: 0.02,
+        }
+    }
+}
+
+/// What the manoeuvre legs need of a robot's shared memory.
+pub trait Motion: Send + 'static {
+    /// Loop time of this tick, s.
+    fn now(&self) -> f64;
+    /// Odometry pose of this tick.
+    fn odo(&self) -> Pose2;
+    /// Stand still (with the robot's auxiliary commands), feedback naming `phase`.
+    fn hold(&mut self, phase: &'static str) -> Step;
+    /// Turn in place toward `heading` (odometry frame, rad); `None` once within
+    /// `tolerance` rad of it (`None`: the robot's own turn controller's tolerance).
+    fn turn_toward(&mut self, heading: f64, tolerance: Option<f64>, phase: &'static str) -> Option<Step>;
+    /// Drive straight at `v` m/s, positive along the body's forward axis.
+    fn straight(&mut self, v: f64, phase: &'static str) -> Step;
+    /// Drive away from the dock at `speed` m/s, the robot's way (Bujold front first,
+    /// RAPOSA keeping the ellipse centred in its backward camera).
+    fn back_off(&mut self, speed: f64, phase: &'static str) -> Step;
+}
+
+/// What a turn aims at this tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Aim {
+    /// This heading, odometry frame, rad.
+    Heading(f64),
+    /// Nothing to aim at yet: stand still.
+    Hold,
+    /// The leg has nothing left to do: end with this event.
+    Reached(&'static str),
+}
+
+/// Robot-specific work a leg does beside its motion: plain functions, so a leg stays
+/// `Send` and a registration states them at a glance.
+pub struct Hooks<M> {
+    /// On entry (RAPOSA: the region-II manoeuvre looks away from the pyramid on purpose).
+    pub enter: fn(&mut M),
+    /// Every tick, before the leg decides (Bujold: keep the frame-change cue running).
+    pub each: fn(&mut M, &Inputs<'_>),
+    /// When the leg ends with its event (Bujold: forget the viewing angle once aligned).
+    pub end: fn(&mut M),
+}
+
+impl<M> Default for Hooks<M> {
+    fn default() -> Self {
+        Self {
+            enter: |_| {},
+            each: |_, _| {},
+            end: |_| {},
+        }
+    }
+}
+
+/// The heading a [`TurnTo`] aims at, read from the memory each tick.
+pub type AimFn<M> = Box<dyn Fn(&M) -> Aim + Send>;
+
+/// The point a [`DriveAbeam`] drives to, read from the memory each tick (`None`: none yet).
+pub type TargetFn<M> = Box<dyn Fn(&M) -> Option<Pose2> + Send>;
+
+/// Turn in place to the heading `aim` gives, then end with `event`; after `timeout_s`
+/// in the leg it ends with `event` too (a turn that cannot finish must not hold the
+/// manoeuvre forever).
+pub struct TurnTo<M> {
+    name: String,
+    phase: &'static str,
+    aim: AimFn<M>,
+    tolerance: Option<f64>,
+    timeout_s: f64,
+    event: &'static str,
+    hooks: Hooks<M>,
+    started: f64,
+}
+
+impl<M: Motion> TurnTo<M> {
+    /// A leaf named `name` (feedback `phase`) turning to `aim` within `tolerance` rad
+    /// (`None`: the robot's controller decides), ending with `event`.
+    pub fn new(name: &str, phase: &'static str, aim: AimFn<M>, tolerance: Option<f64>, event: &'static str) -> Self {
+        Self {
+            name: name.into(),
+            phase,
+            aim,
+            tolerance,
+            timeout_s: f64::INFINITY,
+            event,
+            hooks: Hooks::default(),
+            started: 0.0,
+        }
+    }
+
+    /// Ends the turn with its event after `seconds` in the leg.
+    pub fn timeout(mut self, seconds: f64) -> Self {
+        self.timeout_s = seconds;
+        self
+    }
+
+    /// With `hooks`.
+    pub fn hooks(mut self, hooks: Hooks<M>) -> Self {
+        self.hooks = hooks;
+        self
+    }
+
+    fn end(&self, m: &mut M, event: &'static str) -> Step {
+        (self.hooks.end)(m);
+        m.hold(self.phase).with_event(event)
+    }
+}
+
+impl<M: Motion> Behavior<M> for TurnTo<M> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, m: &mut M, inputs: &Inputs<'_>) {
+        (self.hooks.enter)(m);
+        self.started = inputs.now;
+    }
+
+    fn tick(&mut self, m: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
+        (self.hooks.each)(m, inputs);
+        Some(match (self.aim)(m) {
+            Aim::Hold => m.hold(self.phase),
+            Aim::Reached(e) => self.end(m, e),
+            Aim::Heading(_) if m.now() - self.started > self.timeout_s => self.end(m, self.event),
+            Aim::Heading(h) => match m.turn_toward(h, self.tolerance, self.phase) {
+                Some(step) => step,
+                None => self.end(m, self.event),
+            },
+        })
+    }
+}
+
+/// How far a [`BackOff`] goes.
+pub enum Distance<M> {
+    /// A set distance, m.
+    Fixed(f64),
+    /// Measured on entry from the memory (RAPOSA: out of the dead zone from the view).
+    AtEntry(Box<dyn Fn(&M) -> f64 + Send>),
+}
+
+/// How a [`BackOff`] ends.
+#[derive(Debug, Clone, Copy)]
+pub enum End<M> {
+    /// With this event (retry, search again).
+    Event(&'static str),
+    /// The docking failed, for the reason the memory gives (Bujold's give-up: the
+    /// reason the phase that gave up left).
+    Fail(fn(&M) -> FailureReason),
+}
+
+/// Back off from the dock at `speed_mps` until `distance` is covered by odometry (the
+/// straight-line distance from where the leg began) or `timeout_s` has passed, then end
+/// as `end` says: Bujold's move-away, give-up and unjam drive-out, RAPOSA's retreat and
+/// its way out of the dead zone.
+pub struct BackOff<M> {
+    name: String,
+    phase: &'static str,
+    distance: Distance<M>,
+    speed_mps: f64,
+    timeout_s: f64,
+    end: End<M>,
+    hooks: Hooks<M>,
+    mark: Pose2,
+    started: f64,
+    goal: f64,
+}
+
+impl<M: Motion> BackOff<M> {
+    /// A leaf named `name` (feedback `phase`) backing off `distance` at `speed_mps`,
+    /// with no time limit.
+    pub fn new(name: &str, phase: &'static str, distance: Distance<M>, speed_mps: f64, end: End<M>) -> Self {
+        Self {
+            name: name.into(),
+            phase,
+            distance,
+            speed_mps,
+            timeout_s: f64::INFINITY,
+            end,
+            hooks: Hooks::default(),
+            mark: Pose2::default(),
+            started: 0.0,
+            goal: 0.0,
+        }
+    }
+
+    /// Ends the leg after `seconds` even short of its distance.
+    pub fn timeout(mut self, seconds: f64) -> Self {
+        self.timeout_s = seconds;
+        self
+    }
+
+    /// With `hooks`.
+    pub fn hooks(mut self, hooks: Hooks<M>) -> Self {
+        self.hooks = hooks;
+        self
+    }
+}
+
+impl<M: Motion> Behavior<M> for BackOff<M> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn enter(&mut self, m: &mut M, inputs: &Inputs<'_>) {
+        (self.hooks.enter)(m);
+        self.started = inputs.now;
+        self.mark = m.odo();
+        self.goal = match &self.distance {
+            Distance::Fixed(d) => *d,
+            Distance::AtEntry(f) => f(m),
+        };
+    }
+
+    fn tick(&mut self, m: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
+        (self.hooks.each)(m, inputs);
+        if m.odo().distance(&self.mark) < self.goal && m.now() - self.started <= self.timeout_s {
+            return Some(m.back_off(self.speed_mps, self.phase));
+        }
+        (self.hooks.end)(m);
+        Some(match self.end {
+            End::Event(e) => m.hold(self.phase).with_event(e),
+            End::Fail(why) => {
+                let reason = why(m);
+                m.hold(self.phase).finishing(Outcome::Failed(reason))
+            }
+        })
+    }
+}
+
+/// The drive leg of a turn–drive–turn: with the heading already facing the target
+/// point (either end leading), drive straight until it is abeam (the signed distance to
+/// it along the heading under `abeam_m`: a point off the line of travel is never
+/// reached exactly), slowing so as not to overshoot in one tick. Ends with `abeam`, or
+/// with `arrived` once within `arrive_m` of the point.
+pub struct DriveAbeam<M> {
+    name: String,
+    phase: &'static str,
+    target: TargetFn<M>,
+    speed_mps: f64,
+    tick_s: f64,
+    arrive_m: f64,
+    abeam_m: f64,
+}
+
+impl<M: Motion> DriveAbeam<M> {
+    /// A leaf named `name` (feedback `phase`) driving at up to `speed_mps` (the loop
+    /// ticks every `tick_s`) toward the point `target` reads (`None`: stand still).
+    pub fn new(
+        name: &str,
+        phase: &'static str,
+        target: TargetFn<M>,
+        speed_mps: f64,
+        tick_s: f64,
+        arrive_m: f64,
+        abeam_m: f64,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            phase,
+            target,
+            speed_mps,
+            tick_s,
+            arrive_m,
+            abeam_m,
+        }
+    }
+}
+
+impl<M: Motion> Behavior<M> for DriveAbeam<M> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn tick(&mut self, m: &mut M, _inputs: &Inputs<'_>) -> Option<Step> {
+        let Some(target) = (self.target)(m) else {
+            return Some(m.hold(self.phase));
+        };
+        let odo = m.odo();
+        let (dx, dy) = (target.x - odo.x, target.y - odo.y);
+        if dx.hypot(dy) < self.arrive_m {
+            return Some(m.hold(self.phase).with_event("arrived"));
+        }
+        let along = dx * odo.theta.cos() + dy * odo.theta.sin();
+        if along.abs() < self.abeam_m {
+            return Some(m.hold(self.phase).with_event("abeam"));
+        }
+        let v = self.speed_mps.min(along.abs() / self.tick_s).copysign(along);
+        Some(m.straight(v, self.phase))
+    }
+}
+
+/// The heading that faces `target` from `odo` with whichever end of the robot turns
+/// less to lead toward it; [`Aim::Reached`]`("arrived")` within `arrive_m` of it.
+pub fn face(odo: &Pose2, target: &Pose2, arrive_m: f64) -> Aim {
+    let (dx, dy) = (target.x - odo.x, target.y - odo.y);
+    if dx.hypot(dy) < arrive_m {
+        return Aim::Reached("arrived");
+    }
+    let bearing = dy.atan2(dx);
+    let forward = wrap_angle(bearing - odo.theta).abs() <= std::f64::consts::FRAC_PI_2;
+    Aim::Heading(if forward {
+        bearing
+    } else {
+        bearing + std::f64::consts::PI
+    })
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::geometry::Twist;
+    use crate::schemas::{DriveCommand, Feedback, MotorOutput, Status};
+
+    /// A base driven by script: each tick the test moves it; it records what the legs
+    /// command.
+    #[derive(Default)]
+    pub struct Base {
+        pub now: f64,
+        pub odo: Pose2,
+        pub ends: u32,
+    }
+
+    impl Motion for Base {
+        fn now(&self) -> f64 {
+            self.now
+        }
+        fn odo(&self) -> Pose2 {
+            self.odo
+        }
+        fn hold(&mut self, phase: &'static str) -> Step {
+            Step::running(MotorOutput::stop(), Feedback::new(phase, self.now))
+        }
+        fn turn_toward(&mut self, heading: f64, tolerance: Option<f64>, phase: &'static str) -> Option<Step> {
+            let err = wrap_angle(heading - self.odo.theta);
+            (err.abs() >= tolerance.unwrap_or(0.05)).then(|| {
+                Step::running(
+                    MotorOutput::drive(DriveCommand::Turn { omega: err }),
+                    Feedback::new(phase, 0.0),
+                )
+            })
+        }
+        fn straight(&mut self, v: f64, phase: &'static str) -> Step {
+            Step::running(
+                MotorOutput::drive(DriveCommand::Straight { v }),
+                Feedback::new(phase, 0.0),
+            )
+        }
+        fn back_off(&mut self, speed: f64, phase: &'static str) -> Step {
+            self.straight(-speed, phase)
+        }
+    }
+
+    /// Runs `leaf` on `base` for up to `ticks` ticks of 0.1 s, moving the base by what
+    /// it commands; returns the status that ended it and the ticks it took.
+    pub fn run<B: Behavior<Base>>(leaf: &mut B, base: &mut Base, ticks: usize) -> (Status, usize) {
+        leaf.enter(base, &Inputs::empty(base.now));
+        for i in 0..ticks {
+            base.now += 0.1;
+            let step = leaf.tick(base, &Inputs::empty(base.now)).expect("a leg always steps");
+            if step.status != Status::Running {
+                return (step.status, i + 1);
+            }
+            let twist = match step.output.drive {
+                DriveCommand::Turn { omega } => Twist::new(0.0, omega),
+                DriveCommand::Straight { v } => Twist::new(v, 0.0),
+                _ => Twist::new(0.0, 0.0),
+            };
+            base.odo = crate::geometry::integrate_twist(&base.odo, &twist, 0.1);
+        }
+        (Status::Running, ticks)
+    }
+
+    #[test]
+    fn turn_to_reaches_the_heading_and_ends_with_its_event() {
+        let mut base = Base::default();
+        let aim: AimFn<Base> = Box::new(|_| Aim::Heading(1.0));
+        let mut leg = TurnTo::new("turn", "turn", aim, Some(0.02), "turned").hooks(Hooks {
+            end: |b: &mut Base| b.ends += 1,
+            ..Hooks::default()
+        });
+        let (status, ticks) = run(&mut leg, &mut base, 200);
+        assert_eq!(status, Status::Event("turned"));
+        assert!((base.odo.theta - 1.0).abs() < 0.02, "{}", base.odo.theta);
+        assert!(ticks > 5, "a proportional turn takes time: {ticks}");
+        assert_eq!(base.ends, 1, "the end hook ran once");
+    }
+
+    #[test]
+    fn turn_to_gives_up_after_its_timeout_and_holds_without_an_aim() {
+        // A heading it never reaches (the base does not move: run() is bypassed).
+        let mut base = Base::default();
+        let aim: AimFn<Base> = Box::new(|_| Aim::Heading(2.0));
+        let mut leg = TurnTo::new("turn", "turn", aim, Some(0.01), "turned").timeout(0.5);
+        leg.enter(&mut base, &Inputs::empty(0.0));
+        let mut ended = None;
+        for i in 1..20 {
+            base.now = i as f64 * 0.1;
+            let now = base.now;
+            let step = leg.tick(&mut base, &Inputs::empty(now)).unwrap();
+            if step.status != Status::Running {
+                ended = Some((i, step.status));
+                break;
+            }
+        }
+        assert_eq!(
+            ended,
+            Some((6, Status::Event("turned"))),
+            "ends on the first tick past 0.5 s"
+        );
+        let aim: AimFn<Base> = Box::new(|_| Aim::Hold);
+        let mut idle = TurnTo::new("idle", "idle", aim, None, "turned");
+        let (status, _) = run(&mut idle, &mut base, 30);
+        assert_eq!(status, Status::Running, "no aim: it stands and waits");
+    }
+
+    #[test]
+    fn back_off_covers_its_distance_or_its_time() {
+        let mut base = Base::default();
+        let mut leg = BackOff::new("away", "away", Distance::Fixed(0.3), 0.1, End::Event("done"));
+        let (status, ticks) = run(&mut leg, &mut base, 100);
+        assert_eq!(status, Status::Event("done"));
+        assert!((base.odo.x + 0.3).abs() < 1e-9, "backed 0.3 m: {}", base.odo.x);
+        assert_eq!(ticks, 31, "30 ticks of 1 cm, then the end");
+        // The same leg bounded by 1 s ends short, failed for the memory's reason.
+        let mut base = Base::default();
+        let why: fn(&Base) -> FailureReason = |_| FailureReason::TargetLost;
+        let mut leg = BackOff::new(
+            "give_up",
+            "give_up",
+            Distance::AtEntry(Box::new(|_| 0.3)),
+            0.1,
+            End::Fail(why),
+        )
+        .timeout(1.0);
+        let (status, _) = run(&mut leg, &mut base, 100);
+        assert_eq!(status, Status::Done(Outcome::Failed(FailureReason::TargetLost)));
+        assert!(base.odo.x > -0.15, "stopped by the time limit: {}", base.odo.x);
+    }
+
+    #[test]
+    fn turn_drive_turn_reaches_a_staging_pose_from_many_starts() {
+        // The three legs in sequence, as a profile's sequencer runs them.
+        let target = Pose2::new(1.0, 0.5, 0.3);
+        for (x, y, th) in [(0.0, 0.0, 0.0), (2.0, -1.0, 2.5), (1.5, 1.5, -2.0), (-0.5, 0.4, 3.0)] {
+            let mut base = Base {
+                odo: Pose2::new(x, y, th),
+                ..Base::default()
+            };
+            let face_aim: AimFn<Base> = Box::new(move |b| face(&b.odo, &target, 0.03));
+            let (s, _) = run(
+                &mut TurnTo::new("face", "f", face_aim, Some(0.01), "faced"),
+                &mut base,
+                400,
+            );
+            assert!(matches!(s, Status::Event("faced" | "arrived")), "{s:?}");
+            let mut drive = DriveAbeam::new("drive", "d", Box::new(move |_| Some(target)), 0.1, 0.1, 0.03, 0.005);
+            let (s, _) = run(&mut drive, &mut base, 400);
+            assert!(matches!(s, Status::Event("abeam" | "arrived")), "{s:?}");
+            let align: AimFn<Base> = Box::new(move |_| Aim::Heading(target.theta));
+            let (s, _) = run(
+                &mut TurnTo::new("align", "a", align, Some(0.01), "aligned"),
+                &mut base,
+                400,
+            );
+            assert_eq!(s, Status::Event("aligned"));
+            let off = base.odo.distance(&target);
+            assert!(off < 0.03, "from ({x}, {y}, {th}) ended {off} m off");
+            assert!(wrap_angle(base.odo.theta - target.theta).abs() < 0.01);
+        }
+    }
+}
