@@ -8,6 +8,7 @@ mod common;
 
 mod arbiter;
 mod bujold_phases;
+mod common_leaves;
 mod components_prop;
 mod decision_trace;
 mod lockstep;
