@@ -10,6 +10,8 @@ mod arbiter;
 mod bujold_phases;
 mod components_prop;
 mod decision_trace;
+mod krawler_kind;
+mod krawler_leaves;
 mod lockstep;
 mod no_alloc;
 mod raposa_phases;

@@ -25,13 +25,12 @@ use crate::geometry::Pose2;
 use crate::kinematics::ackermann::DoubleAckermann;
 use crate::perception::RgbImage;
 use crate::perception::krawler::{
-    AxleGeometry, AxleState, ExpectedMarker, GearLayout, KrawlerEstimate, KrawlerParams, KrawlerStateSchema,
-    SteeringPoly,
+    AxleGeometry, ExpectedMarker, GearGeometry, KrawlerEstimate, KrawlerParams, KrawlerStateSchema, SteeringPoly,
 };
 use crate::profile::Profile;
 use crate::report::plot::{Series, paths_svg, time_series_svg};
 use crate::sim::camera::camera_pose;
-use crate::sim::krawler::{GearExtras, GroundPose, KrawlerState, build_with, expected_markers};
+use crate::sim::krawler::{GearExtras, GroundPose, build_with};
 use crate::sim::krawler_sequence::{LightChange, SequenceSpec, TruthFrame, drive_of, generate, odometry, shaken};
 use crate::sim::render::{CameraPose, Renderer, SensorParams};
 use crate::sim::rng::Rng;
@@ -350,18 +349,21 @@ fn run_frames(
     let pe = |e: &dyn std::fmt::Display| format!("profile `{}`: {e}", profile.name);
     let cam = profile.cameras.first().ok_or_else(|| pe(&"no camera"))?;
     let geometry = AxleGeometry::from_profile(profile, 0).map_err(|e| pe(&e))?;
-    let layout = GearLayout::from_profile(profile).map_err(|e| pe(&e))?;
+    let gear_spec = crate::behaviors::krawler::gear_spec(profile).map_err(|e| pe(&e))?;
+    let gear = GearGeometry::from_profile(profile, gear_spec).map_err(|e| pe(&e))?;
     let polys = SteeringPoly::from_profile(profile)
         .ok_or_else(|| pe(&"no `markers` fiducial steering_poly_deg: run `marsupial calibrate-steering --write`"))?;
-    let rest = KrawlerState::rest(profile).map_err(|e| pe(&e))?;
-    let start = expected_markers(profile, &rest).map_err(|e| pe(&e))?;
-    let axles = [0, 1].map(|a| AxleState {
-        roll: rest.roll[a],
-        drop: rest.drop[a],
-        steer: rest.steer[a],
-    });
+    let side = profile
+        .fiducial
+        .get::<crate::profile::MarkersSpec>()
+        .copied()
+        .map_or(0.03, |m| m.side_m);
+    // The estimator starts from its own model of the gear at rest, not the simulator's.
+    let (start, axles) = gear
+        .start(&geometry, side)
+        .ok_or_else(|| pe(&"a marker of the gear at rest does not project into the camera"))?;
     let (w, h) = (cam.width_px, cam.height_px);
-    let mut schema = KrawlerStateSchema::new((w, h), geometry.clone(), layout, polys, params, start, axles);
+    let mut schema = KrawlerStateSchema::new((w, h), geometry.clone(), gear.layout(), polys, params, start, axles);
     let mut renderer = Renderer::new(geometry.model.clone(), w, h, seed);
     let base = camera_pose(&Pose2::new(0.0, 0.0, 0.0), &cam.mount);
     let dt = truth.get(1).map_or(1.0 / cam.fps, |f| f.t - truth[0].t);
@@ -369,11 +371,6 @@ fn run_frames(
         frame_interval_s: dt as f32,
         ..SensorParams::default()
     };
-    let side = profile
-        .fiducial
-        .get::<crate::profile::MarkersSpec>()
-        .copied()
-        .map_or(0.03, |m| m.side_m);
     let knobs = spec.errors;
     // The rover's true path over the floor, when the floor is fixed to the world.
     let ground = match (knobs.moving_ground, drive_of(profile)) {
