@@ -16,6 +16,7 @@ use crate::perception::{
     AxleGeometry, GearGeometry, GearSpec, KrawlerEstimate, KrawlerParams, KrawlerStateSchema, SteeringPoly, VisionError,
 };
 use crate::profile::Profile;
+use serde::Serialize;
 
 /// A RANSAC index draw: an index below its argument.
 pub type Draw = Box<dyn FnMut(usize) -> usize + Send>;
@@ -33,6 +34,47 @@ pub struct KrawlerPercept {
     pub frames: u64,
     /// Frames the estimator refused (another size than the profile's camera).
     pub refused: u64,
+}
+
+impl KrawlerPercept {
+    /// The percept as recorders and replays show it.
+    pub fn observation(&self) -> KrawlerObservation {
+        let e = &self.estimate;
+        KrawlerObservation {
+            stamp: self.stamp,
+            fresh: self.fresh,
+            markers: e.markers.at,
+            roll_rad: e.roll.map(|d| d.value),
+            drop_m: e.drop.map(|d| d.value),
+            steer_rad: e.steer.map(|d| d.value),
+            wheel_rad: e.wheel.map(|d| d.value),
+            wheel_measured: e.wheel.map(|d| d.valid),
+        }
+    }
+}
+
+/// A [`KrawlerPercept`] for recorders and replays
+/// ([`ObservedPercept::Krawler`](super::ObservedPercept::Krawler)): the ten degrees of
+/// freedom and the markers found.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct KrawlerObservation {
+    /// The frame's stamp, s.
+    pub stamp: f64,
+    /// A new frame was estimated this tick.
+    pub fresh: bool,
+    /// Each marker's centre found this frame, px (front plate left, right; front tie rod
+    /// left, right; then the rear's).
+    pub markers: [Option<[f64; 2]>; 8],
+    /// Axle roll ψ (front, rear), rad.
+    pub roll_rad: [f64; 2],
+    /// Camera-to-axle drop d (front, rear), m.
+    pub drop_m: [f64; 2],
+    /// Steering λ (front, rear), rad.
+    pub steer_rad: [f64; 2],
+    /// Wheel rotations θ (FL, FR, RL, RR) from the first frame, rad.
+    pub wheel_rad: [f64; 4],
+    /// Whether this frame measured each wheel's step.
+    pub wheel_measured: [bool; 4],
 }
 
 impl Percept for KrawlerPercept {

@@ -31,7 +31,7 @@ pub use avoid::AvoidObstacles;
 pub use behavior::{Behavior, FailureReason, Feedback, Outcome, Presence, SchemaBehavior, Status, Step};
 pub use goto_point::PointController;
 pub use inputs::{CameraInput, CameraInputs, Inputs, OdometryReading, SensorInput, SensorInputs, TetherReading};
-pub use krawler::{KrawlerPercept, KrawlerSchema};
+pub use krawler::{KrawlerObservation, KrawlerPercept, KrawlerSchema};
 pub use mission::{Agent, AgentStats, Mission, MissionError};
 pub use motor_output::{Auxiliary, DriveCommand, Guides, MotorOutput, Posture, TetherCommand};
 pub use observation::{ColourRanges, Observation, ObservedPercept};

@@ -3,7 +3,9 @@
 
 use super::slip::SlipReading;
 use crate::behaviors::SharedMemory;
-use crate::schemas::{Inputs, KrawlerPercept, KrawlerSchema, Mission, MissionError, PerceptualSchema};
+use crate::schemas::{
+    Inputs, KrawlerPercept, KrawlerSchema, Mission, MissionError, Observation, ObservedPercept, PerceptualSchema,
+};
 
 /// Called with each fresh estimate (for a consumer off the tree: a log, a table).
 pub type Observer = Box<dyn FnMut(&KrawlerPercept) + Send>;
@@ -57,6 +59,15 @@ impl SharedMemory for KrawlerMemory {
         {
             o(&self.percept);
         }
+    }
+
+    /// The estimate, for recorders and replays.
+    fn observe(&self) -> Option<Observation> {
+        Some(Observation {
+            camera: 0,
+            percept: ObservedPercept::Krawler(self.percept.observation()),
+            ranges: None,
+        })
     }
 
     /// A new mission starts with nothing commanded and no slip judged; the estimate goes

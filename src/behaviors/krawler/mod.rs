@@ -81,6 +81,38 @@ pub fn gear_spec(profile: &Profile) -> Result<GearSpec, BuildError> {
     }
 }
 
+/// The estimator of `profile` as `tuning` sets it up.
+fn schema_with(profile: &Profile, tuning: &KrawlerRobot) -> Result<KrawlerSchema, String> {
+    let mut params = KrawlerParams::default();
+    params.mount.enabled = tuning.mount_compensation;
+    KrawlerSchema::from_profile(profile, tuning.gear, params, tuning.ransac_seed).map_err(|e| e.to_string())
+}
+
+/// The state estimator of an AutoKrawler `profile` alone, as its robot runs it (its
+/// `[robot]` tuning, or the defaults for a profile without `[robot]`): what a replay of
+/// its perception runs.
+///
+/// # Errors
+/// As [`gear_spec`], and [`BuildError::Profile`] for what the estimator lacks (a camera,
+/// the `markers` fiducial's steering calibration).
+pub fn schema(profile: &Profile) -> Result<KrawlerSchema, BuildError> {
+    let tuning = match &profile.robot {
+        None => KrawlerRobot {
+            gear: GearSpec::default(),
+            mount_compensation: true,
+            ransac_seed: 0,
+        },
+        Some(_) => {
+            gear_spec(profile)?;
+            super::catalog::tuning::<Krawler>(profile)?
+        }
+    };
+    schema_with(profile, &tuning).map_err(|what| BuildError::Profile {
+        profile: profile.name.clone(),
+        what,
+    })
+}
+
 /// The AutoKrawler's robot, typed: its memory stays reachable
 /// ([`Composed::memory_mut`], to watch each estimate), which the catalog's boxed agent
 /// hides.
@@ -105,15 +137,11 @@ impl RobotKind for Krawler {
     type Memory = KrawlerMemory;
 
     fn memory(&self, profile: &Profile, tuning: &KrawlerRobot) -> Result<KrawlerMemory, String> {
-        let mut params = KrawlerParams::default();
-        params.mount.enabled = tuning.mount_compensation;
-        let schema =
-            KrawlerSchema::from_profile(profile, tuning.gear, params, tuning.ransac_seed).map_err(|e| e.to_string())?;
         let radius = profile
             .drive
             .wheel_radius_m
             .ok_or("needs drive.wheel_radius_m (the commanded wheel rotation is the speed over it)")?;
-        Ok(KrawlerMemory::new(schema, radius))
+        Ok(KrawlerMemory::new(schema_with(profile, tuning)?, radius))
     }
 
     fn leaves(&self, registry: &mut LeafRegistry<KrawlerMemory>) {
