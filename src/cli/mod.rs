@@ -14,6 +14,8 @@ pub mod command;
 pub mod detect;
 #[cfg(feature = "sim")]
 pub mod estimate;
+mod estimate_frames;
+pub mod estimate_runtime;
 #[cfg(feature = "sim")]
 pub mod merge;
 #[cfg(feature = "sim")]
