@@ -6,7 +6,7 @@
 use crate::common;
 
 use marsupial::cli::estimate::{DOF_NAMES, EstimateOptions, estimate, run};
-use marsupial::cli::estimate_runtime::estimate_runtime;
+use marsupial::cli::estimate_runtime::{RuntimePath, estimate_runtime, estimate_threads};
 use marsupial::sim::krawler_sequence::SequenceSpec;
 use std::path::{Path, PathBuf};
 
@@ -45,7 +45,7 @@ fn the_command_writes_its_files_with_sane_errors() {
         profile: profile_path(),
         json: false,
         no_mount_compensation: false,
-        runtime: false,
+        runtime: None,
     };
     let mut printed = Vec::new();
     let s = run(&opts, &mut printed).unwrap();
@@ -138,7 +138,7 @@ fn bad_sequence_files_name_the_field() {
         profile: profile_path(),
         json: true,
         no_mount_compensation: false,
-        runtime: false,
+        runtime: None,
     };
     let e = run(&opts, &mut Vec::new()).unwrap_err();
     assert!(e.contains("missing.toml"), "{e}");
@@ -260,7 +260,7 @@ fn the_loop_gives_the_offline_table_bit_for_bit() {
         profile: profile_path(),
         json: false,
         no_mount_compensation: false,
-        runtime: true,
+        runtime: Some(RuntimePath::Lockstep),
     };
     let mut printed = Vec::new();
     run(&opts, &mut printed).unwrap();
@@ -270,4 +270,22 @@ fn the_loop_gives_the_offline_table_bit_for_bit() {
         "{printed}"
     );
     assert!(printed.contains("same figures as offline: yes"), "{printed}");
+}
+
+/// Table I on the threaded runtime (`estimate --runtime threads`): every frame reaches
+/// the robot's perceptual schema in order, in real time, and the figures are the offline
+/// run's bit for bit.
+#[test]
+fn the_threaded_runtime_gives_the_offline_table_bit_for_bit() {
+    let profile = common::shipped_profile("autokrawler");
+    let spec = SequenceSpec::parse(&short(1.5, "[errors]\nframe_drop = 0.1\n"), Path::new("short.toml")).unwrap();
+    let params = marsupial::perception::KrawlerParams::default();
+    let offline = estimate(&spec, &profile, 7).unwrap().summary;
+    let threads = estimate_threads(&spec, &profile, 7, params).unwrap().summary;
+    assert_eq!(threads.via, "threads");
+    let mut a = offline.to_json();
+    let mut b = threads.to_json();
+    a["via"] = serde_json::Value::Null;
+    b["via"] = serde_json::Value::Null;
+    assert_eq!(a.to_string(), b.to_string());
 }

@@ -58,12 +58,12 @@ pub struct EstimateOptions {
     /// mount, as the paper does): for before/after figures.
     #[arg(long)]
     pub no_mount_compensation: bool,
-    /// Also estimate through the robot's loop (the `krawler` robot's perceptual schema,
-    /// ticked in lockstep on its belly camera's frames; `estimate_runtime`) and print its
-    /// Table I row beside the offline one, with the slip monitor's figures. `--out` and
-    /// `--json` get the offline run's.
-    #[arg(long)]
-    pub runtime: bool,
+    /// Also estimate through the robot's loop (the `krawler` robot's perceptual schema on
+    /// its belly camera's frames, `estimate_runtime`): ticked in `lockstep` (the default;
+    /// with the slip monitor's figures) or on the `threads` of the runtime in real time,
+    /// and print its Table I row beside the offline one. `--out` gets the offline run's.
+    #[arg(long, value_enum, value_name = "LOOP", num_args = 0..=1, default_missing_value = "lockstep")]
+    pub runtime: Option<super::estimate_runtime::RuntimePath>,
 }
 
 /// The ten degrees of freedom's names, in [`KrawlerState`] order.
@@ -215,14 +215,14 @@ impl EstimateSummary {
         let _ = writeln!(s, "Table I (MAE; drift in rad), ours beside the paper's");
         let _ = writeln!(
             s,
-            "{:<22} {:>5}  {:>7} {:>7} {:>8} {:>8} {:>10}",
+            "{:<26} {:>5}  {:>7} {:>7} {:>8} {:>8} {:>10}",
             "dataset", "s", "roll F", "roll R", "steer F", "steer R", "max drift"
         );
         if let Some(d) = self.paper_dataset {
             let (len, m, drift) = PAPER_TABLE_I[d - 1];
             let _ = writeln!(
                 s,
-                "{:<22} {:>5.0}  {:>6.2}° {:>6.2}° {:>7.2}° {:>7.2}° {:>10.2}",
+                "{:<26} {:>5.0}  {:>6.2}° {:>6.2}° {:>7.2}° {:>7.2}° {:>10.2}",
                 format!("paper {d}"),
                 len,
                 m[0],
@@ -234,7 +234,7 @@ impl EstimateSummary {
         }
         let _ = writeln!(
             s,
-            "{:<22} {:>5.0}  {:>6.2}° {:>6.2}° {:>7.2}° {:>7.2}° {:>10.2}",
+            "{:<26} {:>5.0}  {:>6.2}° {:>6.2}° {:>7.2}° {:>7.2}° {:>10.2}",
             format!("ours {} ({})", self.sequence, self.via),
             self.duration_s,
             self.dof[0].mae,
@@ -246,7 +246,7 @@ impl EstimateSummary {
         let (roll, steer, drift) = TARGETS;
         let _ = writeln!(
             s,
-            "{:<22} {:>5}  {:>6.1}° {:>6.1}° {:>7.1}° {:>7.1}° {:>10.1}",
+            "{:<26} {:>5}  {:>6.1}° {:>6.1}° {:>7.1}° {:>7.1}° {:>10.1}",
             "target (≤)", "", roll, roll, steer, steer, drift
         );
         let _ = writeln!(
@@ -637,9 +637,16 @@ pub fn run(opts: &EstimateOptions, out: &mut dyn Write) -> Result<EstimateSummar
         )
         .map_err(w)?;
     }
-    if opts.runtime {
+    if let Some(path) = opts.runtime {
+        use super::estimate_runtime::{RuntimePath, estimate_runtime, estimate_threads};
         let started = std::time::Instant::now();
-        let (rt, slip) = super::estimate_runtime::estimate_runtime(&spec, &profile, seed, params)?;
+        let (rt, slip) = match path {
+            RuntimePath::Lockstep => {
+                let (rt, slip) = estimate_runtime(&spec, &profile, seed, params)?;
+                (rt, Some(slip))
+            }
+            RuntimePath::Threads => (estimate_threads(&spec, &profile, seed, params)?, None),
+        };
         let elapsed = started.elapsed().as_secs_f64();
         let (a, b) = (&result.summary, &rt.summary);
         // Bit for bit (a DOF never valid has a NaN valid-frame MAE on both paths).
@@ -648,13 +655,17 @@ pub fn run(opts: &EstimateOptions, out: &mut dyn Write) -> Result<EstimateSummar
             && a.drift_max.to_bits() == b.drift_max.to_bits()
             && a.dof.iter().zip(&b.dof).all(|(x, y)| bits(x) == bits(y));
         if opts.json {
-            let j = serde_json::json!({"runtime": b.to_json(), "slip": {"windows": slip.windows,
-                "alarms": slip.alarms, "max_disagreement_rad": slip.max_disagreement_rad}, "same_as_offline": same});
+            let slip = slip.map(|s| {
+                serde_json::json!({"windows": s.windows, "alarms": s.alarms,
+                    "max_disagreement_rad": s.max_disagreement_rad})
+            });
+            let j = serde_json::json!({"runtime": b.to_json(), "slip": slip, "same_as_offline": same});
             writeln!(out, "{j}").map_err(w)?;
         } else {
             writeln!(
                 out,
-                "\nthrough the loop (lockstep, the krawler robot's perceptual schema):"
+                "\nthrough the loop ({}, the krawler robot's perceptual schema):",
+                b.via
             )
             .map_err(w)?;
             write!(out, "{}", b.table()).map_err(w)?;
@@ -667,12 +678,14 @@ pub fn run(opts: &EstimateOptions, out: &mut dyn Write) -> Result<EstimateSummar
                 if same { "yes" } else { "no" }
             )
             .map_err(w)?;
-            writeln!(
-                out,
-                "slip monitor (encoder reference): {} windows judged, {} alarms, largest disagreement {:.3} rad",
-                slip.windows, slip.alarms, slip.max_disagreement_rad
-            )
-            .map_err(w)?;
+            if let Some(s) = slip {
+                writeln!(
+                    out,
+                    "slip monitor (encoder reference): {} windows judged, {} alarms, largest disagreement {:.3} rad",
+                    s.windows, s.alarms, s.max_disagreement_rad
+                )
+                .map_err(w)?;
+            }
         }
     }
     Ok(result.summary)
