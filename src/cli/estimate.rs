@@ -66,7 +66,7 @@ pub struct EstimateOptions {
     pub runtime: Option<super::estimate_runtime::RuntimePath>,
 }
 
-/// The ten degrees of freedom's names, in [`KrawlerState`] order.
+/// The ten degrees of freedom's names, in [`KrawlerState`](crate::sim::krawler::KrawlerState) order.
 pub const DOF_NAMES: [&str; 10] = [
     "roll_f", "roll_r", "drop_f", "drop_r", "steer_f", "steer_r", "theta_fl", "theta_fr", "theta_rl", "theta_rr",
 ];

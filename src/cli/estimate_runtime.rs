@@ -1,5 +1,5 @@
 //! `marsupial estimate --runtime`: Table I through the robot's loop. The sequence's
-//! frames are the `krawler` robot's belly camera ([`SequenceFrames`], the same pixels as
+//! frames are the `krawler` robot's belly camera (`cli::estimate_frames`, the same pixels as
 //! the offline run), its encoders report the sequence's true speed, and [`Lockstep`]
 //! ticks the robot built from the profile (its memory's perceptual schema, the
 //! estimator, and its tree) once per frame at the frame's time. Each estimate is taken

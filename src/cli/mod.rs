@@ -14,7 +14,9 @@ pub mod command;
 pub mod detect;
 #[cfg(feature = "sim")]
 pub mod estimate;
+#[cfg(feature = "sim")]
 mod estimate_frames;
+#[cfg(feature = "sim")]
 pub mod estimate_runtime;
 #[cfg(feature = "sim")]
 pub mod merge;

@@ -49,7 +49,7 @@ impl Traverse {
             ));
         }
         if let Some(d) = params.duration_s
-            && !(d > 0.0)
+            && !(d.is_finite() && d > 0.0)
         {
             return Err(format!("params.duration_s: expected a positive number of s, got {d}"));
         }
