@@ -427,7 +427,7 @@ fn bench_krawler(c: &mut Criterion) {
         })
     });
     let mount = marsupial::perception::krawler::MountParams::default();
-    let half_spacing = marsupial::perception::krawler::rotation::PLATE_MARKER_Y_M;
+    let half_spacing = marsupial::perception::krawler::GearSpec::default().plate_marker_y_m;
     g.bench_function("mount_fit_four_plate_markers", |b| {
         b.iter(|| {
             let plate = [at[0], at[1], at[4], at[5]].map(Some);
@@ -497,13 +497,14 @@ fn bench_krawler_state(
     frames: &[marsupial::perception::RgbImage; 2],
 ) {
     use marsupial::perception::krawler::{
-        AxleGeometry, AxleState, GearLayout, KrawlerParams, KrawlerStateSchema, SteeringPoly, WheelParams,
+        AxleGeometry, AxleState, GearGeometry, KrawlerParams, KrawlerStateSchema, SteeringPoly, WheelParams,
         WheelTracker, ransac_angle,
     };
     use marsupial::sim::krawler::{KrawlerState, expected_markers};
     let (w, h) = (p.cameras[0].width_px, p.cameras[0].height_px);
     let geometry = AxleGeometry::from_profile(p, 0).expect("geometry");
-    let layout = GearLayout::from_profile(p).expect("layout");
+    let gear = marsupial::behaviors::krawler::gear_spec(p).expect("gear");
+    let layout = GearGeometry::from_profile(p, gear).expect("layout").layout();
     let rest = KrawlerState::rest(p).expect("rest");
     let axles = [0, 1].map(|a| AxleState {
         roll: [0.05, -0.03][a],

@@ -12,6 +12,7 @@ mod campaign_resume;
 mod detect_cli;
 mod dock_cli;
 mod krawler_estimate;
+mod krawler_replay;
 mod lighting_random;
 mod odometry_calibration;
 mod profile_errors;

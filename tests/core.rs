@@ -11,6 +11,8 @@ mod bujold_phases;
 mod common_leaves;
 mod components_prop;
 mod decision_trace;
+mod krawler_kind;
+mod krawler_leaves;
 mod lockstep;
 mod no_alloc;
 mod raposa_phases;

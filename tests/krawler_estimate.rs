@@ -6,6 +6,7 @@
 use crate::common;
 
 use marsupial::cli::estimate::{DOF_NAMES, EstimateOptions, estimate, run};
+use marsupial::cli::estimate_runtime::{RuntimePath, estimate_runtime, estimate_threads};
 use marsupial::sim::krawler_sequence::SequenceSpec;
 use std::path::{Path, PathBuf};
 
@@ -44,6 +45,7 @@ fn the_command_writes_its_files_with_sane_errors() {
         profile: profile_path(),
         json: false,
         no_mount_compensation: false,
+        runtime: None,
     };
     let mut printed = Vec::new();
     let s = run(&opts, &mut printed).unwrap();
@@ -136,6 +138,7 @@ fn bad_sequence_files_name_the_field() {
         profile: profile_path(),
         json: true,
         no_mount_compensation: false,
+        runtime: None,
     };
     let e = run(&opts, &mut Vec::new()).unwrap_err();
     assert!(e.contains("missing.toml"), "{e}");
@@ -215,4 +218,74 @@ fn scenario_is_another_name_for_sequence() {
     assert_eq!(by_sequence["frames"], 30, "{by_sequence}");
     assert_eq!(summary("--scenario"), by_sequence);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Table I through the robot's loop (`estimate --runtime`): the `krawler` robot's
+/// perceptual schema, ticked in lockstep on its camera's frames, gives the offline run's
+/// figures bit for bit, lost frames and mud included, and its slip monitor, on the
+/// encoders, raises no alarm on a gear that never slips.
+#[test]
+fn the_loop_gives_the_offline_table_bit_for_bit() {
+    let profile = common::shipped_profile("autokrawler");
+    let spec = SequenceSpec::parse(
+        &short(
+            3.0,
+            "[errors]\nframe_drop = 0.1\nmud = { marker = 2, start_s = 1.0, duration_s = 0.5 }\n",
+        ),
+        Path::new("short.toml"),
+    )
+    .unwrap();
+    let params = marsupial::perception::KrawlerParams::default();
+    let offline = estimate(&spec, &profile, 5).unwrap().summary;
+    let (rt, slip) = estimate_runtime(&spec, &profile, 5, params).unwrap();
+    let rt = rt.summary;
+    assert!(offline.delivered < offline.frames, "frames were dropped");
+    assert_eq!((offline.via, rt.via), ("offline", "lockstep"));
+    assert_eq!(rt.delivered, offline.delivered);
+    let mut a = offline.to_json();
+    let mut b = rt.to_json();
+    a["via"] = serde_json::Value::Null;
+    b["via"] = serde_json::Value::Null;
+    assert_eq!(a.to_string(), b.to_string());
+    assert!(slip.windows >= 2, "{slip:?}");
+    assert_eq!(slip.alarms, 0, "{slip:?}");
+    // Through the command: both rows printed.
+    let dir = tmp("runtime");
+    let seq = dir.join("short.toml");
+    std::fs::write(&seq, short(1.0, "")).unwrap();
+    let opts = EstimateOptions {
+        sequence: seq.to_string_lossy().into_owned(),
+        out: None,
+        seed: None,
+        profile: profile_path(),
+        json: false,
+        no_mount_compensation: false,
+        runtime: Some(RuntimePath::Lockstep),
+    };
+    let mut printed = Vec::new();
+    run(&opts, &mut printed).unwrap();
+    let printed = String::from_utf8(printed).unwrap();
+    assert!(
+        printed.contains("ours short (offline)") && printed.contains("ours short (lockstep)"),
+        "{printed}"
+    );
+    assert!(printed.contains("same figures as offline: yes"), "{printed}");
+}
+
+/// Table I on the threaded runtime (`estimate --runtime threads`): every frame reaches
+/// the robot's perceptual schema in order, in real time, and the figures are the offline
+/// run's bit for bit.
+#[test]
+fn the_threaded_runtime_gives_the_offline_table_bit_for_bit() {
+    let profile = common::shipped_profile("autokrawler");
+    let spec = SequenceSpec::parse(&short(1.5, "[errors]\nframe_drop = 0.1\n"), Path::new("short.toml")).unwrap();
+    let params = marsupial::perception::KrawlerParams::default();
+    let offline = estimate(&spec, &profile, 7).unwrap().summary;
+    let threads = estimate_threads(&spec, &profile, 7, params).unwrap().summary;
+    assert_eq!(threads.via, "threads");
+    let mut a = offline.to_json();
+    let mut b = threads.to_json();
+    a["via"] = serde_json::Value::Null;
+    b["via"] = serde_json::Value::Null;
+    assert_eq!(a.to_string(), b.to_string());
 }

@@ -738,3 +738,52 @@ fn krawler_state_estimation_does_not_allocate() {
     assert_eq!(allocs(), 0, "allocations in steady state");
     assert!(valid > 60, "{valid}");
 }
+
+/// The AutoKrawler robot's composed ticks (`krawler` kind): its memory's perceptual
+/// schema (the whole estimate, each frame once) and its tree (slip monitor, traverse)
+/// allocate nothing.
+#[cfg(feature = "sim")]
+#[test]
+fn composed_krawler_ticks_do_not_allocate() {
+    use common::krawler::Rig;
+    use marsupial::schemas::{Agent, Behavior, Inputs, Mission};
+    use marsupial::sim::krawler::KrawlerState;
+    use marsupial::sim::render::SensorParams;
+    let mut rig = Rig::new(SensorParams::default(), 4);
+    let frames: Vec<RgbImage> = (0..6)
+        .map(|k| {
+            let state = KrawlerState {
+                wheel: [0.02 * k as f64 + 0.5; 4],
+                ..rig.rest
+            };
+            let mut im = RgbImage::default();
+            rig.render(&state, &mut im);
+            im
+        })
+        .collect();
+    let mut robot = marsupial::behaviors::krawler::agent(&rig.profile).unwrap();
+    robot.begin(&Mission::docking()).unwrap();
+    let mut k = 0u32;
+    let mut run = |robot: &mut marsupial::behaviors::Composed<marsupial::behaviors::krawler::KrawlerMemory>| {
+        for f in &frames {
+            let t = f64::from(k) / 30.0;
+            k += 1;
+            let cameras = [Some(CameraInput {
+                stamp: t,
+                image: f.view(),
+            })];
+            let inputs = Inputs {
+                cameras: &cameras,
+                ..Inputs::empty(t)
+            };
+            assert!(robot.tick(&mut (), &inputs).is_some());
+        }
+    };
+    run(&mut robot); // warm-up
+    reset();
+    COUNTING.with(|c| c.set(true));
+    run(&mut robot);
+    COUNTING.with(|c| c.set(false));
+    assert_eq!(allocs(), 0, "allocations in steady state");
+    assert_eq!(robot.memory().percept.frames, 12);
+}

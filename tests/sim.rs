@@ -17,6 +17,7 @@ mod circles_render;
 mod dock_judge;
 mod endurance;
 mod fuzz_regressions;
+mod krawler_loop;
 mod krawler_markers;
 mod krawler_state;
 mod krawler_steering;

@@ -7,8 +7,8 @@
 //! per tick) and its leaves; the catalog composes them with the crate's common leaves into
 //! the tree the profile's `[behavior.tree]` declares ([`Composed`]).
 //!
-//! [`Catalog::shipped`] holds the papers' robots (`bujold`, `raposa`, `axel`), the crate's
-//! fiducial kinds and the `range` sensor kind. A user's crate adds its own without editing
+//! [`Catalog::shipped`] holds the papers' robots (`bujold`, `raposa`, `axel`, `krawler`),
+//! the crate's fiducial kinds and the `range` sensor kind. A user's crate adds its own without editing
 //! marsupial, and can serve them from its own `marsupial` command
 //! (`marsupial::cli::run_with`):
 //!
@@ -190,12 +190,13 @@ impl Catalog {
     }
 
     /// The crate's catalog: [`Catalog::new`] with the papers' robot kinds (`bujold`,
-    /// `raposa`, `axel`).
+    /// `raposa`, `axel`, `krawler`).
     pub fn shipped() -> Self {
         let mut c = Self::new();
         c.register_robot(super::bujold::Bujold)
             .register_robot(super::raposa::Raposa)
-            .register_robot(super::axel::Axel);
+            .register_robot(super::axel::Axel)
+            .register_robot(super::krawler::Krawler);
         c
     }
 
@@ -319,7 +320,7 @@ mod tests {
         assert_eq!(problem.path, "robot.kind");
         assert!(problem.line.is_some());
         assert!(
-            problem.message.contains("registered: axel, bujold, raposa"),
+            problem.message.contains("registered: axel, bujold, krawler, raposa"),
             "{}",
             problem.message
         );

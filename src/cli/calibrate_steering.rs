@@ -19,11 +19,11 @@
 use crate::geometry::Pose2;
 use crate::perception::RgbImage;
 use crate::perception::krawler::{
-    AxleGeometry, ExpectedMarker, MarkerFinder, MarkerParams, SteeringFit, SteeringPoly, fit_steering,
+    AxleGeometry, ExpectedMarker, GearGeometry, MarkerFinder, MarkerParams, SteeringFit, SteeringPoly, fit_steering,
 };
 use crate::profile::Profile;
 use crate::sim::camera::camera_pose;
-use crate::sim::krawler::{KrawlerState, build, expected_markers};
+use crate::sim::krawler::{KrawlerState, build};
 use crate::sim::lighting::LightState;
 use crate::sim::render::{Renderer, SensorParams};
 use std::io::Write;
@@ -207,8 +207,17 @@ pub fn calibrate(profile: &Profile, opts: &CalibrateSteeringOptions) -> Result<S
     }
     let geometry = AxleGeometry::from_profile(profile, 0).map_err(|e| e.to_string())?;
     let cam = &profile.cameras[0];
-    let rest = KrawlerState::rest(profile).map_err(|e| e.to_string())?;
-    let mut predicted = expected_markers(profile, &rest).map_err(|e| e.to_string())?;
+    // The first predictions from the estimator's own model of the gear at rest (a real
+    // sweep's frames have no simulator behind them).
+    let gear_spec = crate::behaviors::krawler::gear_spec(profile).map_err(|e| e.to_string())?;
+    let gear = GearGeometry::from_profile(profile, gear_spec).map_err(|e| e.to_string())?;
+    let side = profile
+        .fiducial
+        .get::<crate::profile::MarkersSpec>()
+        .map_or(0.03, |m| m.side_m);
+    let (mut predicted, _) = gear
+        .start(&geometry, side)
+        .ok_or("a marker of the gear at rest does not project into the camera")?;
     let mut finder = MarkerFinder::new(cam.width_px, cam.height_px, MarkerParams::default());
     let mut samples: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
     for f in &frames {

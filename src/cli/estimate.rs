@@ -21,21 +21,15 @@
 //!
 //! Truth is exact here; the paper's came from IMUs, potentiometers and an encoder.
 
-use crate::geometry::Pose2;
-use crate::kinematics::ackermann::DoubleAckermann;
+use super::estimate_frames::{SequenceFrames, steps_of, true_path};
 use crate::perception::RgbImage;
 use crate::perception::krawler::{
-    AxleGeometry, AxleState, ExpectedMarker, GearLayout, KrawlerEstimate, KrawlerParams, KrawlerStateSchema,
-    SteeringPoly,
+    AxleGeometry, GearGeometry, KrawlerEstimate, KrawlerParams, KrawlerStateSchema, SteeringPoly,
 };
 use crate::profile::Profile;
 use crate::report::plot::{Series, paths_svg, time_series_svg};
-use crate::sim::camera::camera_pose;
-use crate::sim::krawler::{GearExtras, GroundPose, KrawlerState, build_with, expected_markers};
-use crate::sim::krawler_sequence::{LightChange, SequenceSpec, TruthFrame, drive_of, generate, odometry, shaken};
-use crate::sim::render::{CameraPose, Renderer, SensorParams};
+use crate::sim::krawler_sequence::{SequenceSpec, TruthFrame, drive_of, generate, odometry};
 use crate::sim::rng::Rng;
-use nalgebra::Point3;
 use std::fmt::Write as _;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -64,9 +58,15 @@ pub struct EstimateOptions {
     /// mount, as the paper does): for before/after figures.
     #[arg(long)]
     pub no_mount_compensation: bool,
+    /// Also estimate through the robot's loop (the `krawler` robot's perceptual schema on
+    /// its belly camera's frames, `estimate_runtime`): ticked in `lockstep` (the default;
+    /// with the slip monitor's figures) or on the `threads` of the runtime in real time,
+    /// and print its Table I row beside the offline one. `--out` gets the offline run's.
+    #[arg(long, value_enum, value_name = "LOOP", num_args = 0..=1, default_missing_value = "lockstep")]
+    pub runtime: Option<super::estimate_runtime::RuntimePath>,
 }
 
-/// The ten degrees of freedom's names, in [`KrawlerState`] order.
+/// The ten degrees of freedom's names, in [`KrawlerState`](crate::sim::krawler::KrawlerState) order.
 pub const DOF_NAMES: [&str; 10] = [
     "roll_f", "roll_r", "drop_f", "drop_r", "steer_f", "steer_r", "theta_fl", "theta_fr", "theta_rl", "theta_rr",
 ];
@@ -140,6 +140,10 @@ pub struct EstimateSummary {
     pub errors: Vec<String>,
     /// Whether the estimator compensated the mount's vibration.
     pub mount_compensation: bool,
+    /// The path that estimated the frames: `offline` (each frame straight into the
+    /// estimator) or `lockstep` (the `krawler` robot's perceptual schema, each frame
+    /// delivered by its camera to the loop's tick).
+    pub via: &'static str,
 }
 
 impl EstimateSummary {
@@ -201,6 +205,7 @@ impl EstimateSummary {
             "paper": paper,
             "errors": self.errors,
             "mount_compensation": self.mount_compensation,
+            "via": self.via,
         })
     }
 
@@ -210,14 +215,14 @@ impl EstimateSummary {
         let _ = writeln!(s, "Table I (MAE; drift in rad), ours beside the paper's");
         let _ = writeln!(
             s,
-            "{:<22} {:>5}  {:>7} {:>7} {:>8} {:>8} {:>10}",
+            "{:<26} {:>5}  {:>7} {:>7} {:>8} {:>8} {:>10}",
             "dataset", "s", "roll F", "roll R", "steer F", "steer R", "max drift"
         );
         if let Some(d) = self.paper_dataset {
             let (len, m, drift) = PAPER_TABLE_I[d - 1];
             let _ = writeln!(
                 s,
-                "{:<22} {:>5.0}  {:>6.2}° {:>6.2}° {:>7.2}° {:>7.2}° {:>10.2}",
+                "{:<26} {:>5.0}  {:>6.2}° {:>6.2}° {:>7.2}° {:>7.2}° {:>10.2}",
                 format!("paper {d}"),
                 len,
                 m[0],
@@ -229,8 +234,8 @@ impl EstimateSummary {
         }
         let _ = writeln!(
             s,
-            "{:<22} {:>5.0}  {:>6.2}° {:>6.2}° {:>7.2}° {:>7.2}° {:>10.2}",
-            format!("ours {}", self.sequence),
+            "{:<26} {:>5.0}  {:>6.2}° {:>6.2}° {:>7.2}° {:>7.2}° {:>10.2}",
+            format!("ours {} ({})", self.sequence, self.via),
             self.duration_s,
             self.dof[0].mae,
             self.dof[1].mae,
@@ -241,7 +246,7 @@ impl EstimateSummary {
         let (roll, steer, drift) = TARGETS;
         let _ = writeln!(
             s,
-            "{:<22} {:>5}  {:>6.1}° {:>6.1}° {:>7.1}° {:>7.1}° {:>10.1}",
+            "{:<26} {:>5}  {:>6.1}° {:>6.1}° {:>7.1}° {:>7.1}° {:>10.1}",
             "target (≤)", "", roll, roll, steer, steer, drift
         );
         let _ = writeln!(
@@ -300,46 +305,14 @@ fn err(path: &Path, e: impl std::fmt::Display) -> String {
     format!("{}: {e}", path.display())
 }
 
-/// Per delivered frame: the truth, the estimate.
-struct Record {
-    index: usize,
-    estimate: KrawlerEstimate,
+/// Per delivered frame: its index in the sequence, the estimate.
+pub(super) struct Record {
+    pub(super) index: usize,
+    pub(super) estimate: KrawlerEstimate,
 }
 
-/// Paints mud over marker `marker` of the gear: a brown patch 1.6 times the marker's
-/// side, centred where it projects.
-fn mud(
-    image: &mut RgbImage,
-    model: &crate::perception::CameraModel,
-    pose: &CameraPose,
-    centre: &Point3<f64>,
-    side: f64,
-) {
-    let project = |q: [f64; 3]| model.project(&pose.to_camera(&Point3::from(q)));
-    let Some(m) = ExpectedMarker::from_square(
-        project,
-        centre.coords.into(),
-        [1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        side * 1.6,
-    ) else {
-        return;
-    };
-    let half = m.area.sqrt() / 2.0;
-    let (w, h) = (image.width() as f64, image.height() as f64);
-    let x0 = (m.at[0] - half).floor().clamp(0.0, w) as usize;
-    let x1 = (m.at[0] + half).ceil().clamp(0.0, w) as usize;
-    let y0 = (m.at[1] - half).floor().clamp(0.0, h) as usize;
-    let y1 = (m.at[1] + half).ceil().clamp(0.0, h) as usize;
-    for y in y0..y1 {
-        for x in x0..x1 {
-            let n = ((x * 31 + y * 17) % 21) as u8;
-            image.put(x, y, [88 + n, 72 + n, 56 + n]);
-        }
-    }
-}
-
-/// Runs the estimator over the sequence's frames.
+/// Runs the estimator over the sequence's frames, offline: each frame straight into
+/// [`KrawlerStateSchema::estimate`].
 fn run_frames(
     spec: &SequenceSpec,
     profile: &Profile,
@@ -350,66 +323,27 @@ fn run_frames(
     let pe = |e: &dyn std::fmt::Display| format!("profile `{}`: {e}", profile.name);
     let cam = profile.cameras.first().ok_or_else(|| pe(&"no camera"))?;
     let geometry = AxleGeometry::from_profile(profile, 0).map_err(|e| pe(&e))?;
-    let layout = GearLayout::from_profile(profile).map_err(|e| pe(&e))?;
+    let gear_spec = crate::behaviors::krawler::gear_spec(profile).map_err(|e| pe(&e))?;
+    let gear = GearGeometry::from_profile(profile, gear_spec).map_err(|e| pe(&e))?;
     let polys = SteeringPoly::from_profile(profile)
         .ok_or_else(|| pe(&"no `markers` fiducial steering_poly_deg: run `marsupial calibrate-steering --write`"))?;
-    let rest = KrawlerState::rest(profile).map_err(|e| pe(&e))?;
-    let start = expected_markers(profile, &rest).map_err(|e| pe(&e))?;
-    let axles = [0, 1].map(|a| AxleState {
-        roll: rest.roll[a],
-        drop: rest.drop[a],
-        steer: rest.steer[a],
-    });
-    let (w, h) = (cam.width_px, cam.height_px);
-    let mut schema = KrawlerStateSchema::new((w, h), geometry.clone(), layout, polys, params, start, axles);
-    let mut renderer = Renderer::new(geometry.model.clone(), w, h, seed);
-    let base = camera_pose(&Pose2::new(0.0, 0.0, 0.0), &cam.mount);
-    let dt = truth.get(1).map_or(1.0 / cam.fps, |f| f.t - truth[0].t);
-    let sensor = SensorParams {
-        frame_interval_s: dt as f32,
-        ..SensorParams::default()
-    };
     let side = profile
         .fiducial
         .get::<crate::profile::MarkersSpec>()
-        .copied()
         .map_or(0.03, |m| m.side_m);
-    let knobs = spec.errors;
-    // The rover's true path over the floor, when the floor is fixed to the world.
-    let ground = match (knobs.moving_ground, drive_of(profile)) {
-        (true, Some(drive)) => true_path(&drive, truth),
-        _ => Vec::new(),
-    };
+    // The estimator starts from its own model of the gear at rest, not the simulator's.
+    let (start, axles) = gear
+        .start(&geometry, side)
+        .ok_or_else(|| pe(&"a marker of the gear at rest does not project into the camera"))?;
+    let size = (cam.width_px, cam.height_px);
+    let mut schema = KrawlerStateSchema::new(size, geometry, gear.layout(), polys, params, start, axles);
+    let mut frames = SequenceFrames::new(spec, profile, truth, seed)?;
     let mut ransac = Rng::named(seed, "krawler-ransac");
-    let mut errors = Rng::named(seed, "krawler-errors");
     let mut image = RgbImage::default();
     let mut out = Vec::with_capacity(truth.len());
-    for (i, f) in truth.iter().enumerate() {
-        if knobs.frame_drop > 0.0 && i > 0 && errors.uniform() < knobs.frame_drop {
+    for i in 0..truth.len() {
+        if !frames.render(i, &mut image)? {
             continue;
-        }
-        let pose = if knobs.vibration_deg > 0.0 || knobs.vibration_mm > 0.0 {
-            shaken(&base, knobs.vibration_deg, knobs.vibration_mm, &mut errors)
-        } else {
-            base
-        };
-        let light = LightChange::light_at(knobs.light.as_ref(), f.t);
-        let extras = GearExtras {
-            shadow: knobs.self_shadow.and_then(|s| s.at(f.t)),
-            mount_plates: knobs.mount_plates,
-            ground: ground.get(i).map(|p| GroundPose {
-                x: p[0],
-                y: p[1],
-                heading: p[2],
-            }),
-        };
-        let gear = build_with(profile, &f.state, &extras).map_err(|e| pe(&e))?;
-        renderer.render(&gear.scene, &pose, &light, &sensor, i as u64, &mut image);
-        if let Some(m) = knobs.mud
-            && f.t >= m.start_s
-            && f.t < m.start_s + m.duration_s
-        {
-            mud(&mut image, &geometry.model, &pose, &gear.markers[m.marker], side);
         }
         let estimate = schema
             .estimate(&image.view(), |n| (ransac.next_u64() % n as u64) as usize)
@@ -446,23 +380,6 @@ fn estimate_value(e: &KrawlerEstimate, k: usize) -> (f64, bool) {
     (v, d.valid)
 }
 
-/// Each frame's time step to the next (0 after the last) and body speed.
-fn steps_of(truth: &[TruthFrame]) -> (Vec<f64>, Vec<f64>) {
-    let dts = truth
-        .windows(2)
-        .map(|w| w[1].t - w[0].t)
-        .chain(std::iter::once(0.0))
-        .collect();
-    (dts, truth.iter().map(|f| f.speed).collect())
-}
-
-/// The rover's true path (x, y, heading per frame) from the truth's speeds and steering.
-fn true_path(drive: &DoubleAckermann, truth: &[TruthFrame]) -> Vec<[f64; 3]> {
-    let (dts, speed) = steps_of(truth);
-    let steer: Vec<[f64; 2]> = truth.iter().map(|f| f.state.steer).collect();
-    odometry(drive, &dts, &speed, &steer)
-}
-
 /// The result of a run: the summary, and the per-frame tables and plots.
 pub struct EstimateRun {
     /// The figures.
@@ -491,9 +408,23 @@ pub fn estimate_with(
     seed: u64,
     params: KrawlerParams,
 ) -> Result<EstimateRun, String> {
-    let drive = drive_of(profile).ok_or_else(|| format!("profile `{}` has no double-Ackermann drive", profile.name))?;
     let truth = generate(spec, profile, seed)?;
     let records = run_frames(spec, profile, &truth, seed, params)?;
+    measure(spec, profile, seed, params, truth, records, "offline")
+}
+
+/// Measures `records`, estimates of the frames of `truth`, the paper's way; `via` names
+/// the path that estimated them.
+pub(super) fn measure(
+    spec: &SequenceSpec,
+    profile: &Profile,
+    seed: u64,
+    params: KrawlerParams,
+    truth: Vec<TruthFrame>,
+    records: Vec<Record>,
+    via: &'static str,
+) -> Result<EstimateRun, String> {
+    let drive = drive_of(profile).ok_or_else(|| format!("profile `{}` has no double-Ackermann drive", profile.name))?;
     let first = &truth[0];
     let mut dof = [DofError::default(); 10];
     let mut valid_sum = [0.0f64; 10];
@@ -565,6 +496,7 @@ pub fn estimate_with(
         paper_dataset: spec.paper_dataset,
         errors: spec.errors.active(),
         mount_compensation: params.mount.enabled,
+        via,
     };
     Ok(EstimateRun {
         summary,
@@ -704,6 +636,57 @@ pub fn run(opts: &EstimateOptions, out: &mut dyn Write) -> Result<EstimateSummar
             1000.0 * elapsed / result.summary.delivered.max(1) as f64
         )
         .map_err(w)?;
+    }
+    if let Some(path) = opts.runtime {
+        use super::estimate_runtime::{RuntimePath, estimate_runtime, estimate_threads};
+        let started = std::time::Instant::now();
+        let (rt, slip) = match path {
+            RuntimePath::Lockstep => {
+                let (rt, slip) = estimate_runtime(&spec, &profile, seed, params)?;
+                (rt, Some(slip))
+            }
+            RuntimePath::Threads => (estimate_threads(&spec, &profile, seed, params)?, None),
+        };
+        let elapsed = started.elapsed().as_secs_f64();
+        let (a, b) = (&result.summary, &rt.summary);
+        // Bit for bit (a DOF never valid has a NaN valid-frame MAE on both paths).
+        let bits = |d: &DofError| [d.mae, d.mae_valid, d.max, d.last, d.valid].map(f64::to_bits);
+        let same = a.delivered == b.delivered
+            && a.drift_max.to_bits() == b.drift_max.to_bits()
+            && a.dof.iter().zip(&b.dof).all(|(x, y)| bits(x) == bits(y));
+        if opts.json {
+            let slip = slip.map(|s| {
+                serde_json::json!({"windows": s.windows, "alarms": s.alarms,
+                    "max_disagreement_rad": s.max_disagreement_rad})
+            });
+            let j = serde_json::json!({"runtime": b.to_json(), "slip": slip, "same_as_offline": same});
+            writeln!(out, "{j}").map_err(w)?;
+        } else {
+            writeln!(
+                out,
+                "\nthrough the loop ({}, the krawler robot's perceptual schema):",
+                b.via
+            )
+            .map_err(w)?;
+            write!(out, "{}", b.table()).map_err(w)?;
+            writeln!(
+                out,
+                "{} frames through the loop in {:.1} s ({:.1} ms a frame); same figures as offline: {}",
+                b.delivered,
+                elapsed,
+                1000.0 * elapsed / b.delivered.max(1) as f64,
+                if same { "yes" } else { "no" }
+            )
+            .map_err(w)?;
+            if let Some(s) = slip {
+                writeln!(
+                    out,
+                    "slip monitor (encoder reference): {} windows judged, {} alarms, largest disagreement {:.3} rad",
+                    s.windows, s.alarms, s.max_disagreement_rad
+                )
+                .map_err(w)?;
+            }
+        }
     }
     Ok(result.summary)
 }

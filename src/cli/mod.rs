@@ -15,6 +15,10 @@ pub mod detect;
 #[cfg(feature = "sim")]
 pub mod estimate;
 #[cfg(feature = "sim")]
+mod estimate_frames;
+#[cfg(feature = "sim")]
+pub mod estimate_runtime;
+#[cfg(feature = "sim")]
 pub mod merge;
 #[cfg(feature = "sim")]
 pub mod pose_trials;

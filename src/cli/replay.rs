@@ -131,6 +131,7 @@ fn found(p: &ObservedPercept) -> bool {
     match p {
         ObservedPercept::TwoBlock(p) => p.found,
         ObservedPercept::Pyramid(p) => p.view.is_some(),
+        ObservedPercept::Krawler(k) => k.fresh && k.markers.iter().all(Option::is_some),
     }
 }
 
@@ -440,6 +441,19 @@ fn write_frame(
             )?,
             None => write!(out, "not found")?,
         },
+        Some(ObservedPercept::Krawler(k)) => write!(
+            out,
+            "markers {}/8  roll {:+.1}° {:+.1}°  steer {:+.1}° {:+.1}°  θ {:.2} {:.2} {:.2} {:.2} rad",
+            k.markers.iter().flatten().count(),
+            k.roll_rad[0].to_degrees(),
+            k.roll_rad[1].to_degrees(),
+            k.steer_rad[0].to_degrees(),
+            k.steer_rad[1].to_degrees(),
+            k.wheel_rad[0],
+            k.wheel_rad[1],
+            k.wheel_rad[2],
+            k.wheel_rad[3]
+        )?,
         None => write!(out, "no percept")?,
     }
     if let (Some(w), Some((_, status))) = (twist, &res.command) {

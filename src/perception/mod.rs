@@ -59,7 +59,9 @@ pub use components::{Component, Labeler, Run};
 pub use hsv::{Hsv, HsvPlanes, hsv_from_rgb};
 pub use hsv_stats::{HsvAccumulator, HsvLimits, HsvStats};
 pub use image::{ImageError, RgbImage, RgbView, srgb_to_linear};
-pub use krawler::{KrawlerEstimate, KrawlerParams, KrawlerStateSchema};
+pub use krawler::{
+    AxleGeometry, GearGeometry, GearSpec, KrawlerEstimate, KrawlerParams, KrawlerStateSchema, SteeringPoly, WheelStep,
+};
 pub use pyramid::{BlueRegion, Ellipse, PyramidDetection, PyramidDetector, PyramidPair, PyramidParams, PyramidShape};
 pub use pyramid_pose::{PyramidGeometry, PyramidPercept, PyramidView};
 pub use pyramid_tracker::{PyramidTracker, PyramidTrackerParams};

@@ -10,8 +10,7 @@
 use super::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount, PerceptionSpec, Profile};
 use super::{PyramidPerceptionSpec, TwoBlockSpec};
 use crate::perception::circles::{CircleModel, CircleParams, FixedThreshold, MarkRotation, RigCamera, Threshold};
-use crate::perception::krawler::rotation::{HUB_BELOW_PLATE_M, PLATE_MARKER_Y_M, TREAD_WIDTH_M};
-use crate::perception::krawler::{AxleGeometry, GearLayout, SteeringPoly};
+use crate::perception::krawler::{AxleGeometry, GearGeometry, GearSpec, SteeringPoly};
 use crate::perception::{
     CameraModel, CastParams, ColorModelParams, Fisheye, HsvLimits, MountAngles, PairLimits, Pinhole, PyramidGeometry,
     PyramidParams, PyramidTrackerParams, SegmentationMode, TwoBlockGeometry, TwoBlockParams, VisionError,
@@ -298,25 +297,23 @@ impl AxleGeometry {
     }
 }
 
-impl GearLayout {
-    /// The wheels of a double-Ackermann profile: its track and wheel radius, with the
-    /// tread's width and the hubs' height below the marker plane the estimates
-    /// [`TREAD_WIDTH_M`] and [`HUB_BELOW_PLATE_M`], and the plate markers'
-    /// [`PLATE_MARKER_Y_M`] (the profile does not carry them).
+impl GearGeometry {
+    /// The gear of a double-Ackermann profile: its track, wheelbase and wheel radius,
+    /// with `spec`'s dimensions (the profile's `[robot.gear]`, which the `krawler` robot
+    /// kind reads: `behaviors::krawler::gear_spec`).
     ///
     /// # Errors
-    /// [`VisionError::Profile`] without `drive.wheel_radius_m`.
-    pub fn from_profile(profile: &Profile) -> Result<Self, VisionError> {
-        let wheel_radius = profile
-            .drive
-            .wheel_radius_m
-            .ok_or_else(|| missing(format!("profile `{}` has no drive.wheel_radius_m", profile.name)))?;
+    /// [`VisionError::Profile`] without `drive.wheel_radius_m` or `drive.wheelbase_m`.
+    pub fn from_profile(profile: &Profile, spec: GearSpec) -> Result<Self, VisionError> {
+        let d = &profile.drive;
+        let need = |v: Option<f64>, what: &str| {
+            v.ok_or_else(|| missing(format!("profile `{}` has no drive.{what}", profile.name)))
+        };
         Ok(Self {
-            track: profile.drive.track_m,
-            wheel_radius,
-            tread_half_width: TREAD_WIDTH_M / 2.0,
-            hub_below_plate: HUB_BELOW_PLATE_M,
-            marker_half_spacing: PLATE_MARKER_Y_M,
+            track: d.track_m,
+            wheelbase: need(d.wheelbase_m, "wheelbase_m")?,
+            wheel_radius: need(d.wheel_radius_m, "wheel_radius_m")?,
+            spec,
         })
     }
 }

@@ -6,14 +6,16 @@ use crate::arbiter::{LoopStatus, ReactiveLoop};
 use crate::perception::{RgbImage, VisionError};
 use crate::profile::Profile;
 use crate::schemas::{
-    Agent, CameraInput, ColourRanges, Inputs, Mission, MotorOutput, ObservedPercept, OdometryReading, PyramidSchema,
-    Stamped, TwoBlockSchema,
+    Agent, CameraInput, ColourRanges, Inputs, KrawlerSchema, Mission, MotorOutput, ObservedPercept, OdometryReading,
+    PerceptualSchema, PyramidSchema, Stamped, TwoBlockSchema,
 };
 
 /// The profile's perceptual schema, by fiducial.
 enum Perception {
     TwoBlock(Box<TwoBlockSchema>),
     Pyramid(Box<PyramidSchema>),
+    /// The AutoKrawler's state estimator (`markers` fiducial).
+    Krawler(Box<KrawlerSchema>),
 }
 
 /// What runs on each frame.
@@ -41,7 +43,8 @@ pub struct Session {
 }
 
 impl Session {
-    /// Builds the profile's perceptual schema for its camera 0 (two-block or pyramid), or
+    /// Builds the profile's perceptual schema for its camera 0 (two-block, pyramid, or the
+    /// AutoKrawler's state estimator for a `markers` fiducial), or
     /// with `behavior` its whole agent, started on a docking mission. `odometry` says
     /// whether the log has odometry; without it the loop does not wait for any, and
     /// inputs the log cannot have (tether, dock switch, other sensors) are never awaited.
@@ -93,9 +96,12 @@ impl Session {
             Runner::Perception(Perception::Pyramid(Box::new(
                 PyramidSchema::from_profile(profile, 0).map_err(vision)?,
             )))
+        } else if profile.fiducial.get::<crate::profile::MarkersSpec>().is_some() {
+            let schema = crate::behaviors::krawler::schema(profile).map_err(|e| setup(&e.to_string()))?;
+            Runner::Perception(Perception::Krawler(Box::new(schema)))
         } else {
             return Err(setup(
-                "replay runs the two-block or pyramid perceptual schema; the profile has neither `two_block` fiducial nor `pyramid` fiducial (use --behavior to run its agent)",
+                "replay runs the two-block, pyramid or AutoKrawler perceptual schema; the profile has no `two_block`, `pyramid` or `markers` fiducial (use --behavior to run its agent)",
             ));
         };
         Ok(Self { runner, camera_size })
@@ -140,6 +146,23 @@ impl Session {
                 Ok(FrameOutput {
                     percept: Some(ObservedPercept::Pyramid(p)),
                     ranges: Some(ColourRanges::Hsv(s.bands())),
+                    command: None,
+                })
+            }
+            Runner::Perception(Perception::Krawler(s)) => {
+                let cameras = [Some(CameraInput {
+                    stamp: t,
+                    image: image.view(),
+                })];
+                let inputs = Inputs {
+                    odometry,
+                    cameras: &cameras,
+                    ..Inputs::empty(t)
+                };
+                let p = s.perceive(&inputs);
+                Ok(FrameOutput {
+                    percept: Some(ObservedPercept::Krawler(p.observation())),
+                    ranges: None,
                     command: None,
                 })
             }

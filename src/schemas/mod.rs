@@ -5,14 +5,15 @@
 //! condition and reports [`Feedback`] and a typed [`Outcome`]. Motion vectors compose by
 //! Arkin's gain-weighted sum ([`MotionVector::weighted_sum`]).
 //!
-//! The perceptual schemas of the shipped robots ([`TwoBlockSchema`], [`PyramidSchema`])
-//! run perception's trackers on one camera of the inputs; perception itself knows
-//! nothing of schemas.
+//! The perceptual schemas of the shipped robots ([`TwoBlockSchema`], [`PyramidSchema`],
+//! the AutoKrawler's [`KrawlerSchema`]) run perception's trackers on one camera of the
+//! inputs; perception itself knows nothing of schemas.
 
 pub mod avoid;
 pub mod behavior;
 pub mod goto_point;
 pub mod inputs;
+pub mod krawler;
 pub mod mission;
 pub mod motor_output;
 pub mod observation;
@@ -30,6 +31,7 @@ pub use avoid::AvoidObstacles;
 pub use behavior::{Behavior, FailureReason, Feedback, Outcome, Presence, SchemaBehavior, Status, Step};
 pub use goto_point::PointController;
 pub use inputs::{CameraInput, CameraInputs, Inputs, OdometryReading, SensorInput, SensorInputs, TetherReading};
+pub use krawler::{KrawlerObservation, KrawlerPercept, KrawlerSchema};
 pub use mission::{Agent, AgentStats, Mission, MissionError};
 pub use motor_output::{Auxiliary, DriveCommand, Guides, MotorOutput, Posture, TetherCommand};
 pub use observation::{ColourRanges, Observation, ObservedPercept};

@@ -19,6 +19,8 @@ pub enum ObservedPercept {
     /// The pyramid's (blue region, ellipse, geometric view); also RAPOSA's cues read from
     /// a two-block flap.
     Pyramid(PyramidPercept),
+    /// The AutoKrawler's state estimate (its markers and ten degrees of freedom).
+    Krawler(super::krawler::KrawlerObservation),
 }
 
 /// The colour model's segmentation ranges for the two fiducial colours.

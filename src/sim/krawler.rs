@@ -16,7 +16,7 @@
 //! **Ackermann linkage.** The steering arms form a trapezoid: each arm points from its
 //! kingpin toward the centre of the *other* axle (the standard Ackermann trapezoid, arms'
 //! lines meeting on the centre line at the opposite axle; seed 003 gives no linkage
-//! geometry, so this and [`ARM`]'s length are our choice). With the arms angled, steering
+//! geometry, so this and the arms' length, `[robot.gear] steering_arm_m`, are our choice). With the arms angled, steering
 //! swings the two tie-rod ends by different amounts along x, so the tie rod both shifts
 //! and tilts, and d(B1,A1) ≠ d(B2,A2) in world coordinates once λ ≠ 0: the paper's ratio
 //! (eq. 5) moves away from 1 with |λ|, with λ's sign, before any camera is involved.
@@ -52,7 +52,7 @@ use super::SimError;
 use super::scene::{Material, PaintedSquare, Prim, Scene, Shape, Tag, albedo, boxed};
 use super::world::paint;
 use crate::kinematics::DriveModel;
-use crate::perception::krawler::ExpectedMarker;
+use crate::perception::krawler::{ExpectedMarker, GearGeometry};
 use crate::profile::{NamedColor, Profile};
 use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
@@ -78,35 +78,33 @@ impl KrawlerState {
     /// As [`build`], for a profile that does not describe the AutoKrawler's gear.
     pub fn rest(profile: &Profile) -> Result<Self, SimError> {
         let gear = Gear::of(profile)?;
-        let drop = gear.camera_z - gear.wheel_radius - PLATE_TOP;
+        let [front, rear] = gear.geometry.rest(gear.camera_z);
         Ok(Self {
             roll: [0.0; 2],
-            drop: [drop; 2],
+            drop: [front.drop, rear.drop],
             steer: [0.0; 2],
             wheel: [0.0; 4],
         })
     }
 }
 
-/// Dimensions of the running gear, from the profile (drive, camera mount and markers);
-/// the rest are our estimates, the constants below.
+/// Dimensions of the running gear, from the profile (drive, camera mount, markers and
+/// `[robot.gear]`, the same the estimator models it with); the beam's, the rod's and the
+/// faces' are the constants below.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Gear {
+    geometry: GearGeometry,
     track: f64,
     wheelbase: f64,
     wheel_radius: f64,
+    wheel_width: f64,
+    marker_y: f64,
+    plate_top: f64,
     camera_z: f64,
     marker_side: f64,
     marker_color: NamedColor,
 }
 
-/// Width of a wheel's tread, m (estimate, shared with the estimator).
-const WHEEL_WIDTH: f64 = crate::perception::krawler::rotation::TREAD_WIDTH_M;
-/// Steering-arm length from kingpin to tie-rod end, m (estimate).
-pub const ARM: f64 = 0.09;
-/// Markers sit this far either side of the axle's centre line, m (estimate, shared with
-/// the estimator).
-const MARKER_Y: f64 = crate::perception::krawler::rotation::PLATE_MARKER_Y_M;
 /// Tread faces per wheel: enough that the prism is the paper's cylinder to 0.2 % of the
 /// radius (with 16, points between the faces' edges sat up to 2 % inside it, and the
 /// estimator, which intersects rays with the cylinder, under-counted θ by 3 %).
@@ -114,9 +112,6 @@ const FACES: usize = 48;
 /// The white correction marker covers this many faces either side of face 0: 22.5° of
 /// the tread in all.
 const WHITE_HALF: usize = 1;
-/// Height of the axle plate's top (the markers' plane, the axle frame's origin) above the
-/// axle beam's centre, m (estimate, shared with the estimator).
-pub const PLATE_TOP: f64 = crate::perception::krawler::rotation::HUB_BELOW_PLATE_M;
 /// The tie rod's height, m: its top, level with the plate's, carries the steering markers.
 const ROD_HEIGHT: f64 = 0.024;
 
@@ -149,10 +144,20 @@ impl Gear {
                 profile.name, markers.count
             )));
         }
+        let spec = crate::behaviors::krawler::gear_spec(profile).map_err(|e| SimError::Unsupported(e.to_string()))?;
         Ok(Self {
+            geometry: GearGeometry {
+                track: drive.track,
+                wheelbase: drive.wheelbase,
+                wheel_radius,
+                spec,
+            },
             track: drive.track,
             wheelbase: drive.wheelbase,
             wheel_radius,
+            wheel_width: spec.tread_width_m,
+            marker_y: spec.plate_marker_y_m,
+            plate_top: spec.hub_below_plate_m,
             camera_z: camera.mount.z_m,
             marker_side: markers.side_m,
             marker_color: markers.color,
@@ -258,13 +263,13 @@ pub fn build_with(profile: &Profile, state: &KrawlerState, extras: &GearExtras) 
     let metal_albedo = albedo([90, 92, 95], 1.0);
     let metal = Material::Solid(metal_albedo);
     let plate_albedo = albedo([150, 150, 150], 1.0);
-    // A pair of markers, ±MARKER_Y across a surface's v axis (its local b).
+    // A pair of markers, ±marker_y across a surface's v axis (its local b).
     let pair = |base: [f32; 3], a: f64| Material::Squares {
         base,
         squares: [1.0f32, -1.0]
             .map(|side| PaintedSquare {
                 a: a as f32,
-                b: side * MARKER_Y as f32,
+                b: side * g.marker_y as f32,
                 half: g.marker_side as f32 / 2.0,
                 albedo: marker_albedo,
             })
@@ -298,10 +303,10 @@ pub fn build_with(profile: &Profile, state: &KrawlerState, extras: &GearExtras) 
             UnitQuaternion::from_axis_angle(&Vector3::x_axis(), state.roll[axle]),
         );
         let mut put = |p: Prim| prims.push(transform(p, &pose));
-        let half_beam = g.track / 2.0 - WHEEL_WIDTH / 2.0 - 0.01;
+        let half_beam = g.track / 2.0 - g.wheel_width / 2.0 - 0.01;
         for p in boxed(
-            Point3::new(-0.02, -half_beam, -0.02 - PLATE_TOP),
-            Point3::new(0.02, half_beam, 0.02 - PLATE_TOP),
+            Point3::new(-0.02, -half_beam, -0.02 - g.plate_top),
+            Point3::new(0.02, half_beam, 0.02 - g.plate_top),
             metal.clone(),
             Tag::Own,
         ) {
@@ -309,7 +314,7 @@ pub fn build_with(profile: &Profile, state: &KrawlerState, extras: &GearExtras) 
         }
         put(flat(Point3::origin(), [0.03, 0.16], pair(plate_albedo, 0.0)));
         // The tie rod joins the arms' ends, each swung by the steering about its kingpin.
-        let rod_ends = tie_rod_ends(g.track, g.wheelbase, inboard, state.steer[axle]);
+        let rod_ends = g.geometry.tie_rod_ends(inboard, state.steer[axle]);
         let (left_end, right_end) = (rod_ends[0], rod_ends[1]);
         let mid = nalgebra::center(&left_end, &right_end);
         let along = (left_end - right_end).normalize();
@@ -330,15 +335,15 @@ pub fn build_with(profile: &Profile, state: &KrawlerState, extras: &GearExtras) 
             put(transform(p, &rod_pose));
         }
         for (k, side) in [1.0, -1.0].into_iter().enumerate() {
-            let on_plate = Point3::new(0.0, side * MARKER_Y, 0.0);
-            let on_rod = rod_pose * Point3::new(0.0, side * MARKER_Y, 0.0);
+            let on_plate = Point3::new(0.0, side * g.marker_y, 0.0);
+            let on_rod = rod_pose * Point3::new(0.0, side * g.marker_y, 0.0);
             markers[axle * 4 + k] = pose * on_plate;
             markers[axle * 4 + 2 + k] = pose * on_rod;
         }
         // Wheels: kingpins at the beam's ends; the left wheel is index 0 of the axle.
         for (k, side) in [1.0, -1.0].into_iter().enumerate() {
             let hub = Isometry3::from_parts(
-                Translation3::new(0.0, side * g.track / 2.0, -PLATE_TOP),
+                Translation3::new(0.0, side * g.track / 2.0, -g.plate_top),
                 UnitQuaternion::from_axis_angle(&Vector3::z_axis(), state.steer[axle]),
             );
             let wheel = pose * hub;
@@ -359,7 +364,7 @@ pub fn build_with(profile: &Profile, state: &KrawlerState, extras: &GearExtras) 
                         centre,
                         u: Vector3::new(cp, 0.0, -sp) * turn,
                         v: Vector3::y() * turn,
-                        half: [half_arc, WHEEL_WIDTH / 2.0],
+                        half: [half_arc, g.wheel_width / 2.0],
                     },
                     if f <= WHITE_HALF || f >= FACES - WHITE_HALF {
                         white.clone()
@@ -380,7 +385,7 @@ pub fn build_with(profile: &Profile, state: &KrawlerState, extras: &GearExtras) 
                 prims.push(transform(
                     Prim::new(
                         Shape::Disc {
-                            centre: Point3::new(0.0, wall * WHEEL_WIDTH / 2.0, 0.0),
+                            centre: Point3::new(0.0, wall * g.wheel_width / 2.0, 0.0),
                             u: n.cross(&Vector3::z()),
                             v: Vector3::z(),
                             radius: g.wheel_radius * 0.98,
@@ -524,21 +529,6 @@ pub fn expected_markers(profile: &Profile, state: &KrawlerState) -> Result<[Expe
     Ok(out)
 }
 
-/// The tie rod's ends (left, right) in the axle frame, on the markers' plane (z = 0), for
-/// an axle of `track` on a rover of `wheelbase` whose arms point toward −x (`inboard` = −1,
-/// the front axle) or +x (+1, the rear), both wheels steered by `steer` (rad, positive
-/// turns the wheels' fronts left). At `steer` = 0 each arm points from its kingpin at
-/// (0, ±track/2) toward the other axle's centre, (inboard·wheelbase, 0): the Ackermann
-/// trapezoid. Public so tests can check the linkage against the rendered markers.
-pub fn tie_rod_ends(track: f64, wheelbase: f64, inboard: f64, steer: f64) -> [Point3<f64>; 2] {
-    [1.0, -1.0].map(|side: f64| {
-        let kingpin = Vector3::new(0.0, side * track / 2.0, 0.0);
-        let toward = Vector3::new(inboard * wheelbase, 0.0, 0.0) - kingpin;
-        let arm = Rotation3::from_axis_angle(&Vector3::z_axis(), steer) * toward.normalize() * ARM;
-        Point3::from(kingpin + arm)
-    })
-}
-
 /// A flat horizontal square or rectangle facing up (+z), half extents along x and y.
 fn flat(centre: Point3<f64>, half: [f64; 2], material: Material) -> Prim {
     Prim::new(
@@ -651,7 +641,7 @@ mod tests {
                 lit += 1;
             }
             if ra.len() == 3 {
-                // A plate or rod top: the left square (b = +MARKER_Y) is in the band, the
+                // A plate or rod top: the left square (b = +marker_y) is in the band, the
                 // right one is not, whatever the base.
                 assert!((rb[1] - ra[1] * 0.5).abs() < 1e-6, "left marker shadowed");
                 assert_eq!(rb[2], ra[2], "right marker lit");

@@ -2,7 +2,7 @@
 
 use marsupial::geometry::Pose2;
 use marsupial::perception::RgbImage;
-use marsupial::perception::krawler::{AxleGeometry, AxleState, GearLayout};
+use marsupial::perception::krawler::{AxleGeometry, AxleState, GearGeometry, GearLayout};
 use marsupial::profile::Profile;
 use marsupial::sim::camera::camera_pose;
 use marsupial::sim::krawler::{KrawlerState, build};
@@ -26,7 +26,8 @@ impl Rig {
     pub fn new(sensor: SensorParams, seed: u64) -> Self {
         let profile = super::shipped_profile("autokrawler");
         let geometry = AxleGeometry::from_profile(&profile, 0).unwrap();
-        let layout = GearLayout::from_profile(&profile).unwrap();
+        let gear = marsupial::behaviors::krawler::gear_spec(&profile).unwrap();
+        let layout = GearGeometry::from_profile(&profile, gear).unwrap().layout();
         let pose = camera_pose(&Pose2::new(0.0, 0.0, 0.0), &profile.cameras[0].mount);
         let rest = KrawlerState::rest(&profile).unwrap();
         let cam = &profile.cameras[0];

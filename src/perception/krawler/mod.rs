@@ -10,9 +10,12 @@
 //! the wheel stage on whole frames (observation windows, Shi–Tomasi and Lucas–Kanade
 //! from [`crate::perception::flow`], RANSAC, the once-per-turn correction); and
 //! [`schema`], [`KrawlerStateSchema`], which runs them all on each frame and reports the
-//! ten degrees of freedom with validity flags.
+//! ten degrees of freedom with validity flags. [`gear`] is the gear's geometry (from the
+//! profile) and the estimator's own model of it: the rest state and its first marker
+//! predictions.
 
 pub mod axle;
+pub mod gear;
 pub mod markers;
 pub mod mount;
 pub mod rotation;
@@ -21,6 +24,7 @@ pub mod steering;
 pub mod wheel;
 
 pub use axle::{AxleGeometry, AxlePose};
+pub use gear::{GearGeometry, GearSpec};
 pub use markers::{Blob, ExpectedMarker, MarkerFinder, MarkerParams, Markers};
 pub use mount::{MountOffset, MountParams, fit_mount};
 pub use rotation::{AxleState, GearLayout, WheelParams, WheelStep, WheelTracker};

@@ -57,20 +57,9 @@ pub struct AxleState {
     pub steer: f64,
 }
 
-/// Width of the AutoKrawler's tread, m: an estimate (seed 003 gives only the radius);
-/// the simulator draws its wheels this wide.
-pub const TREAD_WIDTH_M: f64 = 0.08;
-
-/// Height of the axle plate's top (the markers' plane) above the wheels' centres, m: an
-/// estimate; the simulator builds its axles so.
-pub const HUB_BELOW_PLATE_M: f64 = 0.021;
-
-/// How far each plate marker sits either side of its axle's centre line, m: an estimate;
-/// the simulator builds its plates so.
-pub const PLATE_MARKER_Y_M: f64 = 0.1;
-
 /// Where the wheels sit on their axle: what the paper calls the swivel joints'
-/// positions in the axle frame and the wheels' centres in the swivel frame.
+/// positions in the axle frame and the wheels' centres in the swivel frame (built from the
+/// profile's gear, [`super::GearGeometry::layout`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GearLayout {
     /// Distance between the two kingpins (the wheels' centres), m.

@@ -104,6 +104,17 @@ pub fn annotate(t: Time, obs: &Observation) -> ImageAnnotations {
                 a.texts.push(caption(t, "not found".into()));
             }
         }
+        ObservedPercept::Krawler(k) => {
+            let magenta = Color::rgb8([255, 0, 255]);
+            // Marker centres count pixel centres at +0.5 already.
+            for at in k.markers.iter().flatten() {
+                a.circles.push(dot(t, [at[0] - 0.5, at[1] - 0.5], magenta));
+            }
+            let found = k.markers.iter().flatten().count();
+            let theta = k.wheel_rad.iter().sum::<f64>() / 4.0;
+            a.texts
+                .push(caption(t, format!("markers {found}/8, mean θ {theta:.2} rad")));
+        }
         ObservedPercept::Pyramid(p) => {
             let d = &p.detection;
             let blue = Color::rgb8([40, 120, 255]);
