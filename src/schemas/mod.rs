@@ -7,7 +7,11 @@
 //!
 //! The perceptual schemas of the shipped robots ([`TwoBlockSchema`], [`PyramidSchema`])
 //! run perception's trackers on one camera of the inputs; perception itself knows
-//! nothing of schemas.
+//! nothing of schemas. Their motor schemas ([`RatioSteering`], [`PotentialField`],
+//! [`ServoLaw`], [`PointController`], [`SearchRotation`], [`DeadReckoning`],
+//! [`AvoidObstacles`]) implement [`MotorSchema`] over typed percepts
+//! ([`motor_schemas`]); the robots' leaves pair them with their percepts and memory, as
+//! a [`SchemaBehavior`] pairs a perceptual and a motor schema with a releaser.
 
 pub mod avoid;
 pub mod behavior;
@@ -15,6 +19,7 @@ pub mod goto_point;
 pub mod inputs;
 pub mod mission;
 pub mod motor_output;
+pub mod motor_schemas;
 pub mod observation;
 pub mod percept;
 pub mod potential_field;
@@ -32,6 +37,7 @@ pub use goto_point::PointController;
 pub use inputs::{CameraInput, CameraInputs, Inputs, OdometryReading, SensorInput, SensorInputs, TetherReading};
 pub use mission::{Agent, AgentStats, Mission, MissionError};
 pub use motor_output::{Auxiliary, DriveCommand, Guides, MotorOutput, Posture, TetherCommand};
+pub use motor_schemas::{DockPose, Elapsed, GuideView, PointGoal, Travelled};
 pub use observation::{ColourRanges, Observation, ObservedPercept};
 pub use percept::{Percept, Stamped};
 pub use potential_field::PotentialField;

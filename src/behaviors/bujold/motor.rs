@@ -6,7 +6,7 @@ use super::memory::Memory;
 use crate::geometry::Pose2;
 use crate::perception::two_block_pose::FiducialView;
 use crate::schemas::{
-    Auxiliary, DriveCommand, MotionVector, MotorOutput, Posture, PotentialField, RatioSteering, Step,
+    Auxiliary, DriveCommand, MotionVector, MotorOutput, MotorSchema, Posture, PotentialField, RatioSteering, Step,
 };
 
 /// The approach motor schema the profile selects (`robot.approach`).

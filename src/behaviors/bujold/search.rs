@@ -85,7 +85,7 @@ impl Behavior<Memory> for Search {
         let mut s = self.rotation;
         s.rate *= m.last_side;
         Some(Step::running(
-            MotorOutput::drive(s.act(in_phase)).with_aux(raised()),
+            MotorOutput::drive(s.command(in_phase)).with_aux(raised()),
             m.feedback("search"),
         ))
     }

@@ -50,7 +50,7 @@ impl Behavior<Memory> for Search {
             first_sweep: m.gains.search_sweep_deg.to_radians(),
             doubling: true,
         };
-        Some(m.command(search.act(now - start), "state_5"))
+        Some(m.command(search.command(now - start), "state_5"))
     }
 }
 
@@ -106,6 +106,6 @@ impl Behavior<Memory> for Look {
             first_sweep: m.gains.search_sweep_deg.to_radians(),
             doubling: true,
         };
-        Some(m.command(search.act(t - self.params.settle_s), "state_2_look"))
+        Some(m.command(search.command(t - self.params.settle_s), "state_2_look"))
     }
 }
