@@ -15,6 +15,7 @@
 
 pub mod avoid;
 pub mod behavior;
+pub mod devices;
 pub mod goto_point;
 pub mod inputs;
 pub mod mission;
@@ -33,8 +34,15 @@ pub mod visual_servo;
 
 pub use avoid::AvoidObstacles;
 pub use behavior::{Behavior, FailureReason, Feedback, Outcome, Presence, SchemaBehavior, Status, Step};
+pub use devices::{
+    ARM_KIND, ArmPosition, BUILTIN_ACTUATOR_KINDS, BUILTIN_SENSOR_KINDS, COMMAND_VALUES, Command, DOCK_CONTACT_KIND,
+    DeviceCommand, DeviceKinds, DeviceReading, DockContact, GUIDES_KIND, INLINE_DEVICES, LIGHTS_KIND, Lights,
+    POSTURE_KIND, TETHER_KIND,
+};
 pub use goto_point::PointController;
-pub use inputs::{CameraInput, CameraInputs, Inputs, OdometryReading, SensorInput, SensorInputs, TetherReading};
+pub use inputs::{
+    CameraInput, CameraInputs, INLINE_CAMERAS, Inputs, OdometryReading, SensorInput, SensorInputs, TetherReading,
+};
 pub use mission::{Agent, AgentStats, Mission, MissionError};
 pub use motor_output::{Auxiliary, DriveCommand, Guides, MotorOutput, Posture, TetherCommand};
 pub use motor_schemas::{DockPose, Elapsed, GuideView, PointGoal, Travelled};

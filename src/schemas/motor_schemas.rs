@@ -6,6 +6,7 @@
 //! schema, percept in, output out.
 
 use super::avoid::AvoidObstacles;
+use super::devices::ArmPosition;
 use super::goto_point::PointController;
 use super::motor_output::{Auxiliary, DriveCommand, MotorOutput};
 use super::potential_field::PotentialField;
@@ -99,10 +100,7 @@ impl MotorSchema for ServoLaw {
     type Percept = GuideView;
     fn act(&self, g: &GuideView) -> MotorOutput {
         let twist = self.twist(self.speed(g.distance_m, g.area_root), self.turn(g.x_dev_px));
-        let aux = Auxiliary {
-            arm: Some(self.arm(g.y_dev_px)),
-            ..Auxiliary::default()
-        };
+        let aux = Auxiliary::with(ArmPosition(self.arm(g.y_dev_px)));
         MotorOutput::drive(DriveCommand::Twist(twist)).with_aux(aux)
     }
 }
@@ -167,6 +165,6 @@ mod tests {
         let out = law.act(&g);
         let t = out.drive.to_twist();
         assert!((t.v + 0.05).abs() < 1e-12 && (t.omega + 0.04).abs() < 1e-12);
-        assert!((out.aux.arm.unwrap() + 0.06).abs() < 1e-12);
+        assert!((out.aux.get::<ArmPosition>().unwrap().0 + 0.06).abs() < 1e-12);
     }
 }

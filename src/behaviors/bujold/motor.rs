@@ -82,16 +82,10 @@ impl Memory {
 
 /// Lowered posture (backing in, leaving the pouch).
 pub fn lowered() -> Auxiliary {
-    Auxiliary {
-        posture: Some(Posture::Lowered),
-        ..Auxiliary::default()
-    }
+    Auxiliary::with(Posture::Lowered)
 }
 
 /// Raised posture (everywhere else).
 pub fn raised() -> Auxiliary {
-    Auxiliary {
-        posture: Some(Posture::Raised),
-        ..Auxiliary::default()
-    }
+    Auxiliary::with(Posture::Raised)
 }
