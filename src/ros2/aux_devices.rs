@@ -2,7 +2,7 @@
 //! switch read from a `std_msgs/msg/Bool`, and `posture`, `dock_guides`
 //! (`std_msgs/msg/String`: `raised`/`lowered`, `open`/`closed`) and `lights`
 //! (`std_msgs/msg/Bool`) published. A kind with no standard message (the tether reel, the
-//! arm, a user's kinds) is [`Unbridged`]: it reads nothing and its commands go nowhere,
+//! arm, a user's kinds) is unbridged: it reads nothing and its commands go nowhere,
 //! so a profile that requires such a sensor stays in its safe stop on the node.
 
 use super::devices::LatestPayload;
@@ -51,10 +51,13 @@ pub(super) fn lights_message(values: &[f64]) -> Option<Vec<u8>> {
     Lights::decode(values).map(|l| encode_bool(l.0))
 }
 
+/// Encodes a command's values as its topic's message; `None` when they are not one.
+pub(super) type Encode = fn(&[f64]) -> Option<Vec<u8>>;
+
 /// An actuator published as a topic, each command encoded by `encode`.
 pub(super) struct AuxTopic {
     pub(super) publisher: RmwPublisher,
-    pub(super) encode: fn(&[f64]) -> Option<Vec<u8>>,
+    pub(super) encode: Encode,
 }
 
 impl Actuator for AuxTopic {

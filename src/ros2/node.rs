@@ -20,7 +20,7 @@
 //!   runtime's own. The behavior persists between goals: a docking after an undocking
 //!   uses the colours imprinted on the way out.
 
-use super::aux_devices::{AuxTopic, TopicSwitch, Unbridged, guides_message, lights_message, posture_message};
+use super::aux_devices::{AuxTopic, Encode, TopicSwitch, Unbridged, guides_message, lights_message, posture_message};
 pub use super::aux_devices::{encode_bool, encode_string};
 use super::devices::{ImageKind, TopicCamera, TopicOdometer, TwistDrive, subscribe};
 use super::interfaces::{self, Interface};
@@ -404,7 +404,7 @@ impl Ros2Node {
             robot.sensors.push(device);
         }
         for spec in &profile.actuators {
-            let topic: Option<(&str, &Interface, fn(&[f64]) -> Option<Vec<u8>>)> = match spec.kind.as_str() {
+            let topic: Option<(&str, &Interface, Encode)> = match spec.kind.as_str() {
                 POSTURE_KIND => Some(("posture", &string, posture_message)),
                 GUIDES_KIND => Some(("dock_guides", &string, guides_message)),
                 LIGHTS_KIND => Some(("lights", &boolean, lights_message)),

@@ -27,7 +27,7 @@ pub type CameraInputs<'a> = smallvec::SmallVec<[Option<CameraInput<'a>>; INLINE_
 /// One reading of a `[[sensors]]` entry (see [`crate::profile::devices`]): what the
 /// values mean is the sensor's kind's business (a range finder: one distance per beam;
 /// the tether: its [`TetherReading`]), read typed with
-/// [`DeviceReading`](super::DeviceReading).
+/// [`DeviceReading`].
 #[derive(Debug, Clone, Copy)]
 pub struct SensorInput<'a> {
     /// The sensor's kind (its `[[sensors]]` entry's `kind`).

@@ -83,13 +83,16 @@ impl SimDevices {
     }
 }
 
+/// Builds a simulated device of type `D` from its entry `S`.
+type Factory<S, D> = dyn Fn(&SimRobot, &S) -> Result<Box<D>, String> + Send + Sync;
+
 /// Builds each of `specs` (named `what[i]` in errors) with the factory of its kind.
 fn build_all<S, D: ?Sized>(
     sim: &SimRobot,
     what: &str,
     specs: &[S],
     kind_name: impl Fn(&S) -> (&str, &str),
-    factories: &BTreeMap<String, Arc<dyn Fn(&SimRobot, &S) -> Result<Box<D>, String> + Send + Sync>>,
+    factories: &BTreeMap<String, Arc<Factory<S, D>>>,
 ) -> Result<Vec<Box<D>>, String> {
     specs
         .iter()
