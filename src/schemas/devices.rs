@@ -279,4 +279,32 @@ mod tests {
         assert_eq!(DockContact::decode(&[1.0, 0.0]), None, "the wrong size reads nothing");
         assert!(Command::new("x", &[1.0, 2.0, 3.0]).is_none());
     }
+
+    #[test]
+    fn outputs_keep_one_command_per_kind_and_compare_regardless_of_order() {
+        use crate::schemas::Auxiliary;
+        let mut a = Auxiliary::with(Lights(true));
+        a.set(Guides::Open);
+        a.set(Lights(false));
+        let mut b = Auxiliary::with(Guides::Open);
+        b.set(Lights(false));
+        assert_eq!(a, b);
+        assert_eq!(a.commands().count(), 2, "a later command replaces its kind's");
+        b.clear(LIGHTS_KIND);
+        assert_ne!(a, b);
+        assert_eq!(b.get::<Lights>(), None);
+        let mut full = Auxiliary::default();
+        for (i, kind) in ["k0", "k1", "k2", "k3", "k4", "k5", "k6", "k7", "k8"]
+            .into_iter()
+            .enumerate()
+        {
+            full.put(Command::of(kind, [i as f64]));
+        }
+        assert_eq!(
+            full.commands().count(),
+            INLINE_DEVICES,
+            "a kind beyond the room is dropped, not a panic"
+        );
+        assert!(full.is_finite() && !Auxiliary::with(ArmPosition(f64::NAN)).is_finite());
+    }
 }

@@ -38,7 +38,8 @@ pub enum Posture {
 /// The device commands of one output, by actuator kind (see [`super::devices`]): a kind
 /// with no command means "this behavior has no opinion", so several outputs can be merged
 /// in priority order ([`Auxiliary::or`]). Holds up to [`INLINE_DEVICES`] kinds inline.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+/// Two are equal when they command the same kinds with the same values, in any order.
+#[derive(Debug, Clone, Copy, Default)]
 pub struct Auxiliary {
     commands: [Option<Command>; INLINE_DEVICES],
 }
@@ -128,6 +129,13 @@ impl Auxiliary {
     /// True when every number in every command is finite.
     pub fn is_finite(&self) -> bool {
         self.commands().all(|c| c.values().iter().all(|v| v.is_finite()))
+    }
+}
+
+impl PartialEq for Auxiliary {
+    fn eq(&self, other: &Self) -> bool {
+        self.commands().count() == other.commands().count()
+            && self.commands().all(|c| other.command(c.kind()) == Some(c))
     }
 }
 
