@@ -396,9 +396,9 @@ fn dock() -> Result<(), Box<dyn std::error::Error>> {
         Box::new(ToyDrive(world.clone())),
     );
     robot.encoders = Some(Box::new(ToyEncoders(world.clone())));
-    robot.dock_sensor = Some(Box::new(ToyDockSwitch(world.clone())));
-    // In the profile's [[sensors]] order.
+    // In the profile's [[sensors]] order (the dock switch is toy_robot.toml's).
     robot.sensors = vec![
+        Box::new(ToyDockSwitch(world.clone())),
         Box::new(ToyRange {
             world: world.clone(),
             beams: 13,

@@ -6,7 +6,9 @@
 //!    normally `profiles/<robot>.toml`) describing the drive, cameras, body, dock and loop
 //!    timing. `marsupial check` validates it.
 //! 2. **The hardware traits** from [`marsupial::robot`]: a [`Camera`], a [`Drive`], and
-//!    optionally [`WheelEncoders`], a [`DockSensor`], a tether reel, arm, lights …
+//!    optionally [`WheelEncoders`], and a [`Sensor`] or an [`Actuator`] for each device
+//!    the profile declares by kind (here the `dock_contact` switch; a tether reel, arm,
+//!    lights … are kinds too, read and commanded typed: [`marsupial::schemas::devices`])
 //!    Here they talk to a tiny toy world (a red beacon on a floor,
 //!    `examples/common/toy_world.rs`); on your robot they talk to your drivers.
 //! 3. **Behaviors**: a perceptual schema (find the red beacon with the crate's perception:
@@ -173,7 +175,8 @@ fn main() {
         Box::new(ToyDrive(world.clone())),
     );
     robot.encoders = Some(Box::new(ToyEncoders(world.clone())));
-    robot.dock_sensor = Some(Box::new(ToyDockSwitch(world.clone())));
+    // In the profile's [[sensors]] order: the dock switch is its only one.
+    robot.sensors.push(Box::new(ToyDockSwitch(world.clone())));
 
     let approach = SchemaBehavior::new(
         "approach",

@@ -3,8 +3,12 @@
 //! Reactive, behavior-based robots that dock by vision.
 //!
 //! * [`perception`]: pure image functions over borrowed views and reusable buffers.
-//! * [`schemas`]: perceptual schemas (sensor data → [`schemas::Percept`]), motor schemas
-//!   (percept → [`schemas::MotorOutput`]) and [`schemas::Behavior`]s pairing them.
+//! * [`schemas`]: perceptual schemas (sensor data → [`schemas::Percept`],
+//!   [`schemas::PerceptualSchema`]), motor schemas (percept → [`schemas::MotorOutput`],
+//!   [`schemas::MotorSchema`], which every shipped one implements) and
+//!   [`schemas::Behavior`]s pairing them; the one device model ([`schemas::devices`]):
+//!   the tether, dock switch, arm, lights, guides and posture are device kinds like a
+//!   user's, with typed readings and commands.
 //! * [`arbiter`]: coordination ([`arbiter::Priority`], [`arbiter::VectorSum`],
 //!   [`arbiter::Sequencer`]) and the [`arbiter::ReactiveLoop`], whose tick is a pure
 //!   function of its state and timestamped inputs; [`arbiter::runtime`] runs it on

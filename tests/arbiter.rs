@@ -3,8 +3,8 @@
 use marsupial::arbiter::{Next, Priority, Sequencer, VectorSum};
 use marsupial::geometry::Twist;
 use marsupial::schemas::{
-    Auxiliary, Behavior, DriveCommand, FailureReason, Feedback, Inputs, MotionVector, MotorOutput, Outcome, Status,
-    Step,
+    Auxiliary, Behavior, DriveCommand, FailureReason, Feedback, Inputs, Lights, MotionVector, MotorOutput, Outcome,
+    Status, Step,
 };
 
 /// A scripted behavior: active when `now` is in `[from, to)`, proposing `output`, and
@@ -86,10 +86,7 @@ fn vector_sum_weights_and_merges() {
         MotorOutput::drive(DriveCommand::Vector(MotionVector::new(1.0, 0.0))),
     );
     let mut b_out = MotorOutput::drive(DriveCommand::Vector(MotionVector::new(0.0, 1.0)));
-    b_out.aux = Auxiliary {
-        lights: Some(true),
-        ..Default::default()
-    };
+    b_out.aux = Auxiliary::with(Lights(true));
     let b = Scripted::new("tangent", 0.0, 5.0, b_out);
     let c = Scripted::new("twist", 0.0, 10.0, MotorOutput::twist(0.0, 0.2));
     let mut s = VectorSum::new(
@@ -105,7 +102,7 @@ fn vector_sum_weights_and_merges() {
     // Vector sum (0.5, 0.5): heading 45°, |V| = 0.707 → v = 0.5, ω = π/4; plus twist 0.2.
     assert!((t.v - 0.5).abs() < 1e-12, "{t:?}");
     assert!((t.omega - (std::f64::consts::FRAC_PI_4 + 0.2)).abs() < 1e-12, "{t:?}");
-    assert_eq!(step.output.aux.lights, Some(true));
+    assert_eq!(step.output.aux.get::<Lights>(), Some(Lights(true)));
     let step = s.tick(&mut (), &Inputs::empty(7.0)).unwrap();
     let DriveCommand::Twist(t) = step.output.drive else {
         panic!()

@@ -68,10 +68,17 @@ fn bujold_avoid_is_bujold_but_for_the_listed_keys() {
         "behavior.tree.nodes.approach_field",
         "behavior.tree.nodes.avoid",
         "behavior.tree.nodes.approach_near",
-        "sensors",
     ] {
         assert!(take(&mut avoid, key).is_some(), "bujold-avoid.toml lacks {key}");
     }
+    // Her sensors are Bujold's (the dock switch) after the range finder.
+    let sensors = |t: &mut Table| take(t, "sensors").and_then(|v| v.as_array().cloned()).unwrap();
+    let (plain_sensors, avoid_sensors) = (sensors(&mut plain), sensors(&mut avoid));
+    assert_eq!(
+        avoid_sensors[1..],
+        plain_sensors[..],
+        "bujold-avoid's sensors after the range finder"
+    );
     assert_eq!(
         avoid, plain,
         "bujold-avoid.toml differs from bujold.toml outside its listed keys"

@@ -12,8 +12,8 @@ use marsupial::geometry::Pose2;
 use marsupial::perception::RgbImage;
 use marsupial::perception::two_block_pose::FiducialView;
 use marsupial::schemas::{
-    Behavior, CameraInput, DriveCommand, FailureReason, Inputs, OdometryReading, Outcome, Posture, Stamped, Status,
-    Step,
+    Behavior, CameraInput, DOCK_CONTACT_KIND, DriveCommand, FailureReason, Inputs, OdometryReading, Outcome, Posture,
+    SensorInput, Stamped, Status, Step,
 };
 
 fn memory() -> Memory {
@@ -187,7 +187,7 @@ fn decide_backs_in_aligned_retries_misaligned_and_gives_up_when_out_of_retries()
     }
     let s = tick(&mut d, &mut mem, 0.5, at(0.4), Some(view(0.38, 0.2, 4600)));
     assert_eq!(s.status, Status::Event("aligned"));
-    assert_eq!(s.output.aux.posture, Some(Posture::Lowered));
+    assert_eq!(s.output.aux.get::<Posture>(), Some(Posture::Lowered));
     // 5° off at 0.38 m: reposition (a retry), then out of retries: give up.
     for (retries_before, expected) in [(0, "misaligned"), (1, "retries_exhausted")] {
         mem.retries = retries_before;
@@ -221,7 +221,7 @@ fn back_in_drives_blind_and_lowered_then_reports_the_miss() {
     let mut b = back_in::BackIn::new("back_in", BackInParams::default(), 0.30);
     enter(&mut b, &mut mem, 0.0, at(0.4));
     let s = tick(&mut b, &mut mem, 0.1, at(0.35), None);
-    assert_eq!(s.output.aux.posture, Some(Posture::Lowered));
+    assert_eq!(s.output.aux.get::<Posture>(), Some(Posture::Lowered));
     assert!(matches!(s.output.drive, DriveCommand::Straight { .. }));
     let s = tick(&mut b, &mut mem, 20.0, at(-0.5), None);
     assert_eq!(s.status, Status::Event("missed"));
@@ -299,7 +299,7 @@ fn departure_undocks_imprints_once_and_fails_without_an_imprint() {
     enter(&mut u, &mut mem, 0.0, at(-0.2));
     let s = tick(&mut u, &mut mem, 0.1, at(-0.1), None);
     assert_eq!(
-        (s.status, s.output.aux.posture),
+        (s.status, s.output.aux.get::<Posture>()),
         (Status::Running, Some(Posture::Lowered))
     );
     assert_eq!(tick(&mut u, &mut mem, 5.0, at(0.16), None).status, Status::Event("out"));
@@ -343,8 +343,13 @@ fn the_dock_switch_is_released_only_by_contact() {
     let mut c = DockSwitch::new("dock_switch");
     assert!(c.tick(&mut mem, &Inputs::empty(0.0)).is_none());
     let mut inputs = Inputs::empty(0.1);
-    inputs.dock_contact = Some(Stamped::new(0.1, true));
+    let sensors = [Some(SensorInput {
+        kind: DOCK_CONTACT_KIND,
+        stamp: 0.1,
+        values: &[1.0],
+    })];
+    inputs.sensors = &sensors;
     let s = c.tick(&mut mem, &inputs).unwrap();
     assert_eq!(s.status, Status::Done(Outcome::Docked));
-    assert_eq!(s.output.aux.posture, Some(Posture::Lowered));
+    assert_eq!(s.output.aux.get::<Posture>(), Some(Posture::Lowered));
 }

@@ -10,7 +10,7 @@ use marsupial::geometry::Pose2;
 use marsupial::perception::RgbImage;
 use marsupial::profile::Profile;
 use marsupial::schemas::Agent;
-use marsupial::schemas::{CameraInput, CameraInputs, Inputs, OdometryReading, Stamped};
+use marsupial::schemas::{CameraInput, CameraInputs, DOCK_CONTACT_KIND, Inputs, OdometryReading, SensorInput, Stamped};
 use std::path::Path;
 
 fn shipped() -> String {
@@ -37,7 +37,13 @@ fn tick(agent: &mut Box<dyn Agent>, t: f64, frame: &RgbImage, contact: bool) -> 
             ..Default::default()
         },
     ));
-    inputs.dock_contact = Some(Stamped::new(t, contact));
+    let plates = [f64::from(u8::from(contact))];
+    let sensors = [Some(SensorInput {
+        kind: DOCK_CONTACT_KIND,
+        stamp: t,
+        values: &plates,
+    })];
+    inputs.sensors = &sensors;
     agent.tick(&mut (), &inputs);
     let mut out = Vec::new();
     agent.explain(&mut out);

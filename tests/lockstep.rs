@@ -5,8 +5,10 @@
 use marsupial::arbiter::{InputKind, Lockstep, LoopConfig, LoopStatus, ReactiveLoop, Staleness, StopReason};
 use marsupial::kinematics::{Differential, DriveLimits, DriveModel};
 use marsupial::perception::RgbImage;
-use marsupial::robot::{Camera, DockSensor, Drive, Exposure, HardwareError, Robot, Sensor, WheelEncoders, WheelTravel};
-use marsupial::schemas::{Behavior, DriveCommand, Feedback, Inputs, MotorOutput, Step};
+use marsupial::robot::{Camera, Drive, Exposure, HardwareError, Robot, Sensor, WheelEncoders, WheelTravel};
+use marsupial::schemas::{
+    Behavior, DOCK_CONTACT_KIND, DeviceReading, DockContact, DriveCommand, Feedback, Inputs, MotorOutput, Step,
+};
 use std::sync::{Arc, Mutex};
 
 /// A camera that delivers frames until `silent_from` captures, then nothing.
@@ -84,8 +86,6 @@ fn config(sensor_stale: Option<f64>) -> LoopConfig {
         staleness: Staleness {
             camera: Some(0.25),
             odometry: Some(0.25),
-            tether: None,
-            dock_switch: None,
             sensors: vec![sensor_stale],
             camera_repeats_stale: true,
         },
@@ -95,6 +95,7 @@ fn config(sensor_stale: Option<f64>) -> LoopConfig {
             max_speed: 0.5,
             max_turn_rate: 1.0,
         },
+        devices: Default::default(),
     }
 }
 
@@ -195,13 +196,14 @@ fn a_required_sensor_that_never_reads_stops_the_robot() {
 struct FadingSwitch {
     answers: u32,
 }
-impl DockSensor for FadingSwitch {
-    fn in_contact(&mut self) -> Result<bool, HardwareError> {
+impl Sensor for FadingSwitch {
+    fn read(&mut self, values: &mut Vec<f64>) -> Result<(), HardwareError> {
         if self.answers == 0 {
             return Err(HardwareError::NotReady);
         }
         self.answers -= 1;
-        Ok(false)
+        DockContact(false).encode(values);
+        Ok(())
     }
 }
 
@@ -222,10 +224,9 @@ fn the_dock_switch_and_buffered_frames_are_checked_for_age() {
     let statuses = |camera: Box<dyn Camera>, dock_switch: Option<f64>| {
         let mut robot = Robot::new(vec![camera], Box::new(Log::default()));
         robot.encoders = Some(Box::new(Rolling(0.0)));
-        robot.dock_sensor = Some(Box::new(FadingSwitch { answers: 3 }));
-        let mut cfg = config(None);
-        cfg.staleness.sensors.clear();
-        cfg.staleness.dock_switch = dock_switch;
+        robot.sensors.push(Box::new(FadingSwitch { answers: 3 }));
+        let mut cfg = config(dock_switch);
+        cfg.devices.sensors = vec![DOCK_CONTACT_KIND.into()];
         let mut lp = ReactiveLoop::new(Box::new(Watch::default()), cfg);
         let mut step = Lockstep::new(&robot, lp.config());
         (0..8)
@@ -246,7 +247,7 @@ fn the_dock_switch_and_buffered_frames_are_checked_for_age() {
             st,
             LoopStatus::SafeStop {
                 reason: StopReason::Stale {
-                    input: InputKind::DockSwitch,
+                    input: InputKind::Sensor(0),
                     ..
                 }
             }

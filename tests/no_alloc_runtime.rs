@@ -106,8 +106,6 @@ fn the_threaded_runtime_does_not_allocate_per_tick() {
         staleness: Staleness {
             camera: Some(0.2),
             odometry: Some(0.2),
-            tether: None,
-            dock_switch: None,
             sensors: vec![Some(0.2)],
             camera_repeats_stale: true,
         },
@@ -117,6 +115,7 @@ fn the_threaded_runtime_does_not_allocate_per_tick() {
             max_speed: 0.5,
             max_turn_rate: 1.0,
         },
+        devices: Default::default(),
     };
     let mut lp = ReactiveLoop::new(Box::new(Creep), config);
     let cfg = RuntimeConfig {

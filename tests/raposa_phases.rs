@@ -19,8 +19,8 @@ use marsupial::perception::{BlueRegion, Ellipse, PyramidDetection, PyramidPercep
 use marsupial::profile::tree::NodeSpec;
 use marsupial::profile::{Profile, SegmentationMode};
 use marsupial::schemas::{
-    Behavior, DriveCommand, FailureReason, Guides, Inputs, Mission, MissionError, OdometryReading, Outcome, Stamped,
-    Status, Step,
+    ArmPosition, Behavior, DOCK_CONTACT_KIND, DriveCommand, FailureReason, Guides, Inputs, Lights, Mission,
+    MissionError, OdometryReading, Outcome, SensorInput, Stamped, Status, Step,
 };
 
 fn profile() -> Profile {
@@ -396,19 +396,19 @@ fn final_runs_the_state_1_law_once_then_creeps_and_retries() {
     let near = seen(0.28, Some(3.0), [4.0, 10.0], true);
     enter(&mut f, &mut mem, 5.0, at(0.5), near);
     let aux = mem.aux;
-    assert_eq!(aux.arm, Some(-g.k_arm * 10.0));
-    assert_eq!(aux.lights, Some(true));
+    assert_eq!(aux.get::<ArmPosition>(), Some(ArmPosition(-g.k_arm * 10.0)));
+    assert_eq!(aux.get::<Lights>(), Some(Lights(true)));
     let first = tick(&mut f, &mut mem, 5.0, at(0.5), near);
     let mut approach = servo::Approach::new("approach");
     assert_eq!(first.output, tick(&mut approach, &mut mem, 5.0, at(0.5), near).output);
-    assert_eq!(first.output.aux.lights, Some(true));
+    assert_eq!(first.output.aux.get::<Lights>(), Some(Lights(true)));
     let t = twist(&tick(&mut f, &mut mem, 5.1, at(0.5), near));
     assert_eq!(t.v, -g.final_speed_mps);
     assert_eq!(tick(&mut f, &mut mem, 14.9, at(0.5), near).status, Status::Running);
     let end = tick(&mut f, &mut mem, 15.1, at(0.5), near);
     assert_eq!(end.status, Status::Event("retry"));
     assert_eq!(end.output.drive, DriveCommand::Stop);
-    assert_eq!(end.output.aux.lights, Some(false));
+    assert_eq!(end.output.aux.get::<Lights>(), Some(Lights(false)));
     assert_eq!(mem.retries, 1);
     // The last retry used: retries exhausted.
     mem.retries = 3;
@@ -496,11 +496,16 @@ fn the_dock_switch_closes_the_guides_and_docks() {
     let mut s = DockSwitch::new("dock_switch");
     assert!(s.tick(&mut mem, &Inputs::empty(0.0)).is_none());
     let mut i = Inputs::empty(0.1);
-    i.dock_contact = Some(Stamped::new(0.1, true));
+    let sensors = [Some(SensorInput {
+        kind: DOCK_CONTACT_KIND,
+        stamp: 0.1,
+        values: &[1.0],
+    })];
+    i.sensors = &sensors;
     let step = s.tick(&mut mem, &i).unwrap();
     assert_eq!(step.status, Status::Done(Outcome::Docked));
     assert_eq!(step.output.drive, DriveCommand::Stop);
-    assert_eq!(step.output.aux.guides, Some(Guides::Closed));
+    assert_eq!(step.output.aux.get::<Guides>(), Some(Guides::Closed));
 }
 
 #[test]
@@ -520,7 +525,7 @@ fn the_memory_perceives_only_outside_the_departure() {
     assert_eq!((m.now, m.odo), (0.5, at(0.2)), "time and odometry still follow");
     assert!(m.percept.view.is_some(), "the perception did not run");
     m.begin(&Mission::docking()).unwrap();
-    assert_eq!(m.aux.guides, Some(Guides::Open));
+    assert_eq!(m.aux.get::<Guides>(), Some(Guides::Open));
     m.unseen = 2;
     SharedMemory::perceive(&mut m, &inputs(0.6, at(0.2)));
     assert!(m.percept.view.is_none(), "no camera: nothing seen");

@@ -96,6 +96,7 @@ fn config(staleness: Staleness) -> LoopConfig {
             max_speed: 0.5,
             max_turn_rate: 1.0,
         },
+        devices: Default::default(),
     }
 }
 
@@ -145,8 +146,6 @@ fn run(seed: u64) -> String {
     let mut lp = make_loop(Staleness {
         camera: Some(0.5),
         odometry: None,
-        tether: None,
-        dock_switch: None,
         sensors: Vec::new(),
         camera_repeats_stale: false,
     });
@@ -167,8 +166,6 @@ fn run(seed: u64) -> String {
                     twist: Twist::ZERO,
                 },
             )),
-            tether: None,
-            dock_contact: None,
             sensors: &[],
         };
         let out = lp.tick(&inputs);
@@ -200,8 +197,6 @@ fn one_tick<B: marsupial::schemas::Behavior + ?Sized>(
         now,
         cameras: &cams,
         odometry: odo.map(|o| Stamped::new(now, o)),
-        tether: None,
-        dock_contact: None,
         sensors: &[],
     };
     let out = lp.tick(&inputs);
@@ -220,8 +215,6 @@ fn stale_missing_and_bad_inputs_stop_then_resume() {
     let mut lp = make_loop(Staleness {
         camera: Some(0.5),
         odometry: None,
-        tether: None,
-        dock_switch: None,
         sensors: Vec::new(),
         camera_repeats_stale: false,
     });
@@ -306,8 +299,6 @@ fn required_odometry_must_be_fresh() {
     let mut lp = make_loop(Staleness {
         camera: None,
         odometry: Some(0.2),
-        tether: None,
-        dock_switch: None,
         sensors: Vec::new(),
         camera_repeats_stale: false,
     });

@@ -1,6 +1,6 @@
 //! The ROS 2 bridge end to end, with the simulator as a second Zenoh participant: it
 //! publishes the rendered frames, odometry and the dock switch in `rmw_zenoh`'s keys and
-//! CDR, applies the `cmd_vel`, `posture`, `dock_guides` and `lights` it receives, and
+//! CDR, applies the `cmd_vel` and `posture` it receives (Bujold declares those), and
 //! calls the node's `undock_robot` and `dock_robot` actions.
 //!
 //! Network: the node listens on `tcp/127.0.0.1:0` (a port the OS chooses) and the
@@ -23,7 +23,12 @@ use marsupial::ros2::messages::{
 };
 use marsupial::ros2::node::encode_bool;
 use marsupial::ros2::{BridgeConfig, Ros2Node, zenoh_config};
-use marsupial::schemas::{Guides, Posture};
+use marsupial::schemas::{DOCK_CONTACT_KIND, DeviceCommand, DeviceReading, DockContact, POSTURE_KIND, Posture};
+
+/// Index of the profile's device of kind `kind` (the sim robot's devices are in profile order).
+fn device(kinds: &[String], kind: &str) -> usize {
+    kinds.iter().position(|k| k == kind).expect("the profile declares it")
+}
 use marsupial::sim::campaign::{self, Prepared};
 use marsupial::sim::robot::{SimCamera, SimDevices, SimRobot};
 use marsupial::sim::run::{Recording, docked_robot, run_one};
@@ -86,6 +91,7 @@ impl Simulator {
         let mut threads = Vec::new();
         let frames = Arc::new(Mutex::new(0));
         let mut robot = sim.robot(&SimDevices::default()).unwrap();
+        let kinds = sim.with(|s| s.profile().loop_config().devices);
         let rate = sim.with(|s| s.profile().loop_.rate_hz);
         let publisher = |name: &str, ty: &interfaces::Interface| {
             let key = node.key(name, ty);
@@ -151,7 +157,7 @@ impl Simulator {
             let (odom, go) = publisher("odom", &interfaces::odometry());
             let (switch, gs) = publisher("dock_contact", &interfaces::message("std_msgs/msg/Bool"));
             let mut odometer = robot.odometer.take().unwrap();
-            let mut plates = robot.dock_sensor.take().unwrap();
+            let mut plates = robot.sensors.swap_remove(device(&kinds.sensors, DOCK_CONTACT_KIND));
             let stop = stop.clone();
             threads.push(std::thread::spawn(move || {
                 let mut buf = Vec::new();
@@ -162,8 +168,9 @@ impl Simulator {
                         encode_odometry(&mut buf, stamp(now_ns()), o.pose, o.twist.v, o.twist.omega);
                         put(&odom, go, seq, &buf);
                     }
-                    if let Ok(c) = plates.in_contact() {
-                        put(&switch, gs, seq, &encode_bool(c));
+                    let mut v = Vec::new();
+                    if let Some(c) = plates.read(&mut v).ok().and_then(|()| DockContact::decode(&v)) {
+                        put(&switch, gs, seq, &encode_bool(c.0));
                     }
                     std::thread::sleep(Duration::from_millis(20));
                 }
@@ -171,8 +178,9 @@ impl Simulator {
         }
         // What the node commands.
         let drive = Arc::new(Mutex::new(robot.drive));
-        let posture = Arc::new(Mutex::new(robot.posture.take().unwrap()));
-        let guides = Arc::new(Mutex::new(robot.guides.take().unwrap()));
+        // Bujold's actuators: her posture (she has no guides: the node publishes none).
+        let posture = robot.actuators.swap_remove(device(&kinds.actuators, POSTURE_KIND));
+        let posture = Arc::new(Mutex::new(posture));
         let subscribe = |name: &str, ty: &interfaces::Interface, f: OnPayload| {
             session
                 .declare_subscriber(node.key(name, ty))
@@ -199,18 +207,7 @@ impl Simulator {
                         "lowered" => Posture::Lowered,
                         _ => Posture::Raised,
                     };
-                    posture.lock().unwrap().set(p).unwrap();
-                }),
-            ),
-            subscribe(
-                "dock_guides",
-                &string,
-                Box::new(move |b| {
-                    let g = match text(b).unwrap().as_str() {
-                        "closed" => Guides::Closed,
-                        _ => Guides::Open,
-                    };
-                    guides.lock().unwrap().set(g).unwrap();
+                    posture.lock().unwrap().apply(p.encode().values()).unwrap();
                 }),
             ),
         ];

@@ -7,7 +7,7 @@ use marsupial::kinematics::{Differential, DriveLimits, DriveModel};
 use marsupial::perception::RgbImage;
 use marsupial::robot::{Actuator, Camera, Drive, Exposure, HardwareError, Robot, Sensor};
 use marsupial::schemas::{
-    Agent, Behavior, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Outcome, Step,
+    Agent, Behavior, Command, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Outcome, Step,
 };
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -74,8 +74,6 @@ fn loop_config() -> LoopConfig {
         staleness: Staleness {
             camera: Some(0.25),
             odometry: None,
-            tether: None,
-            dock_switch: None,
             sensors: Vec::new(),
             camera_repeats_stale: true,
         },
@@ -85,6 +83,7 @@ fn loop_config() -> LoopConfig {
             max_speed: 0.5,
             max_turn_rate: 1.0,
         },
+        devices: Default::default(),
     }
 }
 
@@ -227,7 +226,7 @@ impl Behavior for TwoMissions {
         if let (Mission::Docking { .. }, Some(s)) = (m, inputs.sensor(0)) {
             let sum: f64 = s.values.iter().sum();
             self.sums.lock().unwrap().push(sum);
-            out.aux.actuators[0] = Some(sum);
+            out.aux.put(Command::of("log", [sum]));
         }
         let fb = Feedback::new(m.name(), inputs.now);
         Some(if self.ticks >= 5 {
@@ -267,8 +266,8 @@ impl Sensor for Ones {
 #[derive(Clone, Default)]
 struct LogActuator(Arc<Mutex<Vec<f64>>>);
 impl Actuator for LogActuator {
-    fn apply(&mut self, value: f64) -> Result<(), HardwareError> {
-        self.0.lock().unwrap().push(value);
+    fn apply(&mut self, values: &[f64]) -> Result<(), HardwareError> {
+        self.0.lock().unwrap().extend_from_slice(values);
         Ok(())
     }
 }
@@ -295,6 +294,8 @@ fn missions_run_one_after_the_other_and_custom_devices_reach_the_behavior() {
     };
     let mut config = loop_config();
     config.staleness.sensors = vec![Some(0.25)];
+    config.devices.sensors = vec!["ones".into()];
+    config.devices.actuators = vec!["log".into()];
     let mut lp = ReactiveLoop::new(Box::new(agent), config);
     let cfg = RuntimeConfig {
         max_duration: Some(Duration::from_secs(5)),

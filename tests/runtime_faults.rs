@@ -153,8 +153,6 @@ fn loop_config(odometry: bool) -> LoopConfig {
         staleness: Staleness {
             camera: Some(0.25),
             odometry: odometry.then_some(0.25),
-            tether: None,
-            dock_switch: None,
             sensors: Vec::new(),
             // The fakes deliver blank frames: repeats are not faults here.
             camera_repeats_stale: false,
@@ -165,6 +163,7 @@ fn loop_config(odometry: bool) -> LoopConfig {
             max_speed: 0.5,
             max_turn_rate: 1.0,
         },
+        devices: Default::default(),
     }
 }
 

@@ -7,8 +7,9 @@
 
 use marsupial::geometry::{Pose2, Twist, integrate_twist};
 use marsupial::perception::RgbImage;
-use marsupial::robot::{Camera, DockSensor, Drive, Exposure, HardwareError, Sensor, WheelEncoders, WheelTravel};
+use marsupial::robot::{Camera, Drive, Exposure, HardwareError, Sensor, WheelEncoders, WheelTravel};
 use marsupial::schemas::DriveCommand;
+use marsupial::schemas::{DeviceReading, DockContact};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
@@ -177,14 +178,15 @@ impl WheelEncoders for ToyEncoders {
     }
 }
 
-/// The dock's contact switch: closes when the robot's centre is within 35 cm of the
-/// beacon.
+/// The dock's contact switch (the crate's `dock_contact` kind): closes when the robot's
+/// centre is within 35 cm of the beacon.
 pub struct ToyDockSwitch(pub Shared);
 
-impl DockSensor for ToyDockSwitch {
-    fn in_contact(&mut self) -> Result<bool, HardwareError> {
+impl Sensor for ToyDockSwitch {
+    fn read(&mut self, values: &mut Vec<f64>) -> Result<(), HardwareError> {
         let w = world(&self.0)?;
-        Ok((w.pose.x - BEACON.0).hypot(w.pose.y - BEACON.1) < 0.35)
+        DockContact((w.pose.x - BEACON.0).hypot(w.pose.y - BEACON.1) < 0.35).encode(values);
+        Ok(())
     }
 }
 

@@ -21,7 +21,7 @@ use crate::kinematics::{DriveModel, Odometry};
 use crate::perception::RgbImage;
 use crate::robot::{HardwareError, Robot, Sensing, WheelTravel};
 use crate::schemas::{
-    Behavior, CameraInput, CameraInputs, Inputs, OdometryReading, SensorInput, SensorInputs, Stamped, TetherReading,
+    Behavior, CameraInput, CameraInputs, DeviceKinds, Inputs, OdometryReading, SensorInput, SensorInputs, Stamped,
 };
 
 /// A device fault seen during a tick: (loop time, device, error).
@@ -86,8 +86,7 @@ pub struct Lockstep {
     frame_stamps: Vec<Option<f64>>,
     odometry_source: OdometrySource,
     odometry: Option<Stamped<OdometryReading>>,
-    tether: Option<Stamped<TetherReading>>,
-    dock_contact: Option<Stamped<bool>>,
+    kinds: DeviceKinds,
     sensor_values: Vec<Vec<f64>>,
     sensor_stamps: Vec<Option<f64>>,
     scratch: Vec<f64>,
@@ -112,8 +111,7 @@ impl Lockstep {
             frames,
             odometry_source: OdometrySource::new(config.drive),
             odometry: None,
-            tether: None,
-            dock_contact: None,
+            kinds: config.devices.clone(),
             sensor_values: vec![Vec::with_capacity(64); n],
             sensor_stamps: vec![None; n],
             scratch: Vec::with_capacity(64),
@@ -133,7 +131,7 @@ impl Lockstep {
 
     /// Reads every device at time `now`.
     pub fn sense(&mut self, robot: &mut Robot, now: f64) {
-        let (cameras, mut sensing, mut actuation) = robot.split();
+        let (cameras, mut sensing, _) = robot.split();
         for (i, cam) in cameras.iter_mut().enumerate() {
             if let Some(frame) = self.frames.get_mut(i) {
                 match cam.capture(frame) {
@@ -145,18 +143,6 @@ impl Lockstep {
         }
         if let Some(r) = self.odometry_source.read(&mut sensing, now) {
             keep(&mut self.odometry, r, now, "odometry", &mut self.errors);
-        }
-        if let Some(t) = actuation.tether.as_mut() {
-            keep(&mut self.tether, t.read(), now, "tether", &mut self.errors);
-        }
-        if let Some(d) = sensing.dock_sensor.as_mut() {
-            keep(
-                &mut self.dock_contact,
-                d.in_contact(),
-                now,
-                "dock_sensor",
-                &mut self.errors,
-            );
         }
         for (i, s) in sensing.sensors.iter_mut().enumerate() {
             self.scratch.clear();
@@ -180,24 +166,32 @@ impl Lockstep {
             .zip(&self.frame_stamps)
             .map(|(f, s)| s.map(|stamp| CameraInput { stamp, image: f.view() }))
             .collect();
+        let kinds = &self.kinds;
         let sensors: SensorInputs<'_> = self
             .sensor_values
             .iter()
             .zip(&self.sensor_stamps)
-            .map(|(v, s)| s.map(|stamp| SensorInput { stamp, values: v }))
+            .enumerate()
+            .map(|(i, (v, s))| {
+                s.map(|stamp| SensorInput {
+                    kind: kinds.sensors.get(i).map_or("", String::as_str),
+                    stamp,
+                    values: v,
+                })
+            })
             .collect();
         let inputs = Inputs {
             now,
             cameras: &cams,
             odometry: self.odometry,
-            tether: self.tether,
-            dock_contact: self.dock_contact,
             sensors: &sensors,
         };
         let out = lp.tick(&inputs);
         let (_, _, mut actuation) = robot.split();
         let errors = &mut self.errors;
-        actuation.apply(&out.command, |device, e| errors.push((now, device, e)));
+        actuation.apply(&out.command, &self.kinds.actuators, |device, e| {
+            errors.push((now, device, e))
+        });
         out
     }
 }

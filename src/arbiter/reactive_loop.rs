@@ -10,8 +10,8 @@ use super::repeats::Repeats;
 use crate::kinematics::{DriveLimits, DriveModel};
 use crate::robot::DeviceId;
 use crate::schemas::{
-    Agent, Auxiliary, Behavior, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Outcome, Status,
-    TetherCommand,
+    Agent, Auxiliary, Behavior, DeviceKinds, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput,
+    Outcome, Status, TetherCommand,
 };
 use serde::Serialize;
 use std::fmt;
@@ -24,12 +24,8 @@ pub enum InputKind {
     Camera(usize),
     /// Odometry.
     Odometry,
-    /// Tether sensor.
-    Tether,
     /// The `[[sensors]]` entry with this index (profile order).
     Sensor(usize),
-    /// The dock switch.
-    DockSwitch,
     /// The loop clock itself.
     Clock,
 }
@@ -39,9 +35,7 @@ impl fmt::Display for InputKind {
         match self {
             InputKind::Camera(i) => write!(f, "camera {i}"),
             InputKind::Odometry => f.write_str("odometry"),
-            InputKind::Tether => f.write_str("tether"),
             InputKind::Sensor(i) => write!(f, "sensor {i}"),
-            InputKind::DockSwitch => f.write_str("dock switch"),
             InputKind::Clock => f.write_str("clock"),
         }
     }
@@ -175,11 +169,8 @@ pub struct Staleness {
     pub camera: Option<f64>,
     /// Limit for odometry.
     pub odometry: Option<f64>,
-    /// Limit for the tether sensor.
-    pub tether: Option<f64>,
-    /// Limit for the dock switch.
-    pub dock_switch: Option<f64>,
-    /// Limit per `[[sensors]]` entry (profile order).
+    /// Limit per `[[sensors]]` entry (profile order: the tether reel and the dock switch
+    /// are sensors like the others).
     pub sensors: Vec<Option<f64>>,
     /// Date a frame bit-identical to its camera's last one from when that content first
     /// arrived, so a driver re-sending one frame as new turns stale like a silent camera
@@ -203,6 +194,10 @@ pub struct LoopConfig {
     pub drive: DriveModel,
     /// The base's limits.
     pub limits: DriveLimits,
+    /// The kinds of the profile's `[[sensors]]` and `[[actuators]]`, in order: the loop
+    /// drivers ([`Lockstep`](super::Lockstep), the [`runtime`](super::runtime)) label each
+    /// reading and route each command by them.
+    pub devices: DeviceKinds,
 }
 
 /// The loop's status after a tick.
@@ -288,13 +283,10 @@ fn is_fresh(age: f64, limit: f64) -> bool {
 pub fn safe_stop_command() -> MotorOutput {
     MotorOutput {
         drive: DriveCommand::Stop,
-        aux: Auxiliary {
-            tether: Some(TetherCommand {
-                reel_rate: 0.0,
-                free_wheel: false,
-            }),
-            ..Auxiliary::default()
-        },
+        aux: Auxiliary::with(TetherCommand {
+            reel_rate: 0.0,
+            free_wheel: false,
+        }),
     }
 }
 
@@ -437,39 +429,13 @@ impl LoopCore {
                 input: InputKind::Odometry,
             });
         }
-        if let Some(t) = inputs.tether
-            && !(t.value.length.is_finite() && t.value.motor_current_a.is_finite() && t.stamp.is_finite())
-        {
-            return Some(StopReason::NonFinite {
-                input: InputKind::Tether,
-            });
-        }
-        if let Some(d) = inputs.dock_contact
-            && !d.stamp.is_finite()
-        {
-            return Some(StopReason::NonFinite {
-                input: InputKind::DockSwitch,
-            });
-        }
-        let checks = [
-            (
-                InputKind::Odometry,
-                self.config.staleness.odometry,
-                inputs
-                    .odometry
-                    .map(|o| (o.stamp, self.repeats.odometry_since().unwrap_or(o.stamp))),
-            ),
-            (
-                InputKind::Tether,
-                self.config.staleness.tether,
-                inputs.tether.map(|t| (t.stamp, t.stamp)),
-            ),
-            (
-                InputKind::DockSwitch,
-                self.config.staleness.dock_switch,
-                inputs.dock_contact.map(|d| (d.stamp, d.stamp)),
-            ),
-        ];
+        let checks = [(
+            InputKind::Odometry,
+            self.config.staleness.odometry,
+            inputs
+                .odometry
+                .map(|o| (o.stamp, self.repeats.odometry_since().unwrap_or(o.stamp))),
+        )];
         for (i, limit) in self.config.staleness.sensors.iter().enumerate() {
             let input = InputKind::Sensor(i);
             match (inputs.sensor(i), limit) {

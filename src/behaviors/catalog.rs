@@ -46,7 +46,7 @@ use super::agent::BuildError;
 use super::composed::{Composed, SharedMemory};
 use super::registry::Registry;
 use crate::config::{ConfigError, Validate, Validator};
-use crate::profile::{FiducialKind, FiducialKinds, Profile, RANGE_KIND, RangeParams};
+use crate::profile::{FiducialKind, FiducialKinds, Profile};
 use crate::schemas::Agent;
 use serde::de::DeserializeOwned;
 use std::collections::BTreeMap;
@@ -178,14 +178,19 @@ impl Default for Catalog {
 
 impl Catalog {
     /// A catalog with no robot kinds, knowing the crate's fiducial kinds
-    /// ([`FiducialKinds::builtin`]) and its `range` sensor kind.
+    /// ([`FiducialKinds::builtin`]) and its device kinds ([`crate::profile::devices`]).
     pub fn new() -> Self {
         let mut c = Self {
             robots: BTreeMap::new(),
             fiducials: FiducialKinds::builtin(),
             devices: Devices::default(),
         };
-        c.register_sensor_kind(RANGE_KIND, |p| RangeParams::from_table(p).map(|_| ()));
+        for (kind, check) in crate::profile::devices::builtin_sensor_kinds() {
+            c.register_sensor_kind(kind, check);
+        }
+        for (kind, check) in crate::profile::devices::builtin_actuator_kinds() {
+            c.register_actuator_kind(kind, check);
+        }
         c
     }
 

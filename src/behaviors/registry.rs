@@ -34,8 +34,8 @@
 
 use crate::arbiter::{Next, Priority, Selector, Sequencer, VectorSum};
 use crate::config::ConfigError;
+use crate::profile::Profile;
 use crate::profile::tree::{FINISH, Lead, NodeSpec, TreeSpec};
-use crate::profile::{Profile, RANGE_KIND, RangeParams};
 use crate::schemas::Behavior;
 use serde::de::DeserializeOwned;
 use std::collections::BTreeMap;
@@ -66,7 +66,7 @@ impl LeafArgs<'_> {
     }
 
     /// Index of the profile's first `[[actuators]]` entry of kind `kind` (the leaf
-    /// commands it through [`Auxiliary::actuators`](crate::schemas::Auxiliary::actuators)).
+    /// commands its kind through [`Auxiliary::set`](crate::schemas::Auxiliary::set)).
     ///
     /// # Errors
     /// A message saying the leaf needs such an actuator and the profile declares none.
@@ -159,8 +159,8 @@ impl<M: 'static> Default for Registry<M> {
 }
 
 impl<M: 'static> Registry<M> {
-    /// A registry with no schemas, knowing the device kinds the crate ships (the
-    /// [`RANGE_KIND`] range finder).
+    /// A registry with no schemas, knowing the device kinds the crate ships
+    /// ([`crate::profile::devices`]).
     pub fn new() -> Self {
         let mut r = Self {
             leaves: BTreeMap::new(),
@@ -168,7 +168,12 @@ impl<M: 'static> Registry<M> {
             sensor_kinds: BTreeMap::new(),
             actuator_kinds: BTreeMap::new(),
         };
-        r.register_sensor_kind(RANGE_KIND, |p| RangeParams::from_table(p).map(|_| ()));
+        for (kind, check) in crate::profile::devices::builtin_sensor_kinds() {
+            r.register_sensor_kind(kind, check);
+        }
+        for (kind, check) in crate::profile::devices::builtin_actuator_kinds() {
+            r.register_actuator_kind(kind, check);
+        }
         r
     }
 

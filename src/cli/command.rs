@@ -132,7 +132,8 @@ enum Command {
     /// Run a profile's behaviors as a ROS 2 node over Zenoh (built with `--features ros2`).
     ///
     /// Speaks `rmw_zenoh`'s key expressions and CDR: subscribes to the camera image(s),
-    /// odometry and the dock switch, publishes cmd_vel (and posture, dock_guides, lights),
+    /// odometry and the dock switch, publishes cmd_vel (and the posture, dock_guides and
+    /// lights the profile declares),
     /// and serves the actions dock_robot and undock_robot (marsupial_msgs/action/Dock and
     /// Undock, after Nav2's DockRobot and UndockRobot). Multicast scouting is off: it
     /// talks to the endpoints given and nothing else.

@@ -56,13 +56,6 @@ pub struct LoopSpec {
     /// Odometry is required; older than this stops the robot, s.
     #[serde(default)]
     pub odometry_stale_s: Option<f64>,
-    /// Tether sensing is required; older than this stops the robot, s.
-    #[serde(default)]
-    pub tether_stale_s: Option<f64>,
-    /// The dock switch is required; a reading older than this stops the robot, s (a
-    /// docking that ends on the switch must not trust a switch that stopped answering).
-    #[serde(default)]
-    pub dock_switch_stale_s: Option<f64>,
     /// A frame bit-identical to its camera's last one is the same exposure re-sent by a
     /// frozen driver, and ages from when it first arrived (default true: a real sensor's
     /// noise makes every exposure differ). Set false for a noiseless synthetic camera.
@@ -96,8 +89,6 @@ pub(crate) fn validate_loop(l: &LoopSpec, v: &mut Validator<'_>) {
     for (path, s) in [
         ("loop.camera_stale_s", l.camera_stale_s),
         ("loop.odometry_stale_s", l.odometry_stale_s),
-        ("loop.tether_stale_s", l.tether_stale_s),
-        ("loop.dock_switch_stale_s", l.dock_switch_stale_s),
     ] {
         if let Some(s) = s {
             v.positive(path, s);

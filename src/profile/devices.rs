@@ -1,25 +1,38 @@
-//! `[[sensors]]` and `[[actuators]]`: devices beyond the ones every docking robot has.
+//! `[[sensors]]` and `[[actuators]]`: every device beyond the cameras, the drive and
+//! odometry, in one model.
 //!
-//! Cameras, odometry, the tether and the dock switch have their own tables and fields in
-//! [`Inputs`](crate::schemas::Inputs). Anything else (a range finder, an IMU, a gripper)
-//! is declared here by name and *kind*: the kind says what the readings mean and which
-//! `params` it takes. Kinds are open: the crate ships [`RANGE_KIND`], and a user's crate
-//! registers its own with
+//! Each entry names a device and its *kind*: the kind says what the readings or commands
+//! mean and which `params` it takes. The crate's own devices are kinds like any user's
+//! ([`crate::schemas::devices`]): `tether` (the reel: a sensor for its length and current
+//! and an actuator for its rate; needs a `[tether]` table), `dock_contact` (the pressure
+//! plates), `arm`, `lights`, `guides`, `posture`, and the [`RANGE_KIND`] range finder. A
+//! robot has the devices its profile declares, no more: the simulator builds those, the
+//! loop reads and commands those, and a command for a kind the profile does not declare
+//! goes nowhere. Kinds are open: a user's crate registers its own with
 //! [`Registry::register_sensor_kind`](crate::behaviors::registry::Registry::register_sensor_kind)
 //! (or `register_actuator_kind`), so a new device needs no change to marsupial. Readings
-//! reach the schemas as [`Inputs::sensor`](crate::schemas::Inputs::sensor), indexed in
-//! this list's order; commands leave through
-//! [`Auxiliary::actuators`](crate::schemas::Auxiliary::actuators), indexed in
-//! `[[actuators]]` order.
+//! reach the schemas as [`Inputs::sensor`](crate::schemas::Inputs::sensor) (this list's
+//! order) or typed ([`Inputs::reading`](crate::schemas::Inputs::reading)); commands leave
+//! through [`Auxiliary::set`](crate::schemas::Auxiliary::set), to every actuator of their
+//! kind.
 //!
 //! ```toml
 //! [[sensors]]
+//! name = "plates"
+//! kind = "dock_contact"
+//! stale_s = 0.5                  # required: safe stop when older (omit: optional)
+//!
+//! [[sensors]]
 //! name = "bumper_ranges"
 //! kind = "range"
-//! stale_s = 0.3                  # required: safe stop when older (omit: optional)
 //! params = { beams = 9, fov_deg = 120.0, max_range_m = 1.5 }
+//!
+//! [[actuators]]
+//! name = "hips"
+//! kind = "posture"
 //! ```
 
+use super::Profile;
 use crate::config::Validator;
 use serde::{Deserialize, Serialize};
 
@@ -27,11 +40,33 @@ use serde::{Deserialize, Serialize};
 /// to the nearest obstacle along it (m), `max_range_m` when nothing is in range.
 pub const RANGE_KIND: &str = "range";
 
-pub use crate::schemas::motor_output::MAX_ACTUATORS;
+pub use crate::schemas::devices::{BUILTIN_ACTUATOR_KINDS, BUILTIN_SENSOR_KINDS, INLINE_DEVICES, TETHER_KIND};
 
-/// Most `[[sensors]]` a profile may declare without a tick allocating (more are allowed;
-/// the per-tick list then spills to the heap).
-pub const INLINE_SENSORS: usize = 4;
+/// Checks a device kind's `params` table; the error names the field.
+pub type KindCheckFn = fn(&toml::Table) -> Result<(), String>;
+
+/// A kind that takes no params.
+fn no_params(params: &toml::Table) -> Result<(), String> {
+    match params.keys().next() {
+        None => Ok(()),
+        Some(k) => Err(format!("params: unknown field `{k}`: this kind takes no params")),
+    }
+}
+
+/// The sensor kinds the crate ships, with their params checks: the [`RANGE_KIND`] range
+/// finder and [`BUILTIN_SENSOR_KINDS`]. Every registry starts with them.
+pub fn builtin_sensor_kinds() -> impl Iterator<Item = (&'static str, KindCheckFn)> {
+    let range: KindCheckFn = |p| RangeParams::from_table(p).map(|_| ());
+    std::iter::once((RANGE_KIND, range)).chain(BUILTIN_SENSOR_KINDS.map(|k| (k, no_params as KindCheckFn)))
+}
+
+/// The actuator kinds the crate ships ([`BUILTIN_ACTUATOR_KINDS`]), with their params
+/// checks. Every registry starts with them.
+pub fn builtin_actuator_kinds() -> impl Iterator<Item = (&'static str, KindCheckFn)> {
+    BUILTIN_ACTUATOR_KINDS
+        .into_iter()
+        .map(|k| (k, no_params as KindCheckFn))
+}
 
 /// One `[[sensors]]` entry.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -145,26 +180,57 @@ impl RangeParams {
     }
 }
 
-/// Checks names (non-empty, unique), staleness limits and the actuator count.
-pub(super) fn validate_devices(sensors: &[SensorSpec], actuators: &[ActuatorSpec], v: &mut Validator<'_>) {
+/// Checks names (non-empty, unique), staleness limits (positive, at least one tick), the
+/// actuator count, the built-in kinds' params (none) and that a `tether` device has the
+/// `[tether]` table it is simulated and planned with.
+pub(super) fn validate_devices(p: &Profile, v: &mut Validator<'_>) {
+    let tick = 1.0 / p.loop_.rate_hz;
     let mut seen: Vec<&str> = Vec::new();
-    for (i, s) in sensors.iter().enumerate() {
+    for (i, s) in p.sensors.iter().enumerate() {
         let at = format!("sensors[{i}]");
         check_name(&s.name, &s.kind, &at, &mut seen, v);
+        check_builtin(&s.kind, &s.params, &BUILTIN_SENSOR_KINDS, &at, p, v);
         if let Some(t) = s.stale_s {
             v.positive(&format!("{at}.stale_s"), t);
+            if t.is_finite() && t > 0.0 && tick.is_finite() && t < tick {
+                v.problem(
+                    &format!("{at}.stale_s"),
+                    format!("expected a limit of at least one tick (1/rate_hz = {tick:.4} s), got {t}"),
+                );
+            }
         }
     }
     seen.clear();
-    for (i, a) in actuators.iter().enumerate() {
-        check_name(&a.name, &a.kind, &format!("actuators[{i}]"), &mut seen, v);
+    for (i, a) in p.actuators.iter().enumerate() {
+        let at = format!("actuators[{i}]");
+        check_name(&a.name, &a.kind, &at, &mut seen, v);
+        check_builtin(&a.kind, &a.params, &BUILTIN_ACTUATOR_KINDS, &at, p, v);
     }
-    v.require(actuators.len() <= MAX_ACTUATORS, "actuators", || {
+    v.require(p.actuators.len() <= INLINE_DEVICES, "actuators", || {
         format!(
-            "expected at most {MAX_ACTUATORS} [[actuators]], got {}",
-            actuators.len()
+            "expected at most {INLINE_DEVICES} [[actuators]] (one tick's output holds that many commands), got {}",
+            p.actuators.len()
         )
     });
+}
+
+/// A built-in kind takes no params, and the tether needs its table.
+fn check_builtin(kind: &str, params: &toml::Table, builtin: &[&str], at: &str, p: &Profile, v: &mut Validator<'_>) {
+    if !builtin.contains(&kind) {
+        return;
+    }
+    if let Some(k) = params.keys().next() {
+        v.problem(
+            &format!("{at}.params"),
+            format!("unknown field `{k}`: kind `{kind}` takes no params"),
+        );
+    }
+    if kind == TETHER_KIND && p.tether.is_none() {
+        v.problem(
+            &format!("{at}.kind"),
+            "a `tether` device needs the profile's [tether] table (its length, reel rate and geometry)",
+        );
+    }
 }
 
 fn check_name<'a>(name: &'a str, kind: &str, at: &str, seen: &mut Vec<&'a str>, v: &mut Validator<'_>) {
@@ -200,6 +266,25 @@ mod tests {
         };
         let last = ring.beam_angle(3).to_degrees() - ring.beam_angle(0).to_degrees();
         assert!((last - 270.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_bad_builtin_device_is_an_error_at_its_line() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/bujold.toml");
+        let text = std::fs::read_to_string(&path).unwrap()
+            + "\n[[sensors]]\nname = \"reel\"\nkind = \"tether\"\nparams = { gain = 1.0 }\n";
+        let e = Profile::parse(&text, &path).unwrap_err();
+        let problems = e.problems();
+        let at = |field: &str| {
+            problems
+                .iter()
+                .find(|p| p.path == field)
+                .unwrap_or_else(|| panic!("{e}"))
+        };
+        let kind_line = text.lines().position(|l| l == "kind = \"tether\"").unwrap() + 1;
+        assert_eq!(at("sensors[1].kind").line, Some(kind_line), "{e}");
+        assert!(at("sensors[1].kind").message.contains("[tether]"), "{e}");
+        assert!(at("sensors[1].params").message.contains("`gain`"), "{e}");
     }
 
     #[test]

@@ -39,6 +39,7 @@ pub use tree::{NodeSpec, TreeSpec};
 
 use crate::arbiter::{LoopConfig, Staleness};
 use crate::config::{self, ConfigError, Validate, Validator};
+use crate::schemas::DeviceKinds;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -82,10 +83,12 @@ pub struct Profile {
     /// Tether (absent for untethered robots).
     #[serde(default)]
     pub tether: Option<TetherSpec>,
-    /// Sensors beyond cameras, odometry, tether and dock switch (see [`devices`]).
+    /// Sensors beyond cameras and odometry: the tether reel, the dock switch, a range
+    /// finder, a user's kinds (see [`devices`]).
     #[serde(default)]
     pub sensors: Vec<SensorSpec>,
-    /// Actuators beyond drive, tether, arm, lights, guides and posture (see [`devices`]).
+    /// Actuators beyond the drive: the tether reel, arm, lights, guides, posture, a user's
+    /// kinds (see [`devices`]).
     #[serde(default)]
     pub actuators: Vec<ActuatorSpec>,
     /// The behavior tree and the limits its leaves share.
@@ -122,16 +125,10 @@ impl Validate for Profile {
         if let Some(t) = &self.tether {
             geometry::validate_tether(t, v);
         }
-        devices::validate_devices(&self.sensors, &self.actuators, v);
+        devices::validate_devices(self, v);
         behavior::validate_behavior(&self.behavior, v);
         behavior::validate_loop(&self.loop_, v);
         geometry::validate_success(&self.success, v);
-        if self.loop_.tether_stale_s.is_some() && self.tether.is_none() {
-            v.problem(
-                "loop.tether_stale_s",
-                "tether sensing is required but the profile has no [tether] table",
-            );
-        }
     }
 }
 
@@ -221,14 +218,16 @@ impl Profile {
             staleness: Staleness {
                 camera: self.loop_.camera_stale_s,
                 odometry: self.loop_.odometry_stale_s,
-                tether: self.loop_.tether_stale_s,
-                dock_switch: self.loop_.dock_switch_stale_s,
                 sensors: self.sensors.iter().map(|s| s.stale_s).collect(),
                 camera_repeats_stale: self.loop_.camera_repeats_stale,
             },
             frame_sizes: self.cameras.iter().map(|c| (c.width_px, c.height_px)).collect(),
             drive: self.drive.model(),
             limits: self.drive.limits(),
+            devices: DeviceKinds {
+                sensors: self.sensors.iter().map(|s| s.kind.clone()).collect(),
+                actuators: self.actuators.iter().map(|a| a.kind.clone()).collect(),
+            },
         }
     }
 }

@@ -47,7 +47,8 @@ impl Session {
     /// AutoKrawler's state estimator for a `markers` fiducial), or
     /// with `behavior` its whole agent, started on a docking mission. `odometry` says
     /// whether the log has odometry; without it the loop does not wait for any, and
-    /// inputs the log cannot have (tether, dock switch, other sensors) are never awaited.
+    /// the profile's `[[sensors]]` (the tether reel and dock switch among them), which the
+    /// log cannot have, are never awaited.
     ///
     /// # Errors
     /// [`ReplayError::Setup`] when the profile has no perception a replay runs, or no
@@ -74,8 +75,6 @@ impl Session {
         let runner = if behavior {
             let agent = catalog.agent(profile).map_err(|e| setup(&e.to_string()))?;
             let mut config = profile.loop_config();
-            config.staleness.tether = None;
-            config.staleness.dock_switch = None;
             config.staleness.sensors.iter_mut().for_each(|s| *s = None);
             if !odometry {
                 config.staleness.odometry = None;

@@ -12,11 +12,11 @@
 //! device (reopen the port) to use it again.
 
 use super::{
-    Actuation, Actuator, Arm, BodyPosture, Camera, DockGuides, DockSensor, Drive, Exposure, HardwareError, Lights,
-    Odometer, Robot, Sensing, Sensor, TetherReel, WheelEncoders, WheelTravel,
+    Actuation, Actuator, Camera, Drive, Exposure, HardwareError, Odometer, Robot, Sensing, Sensor, WheelEncoders,
+    WheelTravel,
 };
 use crate::perception::RgbImage;
-use crate::schemas::{DriveCommand, Guides, OdometryReading, Posture, TetherCommand, TetherReading};
+use crate::schemas::{DriveCommand, OdometryReading};
 use serde::Serialize;
 use std::fmt;
 
@@ -24,8 +24,8 @@ use std::fmt;
 /// robot can have several of, which one (profile order).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
 pub struct DeviceId {
-    /// The kind: `camera`, `encoders`, `odometer`, `dock_sensor`, `sensor`, `drive`,
-    /// `tether`, `arm`, `lights`, `guides`, `posture` or `actuator`.
+    /// The kind: `camera`, `encoders`, `odometer`, `sensor`, `drive` or `actuator` (the
+    /// tether reel, dock switch, arm... are sensors and actuators of their profile kinds).
     pub kind: &'static str,
     /// Which one, for cameras, sensors and actuators.
     pub index: Option<usize>,
@@ -103,52 +103,16 @@ impl Sensor for Abandoned {
     }
 }
 impl Actuator for Abandoned {
-    fn apply(&mut self, _: f64) -> Result<(), HardwareError> {
+    fn apply(&mut self, _: &[f64]) -> Result<(), HardwareError> {
         Err(self.error())
     }
 }
-impl TetherReel for Abandoned {
-    fn command(&mut self, _: &TetherCommand) -> Result<(), HardwareError> {
-        Err(self.error())
-    }
-    fn read(&mut self) -> Result<TetherReading, HardwareError> {
-        Err(self.error())
-    }
-}
-impl Arm for Abandoned {
-    fn set_position(&mut self, _: f64) -> Result<(), HardwareError> {
-        Err(self.error())
-    }
-}
-impl Lights for Abandoned {
-    fn set(&mut self, _: bool) -> Result<(), HardwareError> {
-        Err(self.error())
-    }
-}
-impl DockGuides for Abandoned {
-    fn set(&mut self, _: Guides) -> Result<(), HardwareError> {
-        Err(self.error())
-    }
-}
-impl BodyPosture for Abandoned {
-    fn set(&mut self, _: Posture) -> Result<(), HardwareError> {
-        Err(self.error())
-    }
-}
-impl DockSensor for Abandoned {
-    fn in_contact(&mut self) -> Result<bool, HardwareError> {
-        Err(self.error())
-    }
-}
-
 /// The sensing devices, owned (lent to the runtime's sensor thread).
 pub struct SensingDevices {
     /// Wheel encoders.
     pub encoders: Option<Box<dyn WheelEncoders>>,
     /// The base's own odometry.
     pub odometer: Option<Box<dyn Odometer>>,
-    /// Dock contact sensor.
-    pub dock_sensor: Option<Box<dyn DockSensor>>,
     /// `[[sensors]]`.
     pub sensors: Vec<Box<dyn Sensor>>,
 }
@@ -160,7 +124,6 @@ impl SensingDevices {
         [
             one(self.encoders.is_some(), "encoders"),
             one(self.odometer.is_some(), "odometer"),
-            one(self.dock_sensor.is_some(), "dock_sensor"),
         ]
         .into_iter()
         .flatten()
@@ -173,7 +136,6 @@ impl SensingDevices {
         Sensing {
             encoders: self.encoders.as_mut(),
             odometer: self.odometer.as_mut(),
-            dock_sensor: self.dock_sensor.as_mut(),
             sensors: &mut self.sensors,
         }
     }
@@ -183,16 +145,6 @@ impl SensingDevices {
 pub struct ActuationDevices {
     /// The base.
     pub drive: Box<dyn Drive>,
-    /// Tether reel.
-    pub tether: Option<Box<dyn TetherReel>>,
-    /// Arm.
-    pub arm: Option<Box<dyn Arm>>,
-    /// Lights.
-    pub lights: Option<Box<dyn Lights>>,
-    /// Dock guides.
-    pub guides: Option<Box<dyn DockGuides>>,
-    /// Posture actuator.
-    pub posture: Option<Box<dyn BodyPosture>>,
     /// `[[actuators]]`.
     pub actuators: Vec<Box<dyn Actuator>>,
 }
@@ -200,30 +152,15 @@ pub struct ActuationDevices {
 impl ActuationDevices {
     /// The devices it holds.
     pub fn ids(&self) -> Vec<DeviceId> {
-        let one = |present: bool, kind| present.then_some(DeviceId::one(kind));
-        [
-            Some(DeviceId::one("drive")),
-            one(self.tether.is_some(), "tether"),
-            one(self.arm.is_some(), "arm"),
-            one(self.lights.is_some(), "lights"),
-            one(self.guides.is_some(), "guides"),
-            one(self.posture.is_some(), "posture"),
-        ]
-        .into_iter()
-        .flatten()
-        .chain((0..self.actuators.len()).map(|i| DeviceId::nth("actuator", i)))
-        .collect()
+        std::iter::once(DeviceId::one("drive"))
+            .chain((0..self.actuators.len()).map(|i| DeviceId::nth("actuator", i)))
+            .collect()
     }
 
     /// Borrows them as the [`Actuation`] side that applies commands.
     pub fn actuation(&mut self) -> Actuation<'_> {
         Actuation {
             drive: &mut self.drive,
-            tether: self.tether.as_mut(),
-            arm: self.arm.as_mut(),
-            lights: self.lights.as_mut(),
-            guides: self.guides.as_mut(),
-            posture: self.posture.as_mut(),
             actuators: &mut self.actuators,
         }
     }
@@ -260,7 +197,6 @@ impl Robot {
         let sensing = SensingDevices {
             encoders: take(&mut self.encoders, Box::new(gone(DeviceId::one("encoders")))),
             odometer: take(&mut self.odometer, Box::new(gone(DeviceId::one("odometer")))),
-            dock_sensor: take(&mut self.dock_sensor, Box::new(gone(DeviceId::one("dock_sensor")))),
             sensors: std::mem::replace(
                 &mut self.sensors,
                 (0..n_sensors)
@@ -270,11 +206,6 @@ impl Robot {
         };
         let actuation = ActuationDevices {
             drive: std::mem::replace(&mut self.drive, Box::new(gone(DeviceId::one("drive")))),
-            tether: take(&mut self.tether, Box::new(gone(DeviceId::one("tether")))),
-            arm: take(&mut self.arm, Box::new(gone(DeviceId::one("arm")))),
-            lights: take(&mut self.lights, Box::new(gone(DeviceId::one("lights")))),
-            guides: take(&mut self.guides, Box::new(gone(DeviceId::one("guides")))),
-            posture: take(&mut self.posture, Box::new(gone(DeviceId::one("posture")))),
             actuators: std::mem::replace(
                 &mut self.actuators,
                 (0..n_actuators)
@@ -296,18 +227,12 @@ impl Robot {
     pub fn return_sensing(&mut self, devices: SensingDevices) {
         self.encoders = devices.encoders;
         self.odometer = devices.odometer;
-        self.dock_sensor = devices.dock_sensor;
         self.sensors = devices.sensors;
     }
 
     /// Gives the actuation devices back.
     pub fn return_actuation(&mut self, devices: ActuationDevices) {
         self.drive = devices.drive;
-        self.tether = devices.tether;
-        self.arm = devices.arm;
-        self.lights = devices.lights;
-        self.guides = devices.guides;
-        self.posture = devices.posture;
         self.actuators = devices.actuators;
     }
 }
@@ -331,8 +256,8 @@ mod tests {
             Ok(())
         }
     }
-    impl Lights for Still {
-        fn set(&mut self, _: bool) -> Result<(), HardwareError> {
+    impl Actuator for Still {
+        fn apply(&mut self, _: &[f64]) -> Result<(), HardwareError> {
             Ok(())
         }
     }
@@ -340,7 +265,7 @@ mod tests {
     #[test]
     fn lent_devices_leave_stand_ins_that_fail_by_name_until_given_back() {
         let mut robot = Robot::new(vec![Box::new(Cam), Box::new(Cam)], Box::new(Still));
-        robot.lights = Some(Box::new(Still));
+        robot.actuators.push(Box::new(Still));
         let (mut cams, sensing, actuation) = robot.lend();
         assert_eq!(robot.cameras.len(), 2);
         assert_eq!(robot.cameras[1].resolution(), (4, 3));
@@ -350,8 +275,8 @@ mod tests {
             other => panic!("{other:?}"),
         }
         assert!(robot.drive.apply(&DriveCommand::Stop).is_err());
-        assert!(robot.lights.as_mut().is_some_and(|l| l.set(true).is_err()));
-        assert!(robot.tether.is_none(), "no stand-in for a device the robot never had");
+        assert!(robot.actuators[0].apply(&[1.0]).is_err());
+        assert!(robot.encoders.is_none(), "no stand-in for a device the robot never had");
 
         robot.return_camera(0, cams.remove(0));
         robot.return_sensing(sensing);
@@ -362,6 +287,6 @@ mod tests {
             "camera 1 was not given back"
         );
         assert!(robot.drive.apply(&DriveCommand::Stop).is_ok());
-        assert!(robot.lights.as_mut().is_some_and(|l| l.set(true).is_ok()));
+        assert!(robot.actuators[0].apply(&[1.0]).is_ok());
     }
 }

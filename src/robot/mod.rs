@@ -5,9 +5,14 @@
 //! Implement [`Camera`] and [`Drive`] at least; the rest are optional and only needed by
 //! behaviors that use them. Odometry comes either from [`WheelEncoders`] (the runtime
 //! integrates them with the profile's kinematics) or from an [`Odometer`] (a base
-//! controller that integrates its own, as ROS's `/odom`). Devices the crate has no field
-//! for are [`Sensor`]s and [`Actuator`]s declared by kind in the profile's `[[sensors]]`
-//! and `[[actuators]]` ([`crate::profile::devices`]). Put the parts in a [`Robot`] and
+//! controller that integrates its own, as ROS's `/odom`). Every other device is a
+//! [`Sensor`] or an [`Actuator`] of a kind the profile declares in `[[sensors]]` and
+//! `[[actuators]]` ([`crate::profile::devices`]): the tether reel, the dock contact
+//! switch, the arm, lights, guides and posture as much as a user's range finder or
+//! gripper, each reading or taking numbers whose meaning its kind's typed
+//! [`DeviceReading`](crate::schemas::DeviceReading) or
+//! [`DeviceCommand`](crate::schemas::DeviceCommand) gives (a reel is two devices, its
+//! sensor and its actuator, sharing the driver). Put the parts in a [`Robot`] and
 //! hand it to [`crate::arbiter::runtime::run`] (threads, wall clock) or step it with
 //! [`crate::arbiter::lockstep::Lockstep`] (one thread, your clock).
 //! `examples/custom_robot.rs` is a complete, runnable starting point.
@@ -21,7 +26,7 @@ mod lending;
 pub use lending::{Abandoned, ActuationDevices, DeviceId, SensingDevices};
 
 use crate::perception::RgbImage;
-use crate::schemas::{DriveCommand, Guides, MotorOutput, OdometryReading, Posture, TetherCommand, TetherReading};
+use crate::schemas::{DriveCommand, MotorOutput, OdometryReading};
 use std::time::Duration;
 use thiserror::Error;
 
@@ -124,84 +129,28 @@ pub trait Odometer: Send {
     fn read(&mut self) -> Result<OdometryReading, HardwareError>;
 }
 
-/// A sensor declared in the profile's `[[sensors]]` (a range finder, an IMU...).
+/// A sensor declared in the profile's `[[sensors]]` (the tether reel's length, the dock
+/// switch, a range finder, an IMU...).
 pub trait Sensor: Send {
     /// Writes its latest reading into `values` (cleared before the call); what the values
-    /// mean is the sensor's kind's business.
+    /// mean is the sensor's kind's business (a built-in kind's typed reading writes them
+    /// with [`DeviceReading::encode`](crate::schemas::DeviceReading::encode)).
     ///
     /// # Errors
     /// [`HardwareError::NotReady`] when nothing new came; a fault otherwise.
     fn read(&mut self, values: &mut Vec<f64>) -> Result<(), HardwareError>;
 }
 
-/// An actuator declared in the profile's `[[actuators]]` (a gripper, a beacon...),
-/// commanded by one number per tick
-/// ([`Auxiliary::actuators`](crate::schemas::Auxiliary::actuators)).
+/// An actuator declared in the profile's `[[actuators]]` (the tether reel, an arm, lights,
+/// guides, posture, a gripper...), commanded by the values of its kind's command each
+/// tick an output has one ([`Auxiliary::set`](crate::schemas::Auxiliary::set)).
 pub trait Actuator: Send {
-    /// Applies a command until the next one.
+    /// Applies a command until the next one; a built-in kind's typed command reads it with
+    /// [`DeviceCommand::decode`](crate::schemas::DeviceCommand::decode).
     ///
     /// # Errors
-    /// On a fault.
-    fn apply(&mut self, value: f64) -> Result<(), HardwareError>;
-}
-
-/// A tether reel.
-pub trait TetherReel: Send {
-    /// Sets reel rate and wheel free rotation.
-    ///
-    /// # Errors
-    /// On a reel fault.
-    fn command(&mut self, command: &TetherCommand) -> Result<(), HardwareError>;
-    /// Reads length and the reel motor's current (no tension: see [`TetherReading`]).
-    ///
-    /// # Errors
-    /// On a sensor fault.
-    fn read(&mut self) -> Result<TetherReading, HardwareError>;
-}
-
-/// An arm (or camera mast) with one position.
-pub trait Arm: Send {
-    /// Moves to `position` rad.
-    ///
-    /// # Errors
-    /// On a fault.
-    fn set_position(&mut self, position: f64) -> Result<(), HardwareError>;
-}
-
-/// Lights.
-pub trait Lights: Send {
-    /// Switches the lights.
-    ///
-    /// # Errors
-    /// On a fault.
-    fn set(&mut self, on: bool) -> Result<(), HardwareError>;
-}
-
-/// Dock guides.
-pub trait DockGuides: Send {
-    /// Opens or closes the guides.
-    ///
-    /// # Errors
-    /// On a fault.
-    fn set(&mut self, guides: Guides) -> Result<(), HardwareError>;
-}
-
-/// Geometry changes (raise or lower the body).
-pub trait BodyPosture: Send {
-    /// Changes posture.
-    ///
-    /// # Errors
-    /// On a fault.
-    fn set(&mut self, posture: Posture) -> Result<(), HardwareError>;
-}
-
-/// A dock contact sensor (pressure plates).
-pub trait DockSensor: Send {
-    /// True when the robot is in the dock.
-    ///
-    /// # Errors
-    /// On a fault.
-    fn in_contact(&mut self) -> Result<bool, HardwareError>;
+    /// On a fault, or values the device cannot take.
+    fn apply(&mut self, values: &[f64]) -> Result<(), HardwareError>;
 }
 
 /// All of one robot's hardware.
@@ -214,18 +163,6 @@ pub struct Robot {
     pub encoders: Option<Box<dyn WheelEncoders>>,
     /// The base's own odometry (preferred over the encoders when both are given).
     pub odometer: Option<Box<dyn Odometer>>,
-    /// Tether reel.
-    pub tether: Option<Box<dyn TetherReel>>,
-    /// Arm.
-    pub arm: Option<Box<dyn Arm>>,
-    /// Lights.
-    pub lights: Option<Box<dyn Lights>>,
-    /// Dock guides.
-    pub guides: Option<Box<dyn DockGuides>>,
-    /// Posture actuator.
-    pub posture: Option<Box<dyn BodyPosture>>,
-    /// Dock contact sensor.
-    pub dock_sensor: Option<Box<dyn DockSensor>>,
     /// The profile's `[[sensors]]`, in order.
     pub sensors: Vec<Box<dyn Sensor>>,
     /// The profile's `[[actuators]]`, in order.
@@ -239,44 +176,38 @@ pub struct Sensing<'a> {
     pub encoders: Option<&'a mut Box<dyn WheelEncoders>>,
     /// The base's own odometry.
     pub odometer: Option<&'a mut Box<dyn Odometer>>,
-    /// Dock contact sensor.
-    pub dock_sensor: Option<&'a mut Box<dyn DockSensor>>,
     /// `[[sensors]]`.
     pub sensors: &'a mut [Box<dyn Sensor>],
 }
 
-/// The robot's actuation side (and the tether reel, which is one device for reading and
-/// commanding).
+/// The robot's actuation side.
 pub struct Actuation<'a> {
     /// The base.
     pub drive: &'a mut Box<dyn Drive>,
-    /// Tether reel.
-    pub tether: Option<&'a mut Box<dyn TetherReel>>,
-    /// Arm.
-    pub arm: Option<&'a mut Box<dyn Arm>>,
-    /// Lights.
-    pub lights: Option<&'a mut Box<dyn Lights>>,
-    /// Dock guides.
-    pub guides: Option<&'a mut Box<dyn DockGuides>>,
-    /// Posture actuator.
-    pub posture: Option<&'a mut Box<dyn BodyPosture>>,
     /// `[[actuators]]`.
     pub actuators: &'a mut [Box<dyn Actuator>],
 }
 
 impl Actuation<'_> {
-    /// Sends `command` to every device it has an opinion for (the drive always; an
-    /// auxiliary only when the command sets it, so `None` leaves the device as it is).
-    /// `report` hears each device that failed, by name.
-    pub fn apply(&mut self, command: &MotorOutput, mut report: impl FnMut(&'static str, HardwareError)) {
-        self.apply_watched(command, |_| {}, |device, e| report(device.kind, e));
+    /// Sends `command` to every device it has an opinion for: the drive always; actuator
+    /// `i`, of kind `kinds[i]` (the profile's `[[actuators]]` order), only when the
+    /// command has one for its kind, so no command leaves the device as it is. `report`
+    /// hears each device that failed, by kind.
+    pub fn apply<K: AsRef<str>>(
+        &mut self,
+        command: &MotorOutput,
+        kinds: &[K],
+        mut report: impl FnMut(&'static str, HardwareError),
+    ) {
+        self.apply_watched(command, kinds, |_| {}, |device, e| report(device.kind, e));
     }
 
     /// [`Actuation::apply`], telling `enter` which device it is about to call before each
     /// call, so a watchdog can name the device a blocked call is stuck in.
-    pub fn apply_watched(
+    pub fn apply_watched<K: AsRef<str>>(
         &mut self,
         command: &MotorOutput,
+        kinds: &[K],
         mut enter: impl FnMut(DeviceId),
         mut report: impl FnMut(DeviceId, HardwareError),
     ) {
@@ -287,25 +218,9 @@ impl Actuation<'_> {
             }
         };
         call(DeviceId::one("drive"), &mut || self.drive.apply(&command.drive));
-        let aux = &command.aux;
-        if let (Some(t), Some(c)) = (self.tether.as_mut(), aux.tether) {
-            call(DeviceId::one("tether"), &mut || t.command(&c));
-        }
-        if let (Some(a), Some(p)) = (self.arm.as_mut(), aux.arm) {
-            call(DeviceId::one("arm"), &mut || a.set_position(p));
-        }
-        if let (Some(l), Some(on)) = (self.lights.as_mut(), aux.lights) {
-            call(DeviceId::one("lights"), &mut || l.set(on));
-        }
-        if let (Some(g), Some(gc)) = (self.guides.as_mut(), aux.guides) {
-            call(DeviceId::one("guides"), &mut || g.set(gc));
-        }
-        if let (Some(p), Some(pc)) = (self.posture.as_mut(), aux.posture) {
-            call(DeviceId::one("posture"), &mut || p.set(pc));
-        }
-        for (i, (a, v)) in self.actuators.iter_mut().zip(aux.actuators).enumerate() {
-            if let Some(v) = v {
-                call(DeviceId::nth("actuator", i), &mut || a.apply(v));
+        for (i, (a, kind)) in self.actuators.iter_mut().zip(kinds).enumerate() {
+            if let Some(c) = command.aux.command(kind.as_ref()) {
+                call(DeviceId::nth("actuator", i), &mut || a.apply(c.values()));
             }
         }
     }
@@ -319,12 +234,6 @@ impl Robot {
             drive,
             encoders: None,
             odometer: None,
-            tether: None,
-            arm: None,
-            lights: None,
-            guides: None,
-            posture: None,
-            dock_sensor: None,
             sensors: Vec::new(),
             actuators: Vec::new(),
         }
@@ -337,16 +246,10 @@ impl Robot {
             Sensing {
                 encoders: self.encoders.as_mut(),
                 odometer: self.odometer.as_mut(),
-                dock_sensor: self.dock_sensor.as_mut(),
                 sensors: &mut self.sensors,
             },
             Actuation {
                 drive: &mut self.drive,
-                tether: self.tether.as_mut(),
-                arm: self.arm.as_mut(),
-                lights: self.lights.as_mut(),
-                guides: self.guides.as_mut(),
-                posture: self.posture.as_mut(),
                 actuators: &mut self.actuators,
             },
         )

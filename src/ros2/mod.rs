@@ -17,6 +17,7 @@
 //! the bridge, with the simulator as a second Zenoh participant. No live ROS 2
 //! installation was run against it.
 
+pub mod aux_devices;
 pub mod client;
 pub mod devices;
 pub mod interfaces;

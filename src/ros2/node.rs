@@ -2,10 +2,11 @@
 //! topics ([`super::devices`]), and its missions as two ROS 2 actions.
 //!
 //! * **Topics.** It subscribes to one image topic per camera of the profile, to
-//!   `nav_msgs/msg/Odometry` and to the dock contact switch (`std_msgs/msg/Bool`); it
-//!   publishes `geometry_msgs/msg/Twist` on `cmd_vel` and, for the auxiliaries the profile
-//!   drives, `posture` and `dock_guides` (`std_msgs/msg/String`: `raised`/`lowered`,
-//!   `open`/`closed`) and `lights` (`std_msgs/msg/Bool`).
+//!   `nav_msgs/msg/Odometry` and, when the profile declares a `dock_contact` sensor, to
+//!   the dock contact switch (`std_msgs/msg/Bool`); it publishes
+//!   `geometry_msgs/msg/Twist` on `cmd_vel` and, for the actuators the profile declares,
+//!   `posture` and `dock_guides` (`std_msgs/msg/String`: `raised`/`lowered`,
+//!   `open`/`closed`) and `lights` (`std_msgs/msg/Bool`) ([`super::aux_devices`]).
 //! * **Actions.** `dock_robot` (`marsupial_msgs/action/Dock`) starts a docking mission
 //!   and `undock_robot` (`marsupial_msgs/action/Undock`) a departure, after Nav2's
 //!   `DockRobot` and `UndockRobot`: the ROS 2 action protocol's `send_goal`,
@@ -19,6 +20,8 @@
 //!   runtime's own. The behavior persists between goals: a docking after an undocking
 //!   uses the colours imprinted on the way out.
 
+use super::aux_devices::{AuxTopic, Encode, TopicSwitch, Unbridged, guides_message, lights_message, posture_message};
+pub use super::aux_devices::{encode_bool, encode_string};
 use super::devices::{ImageKind, TopicCamera, TopicOdometer, TwistDrive, subscribe};
 use super::interfaces::{self, Interface};
 use super::keys::{Attachment, NodeName, RmwPublisher, gid, now_ns};
@@ -31,8 +34,10 @@ use crate::arbiter::reactive_loop::LoopStatus;
 use crate::arbiter::runtime::{RuntimeConfig, RuntimeEvent, RuntimeReport, StopHandle, run_missions_observed};
 use crate::msgs::ros::Time;
 use crate::profile::Profile;
-use crate::robot::{BodyPosture, DockGuides, DockSensor, HardwareError, Lights, Robot};
-use crate::schemas::{Agent, FailureReason, Guides, Mission, Outcome, Posture};
+use crate::robot::{Actuator, Robot, Sensor};
+use crate::schemas::{
+    Agent, DOCK_CONTACT_KIND, FailureReason, GUIDES_KIND, LIGHTS_KIND, Mission, Outcome, POSTURE_KIND,
+};
 use crossbeam::channel::{Receiver, RecvTimeoutError, Sender, unbounded};
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -383,23 +388,41 @@ impl Ros2Node {
         }
         let boolean = interfaces::message("std_msgs/msg/Bool");
         let string = interfaces::message("std_msgs/msg/String");
-        if let Some(topic) = &config.dock_contact {
-            token(&mut declared, "MS", topic, &boolean)?;
-            let (latest, sub) = subscribe(&session, &node.key(topic, &boolean)).map_err(BridgeError::Zenoh)?;
-            robot.dock_sensor = Some(Box::new(TopicSwitch {
-                topic: node.qualify(topic),
-                latest,
-                _sub: sub,
-            }));
+        for spec in &profile.sensors {
+            let device: Box<dyn Sensor> = match (spec.kind.as_str(), &config.dock_contact) {
+                (DOCK_CONTACT_KIND, Some(topic)) => {
+                    token(&mut declared, "MS", topic, &boolean)?;
+                    let (latest, sub) = subscribe(&session, &node.key(topic, &boolean)).map_err(BridgeError::Zenoh)?;
+                    Box::new(TopicSwitch {
+                        topic: node.qualify(topic),
+                        latest,
+                        _sub: sub,
+                    })
+                }
+                _ => Box::new(Unbridged),
+            };
+            robot.sensors.push(device);
         }
-        let mut aux = |name: &str, ty: &Interface| -> Result<AuxTopic, BridgeError> {
-            let g = token(&mut declared, "MP", name, ty)?;
-            let p = session.declare_publisher(node.key(name, ty)).wait().map_err(zerr)?;
-            Ok(AuxTopic(RmwPublisher::new(p, g)))
-        };
-        robot.posture = Some(Box::new(aux("posture", &string)?));
-        robot.guides = Some(Box::new(aux("dock_guides", &string)?));
-        robot.lights = Some(Box::new(aux("lights", &boolean)?));
+        for spec in &profile.actuators {
+            let topic: Option<(&str, &Interface, Encode)> = match spec.kind.as_str() {
+                POSTURE_KIND => Some(("posture", &string, posture_message)),
+                GUIDES_KIND => Some(("dock_guides", &string, guides_message)),
+                LIGHTS_KIND => Some(("lights", &boolean, lights_message)),
+                _ => None,
+            };
+            let device: Box<dyn Actuator> = match topic {
+                Some((name, ty, encode)) => {
+                    let g = token(&mut declared, "MP", name, ty)?;
+                    let p = session.declare_publisher(node.key(name, ty)).wait().map_err(zerr)?;
+                    Box::new(AuxTopic {
+                        publisher: RmwPublisher::new(p, g),
+                        encode,
+                    })
+                }
+                None => Box::new(Unbridged),
+            };
+            robot.actuators.push(device);
+        }
 
         // The two actions.
         let cancel = interfaces::cancel_goal();
@@ -698,84 +721,6 @@ fn error_code(r: FailureReason, dock: bool) -> u16 {
         FailureReason::TargetNeverDetected | FailureReason::TargetLost if dock => 904,
         FailureReason::Timeout if dock => 907,
         _ => 905,
-    }
-}
-
-/// An auxiliary actuator published as a topic.
-struct AuxTopic(RmwPublisher);
-
-impl AuxTopic {
-    fn send(&self, payload: Vec<u8>) -> Result<(), HardwareError> {
-        self.0.put(&payload).map_err(|detail| HardwareError::Fault {
-            device: self.0.key(),
-            detail,
-        })
-    }
-}
-
-/// A `std_msgs/msg/String`.
-pub fn encode_string(s: &str) -> Vec<u8> {
-    let mut buf = Vec::new();
-    crate::msgs::cdr::CdrWriter::new(&mut buf).string(s);
-    buf
-}
-
-/// A `std_msgs/msg/Bool`.
-pub fn encode_bool(b: bool) -> Vec<u8> {
-    let mut buf = Vec::new();
-    crate::msgs::cdr::CdrWriter::new(&mut buf).u8(u8::from(b));
-    buf
-}
-
-impl BodyPosture for AuxTopic {
-    fn set(&mut self, posture: Posture) -> Result<(), HardwareError> {
-        self.send(encode_string(match posture {
-            Posture::Raised => "raised",
-            Posture::Lowered => "lowered",
-        }))
-    }
-}
-
-impl DockGuides for AuxTopic {
-    fn set(&mut self, guides: Guides) -> Result<(), HardwareError> {
-        self.send(encode_string(match guides {
-            Guides::Open => "open",
-            Guides::Closed => "closed",
-        }))
-    }
-}
-
-impl Lights for AuxTopic {
-    fn set(&mut self, on: bool) -> Result<(), HardwareError> {
-        self.send(encode_bool(on))
-    }
-}
-
-/// The dock switch as a `std_msgs/msg/Bool` topic. A read with no new message since the
-/// last is [`HardwareError::NotReady`], so a switch that stops publishing goes stale.
-struct TopicSwitch {
-    topic: String,
-    latest: Arc<super::devices::LatestPayload>,
-    _sub: zenoh::pubsub::Subscriber<()>,
-}
-
-impl DockSensor for TopicSwitch {
-    fn in_contact(&mut self) -> Result<bool, HardwareError> {
-        let Some(p) = self.latest.take(Duration::ZERO) else {
-            return Err(HardwareError::NotReady);
-        };
-        let p = p.to_bytes();
-        let mut r = crate::msgs::cdr::CdrReader::new(&p).map_err(|e| self.fault(e))?;
-        Ok(r.u8("data").map_err(|e| self.fault(e))? != 0)
-    }
-}
-
-impl TopicSwitch {
-    fn fault(&self, e: impl std::fmt::Display) -> HardwareError {
-        HardwareError::Fault {
-            device: format!("dock switch on {}", self.topic),
-            detail: e.to_string(),
-        }
     }
 }
 

@@ -1,5 +1,6 @@
 //! The timestamped sensor snapshot one loop tick consumes.
 
+use super::devices::{DeviceReading, DockContact};
 use super::percept::Stamped;
 use crate::geometry::{Pose2, Twist};
 use crate::perception::RgbView;
@@ -14,24 +15,33 @@ pub struct CameraInput<'a> {
     pub image: RgbView<'a>,
 }
 
-/// The cameras of one tick, built fresh each tick (the frames they borrow change): inline
-/// up to four cameras, so building it allocates nothing for any robot this crate models
-/// (Axel's stereo pair is the most; `tests/no_alloc.rs`).
-pub type CameraInputs<'a> = smallvec::SmallVec<[Option<CameraInput<'a>>; 4]>;
+/// Most cameras a tick holds without allocating: the cameras of one tick are built fresh
+/// each tick (the frames they borrow change), inline up to this many, so building them
+/// allocates nothing for any robot this crate models (Axel's stereo pair is the most;
+/// `tests/no_alloc.rs`); more spill to the heap.
+pub const INLINE_CAMERAS: usize = 4;
+
+/// The cameras of one tick (inline up to [`INLINE_CAMERAS`]).
+pub type CameraInputs<'a> = smallvec::SmallVec<[Option<CameraInput<'a>>; INLINE_CAMERAS]>;
 
 /// One reading of a `[[sensors]]` entry (see [`crate::profile::devices`]): what the
-/// values mean is the sensor's kind's business (a range finder: one distance per beam).
+/// values mean is the sensor's kind's business (a range finder: one distance per beam;
+/// the tether: its [`TetherReading`]), read typed with
+/// [`DeviceReading`].
 #[derive(Debug, Clone, Copy)]
 pub struct SensorInput<'a> {
+    /// The sensor's kind (its `[[sensors]]` entry's `kind`).
+    pub kind: &'a str,
     /// Capture time, seconds on the loop clock.
     pub stamp: f64,
     /// The values.
     pub values: &'a [f64],
 }
 
-/// The `[[sensors]]` readings of one tick, inline for up to four sensors (building it
-/// allocates nothing for such robots).
-pub type SensorInputs<'a> = smallvec::SmallVec<[Option<SensorInput<'a>>; 4]>;
+/// The `[[sensors]]` readings of one tick, inline for up to
+/// [`INLINE_DEVICES`](super::INLINE_DEVICES) sensors (building it allocates nothing for
+/// such robots; more spill to the heap).
+pub type SensorInputs<'a> = smallvec::SmallVec<[Option<SensorInput<'a>>; super::devices::INLINE_DEVICES]>;
 
 /// An odometry estimate: pose in the odometry frame plus the current body twist.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -58,8 +68,9 @@ pub struct TetherReading {
 ///
 /// `now` is the loop clock, supplied by the caller (the threaded runtime's monotonic
 /// clock, or the simulator's step counter); nothing downstream reads a clock itself.
-/// `cameras` is indexed like the profile's `[[cameras]]` list; a `None` entry means no
-/// frame has arrived from that camera yet.
+/// `cameras` is indexed like the profile's `[[cameras]]` list and `sensors` like its
+/// `[[sensors]]`, the tether reel and the dock switch among them; a `None` entry means
+/// nothing has arrived from that device yet.
 #[derive(Debug, Clone, Copy)]
 pub struct Inputs<'a> {
     /// Loop time, seconds.
@@ -68,10 +79,6 @@ pub struct Inputs<'a> {
     pub cameras: &'a [Option<CameraInput<'a>>],
     /// Latest odometry estimate.
     pub odometry: Option<Stamped<OdometryReading>>,
-    /// Latest tether reading.
-    pub tether: Option<Stamped<TetherReading>>,
-    /// Latest dock contact switch (pressure plates) reading.
-    pub dock_contact: Option<Stamped<bool>>,
     /// Latest reading per `[[sensors]]` entry, in profile order (`None`: none yet).
     pub sensors: &'a [Option<SensorInput<'a>>],
 }
@@ -83,8 +90,6 @@ impl<'a> Inputs<'a> {
             now,
             cameras: &[],
             odometry: None,
-            tether: None,
-            dock_contact: None,
             sensors: &[],
         }
     }
@@ -99,8 +104,27 @@ impl<'a> Inputs<'a> {
         self.sensors.get(i).and_then(Option::as_ref)
     }
 
+    /// The latest reading of the first sensor of `R`'s kind that has one, typed; `None`
+    /// when the profile declares no such sensor, it has not reported yet, or its values
+    /// do not make a reading.
+    pub fn reading<R: DeviceReading>(&self) -> Option<Stamped<R>> {
+        let s = self.sensors.iter().flatten().find(|s| s.kind == R::KIND)?;
+        R::decode(s.values).map(|r| Stamped::new(s.stamp, r))
+    }
+
+    /// The tether reel's latest reading (a [`TETHER_KIND`](super::TETHER_KIND) sensor).
+    pub fn tether(&self) -> Option<Stamped<TetherReading>> {
+        self.reading()
+    }
+
+    /// The dock contact switch's latest reading (a
+    /// [`DOCK_CONTACT_KIND`](super::DOCK_CONTACT_KIND) sensor): true when closed.
+    pub fn dock_contact(&self) -> Option<Stamped<bool>> {
+        self.reading::<DockContact>().map(|c| Stamped::new(c.stamp, c.value.0))
+    }
+
     /// True when the dock contact switch reads closed.
     pub fn docked_contact(&self) -> bool {
-        self.dock_contact.is_some_and(|c| c.value)
+        self.dock_contact().is_some_and(|c| c.value)
     }
 }

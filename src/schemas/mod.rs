@@ -7,15 +7,21 @@
 //!
 //! The perceptual schemas of the shipped robots ([`TwoBlockSchema`], [`PyramidSchema`],
 //! the AutoKrawler's [`KrawlerSchema`]) run perception's trackers on one camera of the
-//! inputs; perception itself knows nothing of schemas.
+//! inputs; perception itself knows nothing of schemas. Their motor schemas ([`RatioSteering`], [`PotentialField`],
+//! [`ServoLaw`], [`PointController`], [`SearchRotation`], [`DeadReckoning`],
+//! [`AvoidObstacles`]) implement [`MotorSchema`] over typed percepts
+//! ([`motor_schemas`]); the robots' leaves pair them with their percepts and memory, as
+//! a [`SchemaBehavior`] pairs a perceptual and a motor schema with a releaser.
 
 pub mod avoid;
 pub mod behavior;
+pub mod devices;
 pub mod goto_point;
 pub mod inputs;
 pub mod krawler;
 pub mod mission;
 pub mod motor_output;
+pub mod motor_schemas;
 pub mod observation;
 pub mod percept;
 pub mod potential_field;
@@ -29,11 +35,19 @@ pub mod visual_servo;
 
 pub use avoid::AvoidObstacles;
 pub use behavior::{Behavior, FailureReason, Feedback, Outcome, Presence, SchemaBehavior, Status, Step};
+pub use devices::{
+    ARM_KIND, ArmPosition, BUILTIN_ACTUATOR_KINDS, BUILTIN_SENSOR_KINDS, COMMAND_VALUES, Command, DOCK_CONTACT_KIND,
+    DeviceCommand, DeviceKinds, DeviceReading, DockContact, GUIDES_KIND, INLINE_DEVICES, LIGHTS_KIND, Lights,
+    POSTURE_KIND, TETHER_KIND,
+};
 pub use goto_point::PointController;
-pub use inputs::{CameraInput, CameraInputs, Inputs, OdometryReading, SensorInput, SensorInputs, TetherReading};
+pub use inputs::{
+    CameraInput, CameraInputs, INLINE_CAMERAS, Inputs, OdometryReading, SensorInput, SensorInputs, TetherReading,
+};
 pub use krawler::{KrawlerObservation, KrawlerPercept, KrawlerSchema};
 pub use mission::{Agent, AgentStats, Mission, MissionError};
 pub use motor_output::{Auxiliary, DriveCommand, Guides, MotorOutput, Posture, TetherCommand};
+pub use motor_schemas::{DockPose, Elapsed, GuideView, PointGoal, Travelled};
 pub use observation::{ColourRanges, Observation, ObservedPercept};
 pub use percept::{Percept, Stamped};
 pub use potential_field::PotentialField;

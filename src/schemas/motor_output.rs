@@ -1,13 +1,10 @@
 //! Motor outputs: what a motor schema proposes and the arbiter commands.
 
+use super::devices::{Command, DeviceCommand, INLINE_DEVICES};
 use crate::geometry::Twist;
 use serde::{Deserialize, Serialize};
 
 pub use crate::kinematics::DriveCommand;
-
-/// Most `[[actuators]]` a profile may declare: their commands travel in a fixed array,
-/// so a tick's output never allocates.
-pub const MAX_ACTUATORS: usize = 4;
 
 /// Command for a tether reel.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -38,63 +35,119 @@ pub enum Posture {
     Lowered,
 }
 
-/// Auxiliary actuators; `None` means "this behavior has no opinion", so several outputs
-/// can be merged in priority order.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+/// The device commands of one output, by actuator kind (see [`super::devices`]): a kind
+/// with no command means "this behavior has no opinion", so several outputs can be merged
+/// in priority order ([`Auxiliary::or`]). Holds up to [`INLINE_DEVICES`] kinds inline.
+/// Two are equal when they command the same kinds with the same values, in any order.
+#[derive(Debug, Clone, Copy, Default)]
 pub struct Auxiliary {
-    /// Tether reel command.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub tether: Option<TetherCommand>,
-    /// Arm position, radians (RAPOSA's front arm; positive raises).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub arm: Option<f64>,
-    /// Lights on or off.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lights: Option<bool>,
-    /// Dock guides.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub guides: Option<Guides>,
-    /// Body posture.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub posture: Option<Posture>,
-    /// Commands for the profile's `[[actuators]]`, by index (a gripper's position, a
-    /// beacon's power...): what a value means is the actuator's kind's business.
-    #[serde(default, skip_serializing_if = "no_commands")]
-    pub actuators: [Option<f64>; MAX_ACTUATORS],
-}
-
-fn no_commands(a: &[Option<f64>; MAX_ACTUATORS]) -> bool {
-    a.iter().all(Option::is_none)
+    commands: [Option<Command>; INLINE_DEVICES],
 }
 
 impl Auxiliary {
-    /// Fills each field this one leaves open with `other`'s value (self has priority).
-    ///
-    /// ```
-    /// use marsupial::schemas::{Auxiliary, Guides};
-    ///
-    /// let dock = Auxiliary { guides: Some(Guides::Closed), ..Default::default() };
-    /// let carry = Auxiliary { arm: Some(0.3), guides: Some(Guides::Open), ..Default::default() };
-    /// let merged = dock.or(carry);
-    /// assert_eq!((merged.guides, merged.arm), (Some(Guides::Closed), Some(0.3)));
-    /// assert_eq!(merged.lights, None, "nobody had an opinion");
-    /// ```
-    pub fn or(self, other: Auxiliary) -> Auxiliary {
-        Auxiliary {
-            tether: self.tether.or(other.tether),
-            arm: self.arm.or(other.arm),
-            lights: self.lights.or(other.lights),
-            guides: self.guides.or(other.guides),
-            posture: self.posture.or(other.posture),
-            actuators: std::array::from_fn(|i| self.actuators[i].or(other.actuators[i])),
+    /// Only `command`.
+    pub fn with(command: impl DeviceCommand) -> Self {
+        let mut a = Self::default();
+        a.set(command);
+        a
+    }
+
+    /// Sets the command for `C`'s kind, replacing an earlier one.
+    pub fn set<C: DeviceCommand>(&mut self, command: C) {
+        self.put(command.encode());
+    }
+
+    /// Sets a command given as values (for a kind without a typed command), replacing an
+    /// earlier one for its kind. With [`INLINE_DEVICES`] kinds already set a new kind is
+    /// dropped (a profile declares at most that many actuators, so no declared device
+    /// loses its command).
+    pub fn put(&mut self, command: Command) {
+        let slot = match self
+            .commands
+            .iter()
+            .position(|c| c.is_some_and(|c| c.kind() == command.kind()))
+        {
+            Some(i) => Some(i),
+            None => self.commands.iter().position(Option::is_none),
+        };
+        if let Some(i) = slot {
+            self.commands[i] = Some(command);
         }
     }
 
-    /// True when every number in the command is finite.
+    /// The command for `C`'s kind, typed.
+    pub fn get<C: DeviceCommand>(&self) -> Option<C> {
+        self.command(C::KIND).and_then(|c| C::decode(c.values()))
+    }
+
+    /// The command for kind `kind`.
+    pub fn command(&self, kind: &str) -> Option<&Command> {
+        self.commands().find(|c| c.kind() == kind)
+    }
+
+    /// Every command set, in the order first set.
+    pub fn commands(&self) -> impl Iterator<Item = &Command> {
+        self.commands.iter().flatten()
+    }
+
+    /// Drops the command for `kind`.
+    pub fn clear(&mut self, kind: &str) {
+        for c in &mut self.commands {
+            if c.is_some_and(|c| c.kind() == kind) {
+                *c = None;
+            }
+        }
+    }
+
+    /// Adds each command of `other`'s whose kind this one leaves open (self has priority).
+    ///
+    /// ```
+    /// use marsupial::schemas::{ArmPosition, Auxiliary, Guides, Lights};
+    ///
+    /// let dock = Auxiliary::with(Guides::Closed);
+    /// let mut carry = Auxiliary::with(ArmPosition(0.3));
+    /// carry.set(Guides::Open);
+    /// let merged = dock.or(carry);
+    /// assert_eq!(merged.get::<Guides>(), Some(Guides::Closed));
+    /// assert_eq!(merged.get::<ArmPosition>(), Some(ArmPosition(0.3)));
+    /// assert_eq!(merged.get::<Lights>(), None, "nobody had an opinion");
+    /// ```
+    pub fn or(mut self, other: Auxiliary) -> Auxiliary {
+        for c in other.commands() {
+            if self.command(c.kind()).is_none() {
+                self.put(*c);
+            }
+        }
+        self
+    }
+
+    /// True when no command is set.
+    pub fn is_empty(&self) -> bool {
+        self.commands().next().is_none()
+    }
+
+    /// True when every number in every command is finite.
     pub fn is_finite(&self) -> bool {
-        self.tether.is_none_or(|t| t.reel_rate.is_finite())
-            && self.arm.is_none_or(f64::is_finite)
-            && self.actuators.iter().all(|a| a.is_none_or(f64::is_finite))
+        self.commands().all(|c| c.values().iter().all(|v| v.is_finite()))
+    }
+}
+
+impl PartialEq for Auxiliary {
+    fn eq(&self, other: &Self) -> bool {
+        self.commands().count() == other.commands().count()
+            && self.commands().all(|c| other.command(c.kind()) == Some(c))
+    }
+}
+
+/// A map from kind to values (`{"tether": [0.0, 0.0]}`), for traces and logs.
+impl Serialize for Auxiliary {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut m = s.serialize_map(None)?;
+        for c in self.commands() {
+            m.serialize_entry(c.kind(), c.values())?;
+        }
+        m.end()
     }
 }
 
@@ -110,18 +163,18 @@ impl Auxiliary {
 /// assert_eq!(out.drive, DriveCommand::Twist(Twist::new(0.1, -0.2)));
 /// assert!(MotorOutput::stop().drive.is_stop());
 /// // Backing in, lowered: the base reverses at 3 cm/s without turning.
-/// let lowered = Auxiliary { posture: Some(Posture::Lowered), ..Default::default() };
+/// let lowered = Auxiliary::with(Posture::Lowered);
 /// let out = MotorOutput::drive(DriveCommand::Straight { v: -0.03 }).with_aux(lowered);
 /// assert_eq!(out.drive.to_twist(), Twist::new(-0.03, 0.0));
-/// assert_eq!(out.aux.posture, Some(Posture::Lowered));
+/// assert_eq!(out.aux.get::<Posture>(), Some(Posture::Lowered));
 /// assert!(out.is_finite());
 /// assert!(!MotorOutput::drive(DriveCommand::Turn { omega: f64::NAN }).is_finite());
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct MotorOutput {
     /// Base motion.
     pub drive: DriveCommand,
-    /// Auxiliary actuators.
+    /// Device commands (tether, arm, lights, guides, posture, a user's kinds).
     pub aux: Auxiliary,
 }
 

@@ -32,7 +32,7 @@ pub const MAX_AIM_RAD: f64 = 25.0 * std::f64::consts::PI / 180.0;
 ///
 /// ```
 /// use marsupial::perception::{FiducialView, TwoBlockGeometry};
-/// use marsupial::schemas::{DriveCommand, RatioSteering};
+/// use marsupial::schemas::{DriveCommand, MotorSchema, RatioSteering};
 ///
 /// let s = RatioSteering {
 ///     geometry: TwoBlockGeometry { fx: 182.8, size: (0.18, 0.11), image_right_sign: 1.0, drive_dir: -1.0 },
@@ -125,13 +125,6 @@ impl RatioSteering {
         self.speed * k * self.geometry.drive_dir
     }
 
-    /// The command for one tick.
-    pub fn act(&self, view: &FiducialView) -> MotorOutput {
-        let e = self.error(view);
-        let angle = (e * self.image_width / 2.0 / self.geometry.fx).atan();
-        self.steer(angle, self.speed_for(view.total_px as f64))
-    }
-
     /// The dead band as a heading error, rad: the angle a steering error of `dead_band`
     /// (a fraction of the half image) stands for.
     pub fn dead_band_angle(&self) -> f64 {
@@ -158,6 +151,7 @@ impl RatioSteering {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::schemas::MotorSchema;
 
     fn rear_flipped() -> TwoBlockGeometry {
         TwoBlockGeometry {

@@ -15,12 +15,12 @@ use super::motor_output::DriveCommand;
 /// use marsupial::schemas::{DriveCommand, SearchRotation};
 ///
 /// let s = SearchRotation { rate: 0.5, first_sweep: 0.5, doubling: true };
-/// assert_eq!(s.act(0.5), DriveCommand::Turn { omega: 0.5 });
-/// assert_eq!(s.act(1.5), DriveCommand::Turn { omega: -0.5 });
-/// assert_eq!(s.act(3.1), DriveCommand::Turn { omega: 0.5 });
+/// assert_eq!(s.command(0.5), DriveCommand::Turn { omega: 0.5 });
+/// assert_eq!(s.command(1.5), DriveCommand::Turn { omega: -0.5 });
+/// assert_eq!(s.command(3.1), DriveCommand::Turn { omega: 0.5 });
 /// // Without doubling it keeps turning one way.
 /// let plain = SearchRotation { doubling: false, ..s };
-/// assert_eq!(plain.act(100.0), DriveCommand::Turn { omega: 0.5 });
+/// assert_eq!(plain.command(100.0), DriveCommand::Turn { omega: 0.5 });
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SearchRotation {
@@ -33,8 +33,13 @@ pub struct SearchRotation {
 }
 
 impl SearchRotation {
-    /// Command after `elapsed` seconds of searching.
-    pub fn act(&self, elapsed: f64) -> DriveCommand {
+    /// Command after `elapsed` seconds of searching (what [`MotorSchema::act`] proposes
+    /// for [`Elapsed`]`(elapsed)`; a leaf that adds its own auxiliary commands reads it
+    /// here).
+    ///
+    /// [`MotorSchema::act`]: super::MotorSchema::act
+    /// [`Elapsed`]: super::Elapsed
+    pub fn command(&self, elapsed: f64) -> DriveCommand {
         if !self.doubling || self.first_sweep <= 0.0 {
             return DriveCommand::Turn { omega: self.rate };
         }
@@ -71,8 +76,8 @@ pub const MAX_SWEEP_DEG: f64 = 350.0;
 /// use marsupial::schemas::{DeadReckoning, DriveCommand};
 ///
 /// let back_in = DeadReckoning { speed: -0.03, distance: 0.5 };
-/// assert_eq!(back_in.act(0.2), Some(DriveCommand::Straight { v: -0.03 }));
-/// assert_eq!(back_in.act(0.5), None, "50 cm covered");
+/// assert_eq!(back_in.command(0.2), Some(DriveCommand::Straight { v: -0.03 }));
+/// assert_eq!(back_in.command(0.5), None, "50 cm covered");
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DeadReckoning {
@@ -83,8 +88,10 @@ pub struct DeadReckoning {
 }
 
 impl DeadReckoning {
-    /// Command after covering `travelled` metres; `None` once the distance is done.
-    pub fn act(&self, travelled: f64) -> Option<DriveCommand> {
+    /// Command after covering `travelled` metres; `None` once the distance is done (the
+    /// trait's [`act`](super::MotorSchema::act) proposes a stop then; a leaf that must
+    /// tell "done" from "stopped" reads this).
+    pub fn command(&self, travelled: f64) -> Option<DriveCommand> {
         (travelled < self.distance).then_some(DriveCommand::Straight { v: self.speed })
     }
 }
@@ -101,11 +108,11 @@ mod tests {
             doubling: true,
         };
         // Sweep 0 lasts 1 s, sweep 1 lasts 2 s, sweep 2 lasts 4 s.
-        assert_eq!(s.act(0.5), DriveCommand::Turn { omega: 0.5 });
-        assert_eq!(s.act(1.5), DriveCommand::Turn { omega: -0.5 });
-        assert_eq!(s.act(2.9), DriveCommand::Turn { omega: -0.5 });
-        assert_eq!(s.act(3.1), DriveCommand::Turn { omega: 0.5 });
-        assert_eq!(s.act(7.1), DriveCommand::Turn { omega: -0.5 });
+        assert_eq!(s.command(0.5), DriveCommand::Turn { omega: 0.5 });
+        assert_eq!(s.command(1.5), DriveCommand::Turn { omega: -0.5 });
+        assert_eq!(s.command(2.9), DriveCommand::Turn { omega: -0.5 });
+        assert_eq!(s.command(3.1), DriveCommand::Turn { omega: 0.5 });
+        assert_eq!(s.command(7.1), DriveCommand::Turn { omega: -0.5 });
         // Sweeps cap below a full turn: with a 200° first sweep the second lasts 350°.
         let big = SearchRotation {
             rate: 1.0,
@@ -114,14 +121,14 @@ mod tests {
         };
         let t1 = 200f64.to_radians();
         let t2 = t1 + 350f64.to_radians();
-        assert_eq!(big.act(t2 - 0.01), DriveCommand::Turn { omega: -1.0 });
-        assert_eq!(big.act(t2 + 0.01), DriveCommand::Turn { omega: 1.0 });
+        assert_eq!(big.command(t2 - 0.01), DriveCommand::Turn { omega: -1.0 });
+        assert_eq!(big.command(t2 + 0.01), DriveCommand::Turn { omega: 1.0 });
         let plain = SearchRotation {
             rate: -0.3,
             first_sweep: 0.0,
             doubling: false,
         };
-        assert_eq!(plain.act(100.0), DriveCommand::Turn { omega: -0.3 });
+        assert_eq!(plain.command(100.0), DriveCommand::Turn { omega: -0.3 });
     }
 
     #[test]
@@ -130,7 +137,7 @@ mod tests {
             speed: -0.03,
             distance: 0.5,
         };
-        assert_eq!(d.act(0.2), Some(DriveCommand::Straight { v: -0.03 }));
-        assert_eq!(d.act(0.5), None);
+        assert_eq!(d.command(0.2), Some(DriveCommand::Straight { v: -0.03 }));
+        assert_eq!(d.command(0.5), None);
     }
 }

@@ -17,9 +17,15 @@ pub trait PerceptualSchema: Send {
 }
 
 /// Turns a percept into a motor output. Pure: same percept, same output.
+///
+/// Every motor schema the crate ships implements it, each over its own typed percept
+/// ([`RatioSteering`](super::RatioSteering) over a fiducial view,
+/// [`PotentialField`](super::PotentialField) over a [`DockPose`](super::DockPose), the
+/// search sweep over [`Elapsed`](super::Elapsed) time, obstacle avoidance over range
+/// returns...; see [`super::motor_schemas`]), so one signature drives them all.
 pub trait MotorSchema: Send {
-    /// The percept type consumed.
-    type Percept;
+    /// The percept type consumed (unsized for a slice of returns).
+    type Percept: ?Sized;
     /// Computes the proposed output.
     fn act(&self, percept: &Self::Percept) -> MotorOutput;
 }

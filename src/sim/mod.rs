@@ -44,6 +44,7 @@ pub enum SimError {
     },
 }
 pub mod campaign;
+pub mod devices;
 pub mod dock;
 pub mod endurance;
 pub mod engine;

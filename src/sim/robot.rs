@@ -8,20 +8,19 @@
 //! threaded runtime can drive it too, with [`SimRobot::run_physics`] advancing the world
 //! on the wall clock (`examples/bujold_on_threads.rs`).
 //!
-//! Devices the profile declares in `[[sensors]]` are built by kind from a
-//! [`SimDevices`] table: the built-in `range` kind casts its beams against the world's
-//! obstacles and the dock ([`super::range`]); a user's crate adds simulated devices for
-//! its own kinds.
+//! The robot has the devices its profile declares in `[[sensors]]` and `[[actuators]]`,
+//! built by kind from a [`SimDevices`] table: the `range` kind casts its beams against the
+//! world's obstacles and the dock ([`super::range`]); the tether reel, dock switch and
+//! posture act on the simulated world, the arm, lights and guides are accepted with no
+//! effect on it ([`super::devices`]); a user's crate adds simulated devices for its own
+//! kinds.
 
 use super::engine::{PhaseEnd, Sim};
 use super::rng::Rng;
 use crate::perception::RgbImage;
-use crate::profile::{RANGE_KIND, RangeParams, SensorSpec};
-use crate::robot::{
-    BodyPosture, Camera, DockGuides, DockSensor, Drive, Exposure, HardwareError, Lights, Odometer, Robot, Sensor,
-    TetherReel,
-};
-use crate::schemas::{DriveCommand, Guides, OdometryReading, Posture, TetherCommand, TetherReading};
+use crate::profile::{ActuatorSpec, RANGE_KIND, RangeParams, SensorSpec};
+use crate::robot::{Actuator, Camera, Drive, Exposure, HardwareError, Odometer, Robot, Sensor};
+use crate::schemas::{DriveCommand, OdometryReading};
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
@@ -33,18 +32,25 @@ pub struct SimRobot(Arc<Mutex<Sim>>);
 /// Builds the simulated device for a `[[sensors]]` entry.
 pub type SensorFactory = dyn Fn(&SimRobot, &SensorSpec) -> Result<Box<dyn Sensor>, String> + Send + Sync;
 
+/// Builds the simulated device for an `[[actuators]]` entry.
+pub type ActuatorFactory = dyn Fn(&SimRobot, &ActuatorSpec) -> Result<Box<dyn Actuator>, String> + Send + Sync;
+
 /// Simulated devices by kind (see the module docs).
 #[derive(Clone)]
 pub struct SimDevices {
     sensors: BTreeMap<String, Arc<SensorFactory>>,
+    actuators: BTreeMap<String, Arc<ActuatorFactory>>,
 }
 
 impl Default for SimDevices {
-    /// The kinds the simulator ships: the `range` finder.
+    /// The kinds the simulator ships: the `range` finder and the crate's built-in kinds
+    /// ([`super::devices`]).
     fn default() -> Self {
         let mut d = Self {
             sensors: BTreeMap::new(),
+            actuators: BTreeMap::new(),
         };
+        super::devices::register_builtin(&mut d);
         d.register_sensor(RANGE_KIND, |sim, spec| {
             let params = RangeParams::from_table(&spec.params)?;
             // Each range finder draws its noise from its own stream, named by the sensor.
@@ -65,6 +71,44 @@ impl SimDevices {
         self.sensors.insert(kind.into(), Arc::new(factory));
         self
     }
+
+    /// Registers (or replaces) how the simulator simulates actuator kind `kind`.
+    pub fn register_actuator(
+        &mut self,
+        kind: impl Into<String>,
+        factory: impl Fn(&SimRobot, &ActuatorSpec) -> Result<Box<dyn Actuator>, String> + Send + Sync + 'static,
+    ) -> &mut Self {
+        self.actuators.insert(kind.into(), Arc::new(factory));
+        self
+    }
+}
+
+/// Builds a simulated device of type `D` from its entry `S`.
+type Factory<S, D> = dyn Fn(&SimRobot, &S) -> Result<Box<D>, String> + Send + Sync;
+
+/// Builds each of `specs` (named `what[i]` in errors) with the factory of its kind.
+fn build_all<S, D: ?Sized>(
+    sim: &SimRobot,
+    what: &str,
+    specs: &[S],
+    kind_name: impl Fn(&S) -> (&str, &str),
+    factories: &BTreeMap<String, Arc<Factory<S, D>>>,
+) -> Result<Vec<Box<D>>, String> {
+    specs
+        .iter()
+        .enumerate()
+        .map(|(i, spec)| {
+            let (kind, name) = kind_name(spec);
+            let factory = factories.get(kind).ok_or_else(|| {
+                let known: Vec<&str> = factories.keys().map(String::as_str).collect();
+                format!(
+                    "{what}[{i}] `{name}`: the simulator cannot simulate kind `{kind}` (it simulates: {})",
+                    known.join(", ")
+                )
+            })?;
+            factory(sim, spec).map_err(|e| format!("{what}[{i}] `{name}`: {e}"))
+        })
+        .collect()
 }
 
 fn lock(sim: &Arc<Mutex<Sim>>) -> MutexGuard<'_, Sim> {
@@ -89,12 +133,11 @@ impl SimRobot {
         self.with(Sim::advance)
     }
 
-    /// The robot's hardware: cameras, drive, odometer, dock switch, posture, lights,
-    /// guides, arm, the tether reel when the profile has a tether, and the profile's
-    /// `[[sensors]]` built by `devices`.
+    /// The robot's hardware: cameras, drive, odometer, and the profile's `[[sensors]]`
+    /// and `[[actuators]]` built by `devices`.
     ///
     /// # Errors
-    /// A message naming a sensor whose kind `devices` cannot simulate, or whose params it
+    /// A message naming a device whose kind `devices` cannot simulate, or whose params it
     /// refuses.
     pub fn robot(&self, devices: &SimDevices) -> Result<Robot, String> {
         self.build_robot(devices, false)
@@ -112,9 +155,9 @@ impl SimRobot {
     }
 
     fn build_robot(&self, devices: &SimDevices, paced: bool) -> Result<Robot, String> {
-        let (cameras, tether, specs) = self.with(|s| {
+        let (cameras, sensors, actuators) = self.with(|s| {
             let p = s.profile();
-            (p.cameras.len(), p.tether.is_some(), p.sensors.clone())
+            (p.cameras.len(), p.sensors.clone(), p.actuators.clone())
         });
         let mut robot = Robot::new(
             (0..cameras)
@@ -129,27 +172,14 @@ impl SimRobot {
             Box::new(SimDrive(self.clone())),
         );
         robot.odometer = Some(Box::new(SimOdometer(self.clone())));
-        robot.dock_sensor = Some(Box::new(SimDockSwitch(self.clone())));
-        robot.posture = Some(Box::new(SimPosture(self.clone())));
-        robot.lights = Some(Box::new(Switch));
-        robot.guides = Some(Box::new(Switch));
-        if tether {
-            robot.tether = Some(Box::new(SimReel(self.clone())));
-        }
-        for (i, spec) in specs.iter().enumerate() {
-            let factory = devices.sensors.get(&spec.kind).ok_or_else(|| {
-                let known: Vec<&str> = devices.sensors.keys().map(String::as_str).collect();
-                format!(
-                    "sensors[{i}] `{}`: the simulator cannot simulate kind `{}` (it simulates: {})",
-                    spec.name,
-                    spec.kind,
-                    known.join(", ")
-                )
-            })?;
-            robot
-                .sensors
-                .push(factory(self, spec).map_err(|e| format!("sensors[{i}] `{}`: {e}", spec.name))?);
-        }
+        robot.sensors = build_all(self, "sensors", &sensors, |s| (&s.kind, &s.name), &devices.sensors)?;
+        robot.actuators = build_all(
+            self,
+            "actuators",
+            &actuators,
+            |a| (&a.kind, &a.name),
+            &devices.actuators,
+        )?;
         Ok(robot)
     }
 
@@ -244,54 +274,5 @@ pub struct SimOdometer(SimRobot);
 impl Odometer for SimOdometer {
     fn read(&mut self) -> Result<OdometryReading, HardwareError> {
         Ok(self.0.with(|s| s.odometry_reported()))
-    }
-}
-
-/// The pressure plates (or the open dock's contact).
-pub struct SimDockSwitch(SimRobot);
-
-impl DockSensor for SimDockSwitch {
-    fn in_contact(&mut self) -> Result<bool, HardwareError> {
-        Ok(self.0.with(|s| s.docked()))
-    }
-}
-
-/// Raising and lowering the body (the dock judge admits a lowered robot into the pouch).
-pub struct SimPosture(SimRobot);
-
-impl BodyPosture for SimPosture {
-    fn set(&mut self, posture: Posture) -> Result<(), HardwareError> {
-        self.0.with(|s| s.set_posture(posture));
-        Ok(())
-    }
-}
-
-/// The tether reel.
-pub struct SimReel(SimRobot);
-
-impl TetherReel for SimReel {
-    fn command(&mut self, command: &TetherCommand) -> Result<(), HardwareError> {
-        self.0.with(|s| s.command_reel(*command));
-        Ok(())
-    }
-
-    fn read(&mut self) -> Result<TetherReading, HardwareError> {
-        self.0.with(|s| s.tether_reading()).ok_or(HardwareError::NotReady)
-    }
-}
-
-/// Lights and guides: accepted, with no effect on the planar world (the simulator does
-/// not render the robot's own lights).
-pub struct Switch;
-
-impl Lights for Switch {
-    fn set(&mut self, _on: bool) -> Result<(), HardwareError> {
-        Ok(())
-    }
-}
-
-impl DockGuides for Switch {
-    fn set(&mut self, _guides: Guides) -> Result<(), HardwareError> {
-        Ok(())
     }
 }

@@ -313,10 +313,7 @@ impl marsupial::schemas::Behavior for Backer {
         use marsupial::schemas::{Auxiliary, DriveCommand, Feedback, MotorOutput, Outcome, Posture, Step};
         let t0 = *self.started.get_or_insert(inputs.now);
         let fb = Feedback::new("back_in", inputs.now - t0);
-        let aux = Auxiliary {
-            posture: Some(Posture::Lowered),
-            ..Default::default()
-        };
+        let aux = Auxiliary::with(Posture::Lowered);
         if inputs.docked_contact() {
             return Some(Step::done(Outcome::Docked, MotorOutput::stop().with_aux(aux), fb));
         }

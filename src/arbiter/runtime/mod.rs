@@ -3,9 +3,9 @@
 //! One thread per camera captures into pooled buffers and hands frames to the loop over a
 //! one-slot crossbeam channel where the newest frame replaces an unread older one
 //! (latest-frame-wins). One sensor thread polls the odometer (or the encoders, integrated
-//! into odometry with the profile's kinematics), the dock switch and the `[[sensors]]`.
-//! One actuator thread applies commands and also reads the tether reel, which is one
-//! device for both. [`run_missions`] starts a robot's missions one after the other. The calling thread runs the loop at the profile's fixed rate, counting
+//! into odometry with the profile's kinematics) and the `[[sensors]]` (the tether reel's
+//! and dock switch's readings among them). One actuator thread applies commands to the
+//! drive and routes each device command to the `[[actuators]]` of its kind. [`run_missions`] starts a robot's missions one after the other. The calling thread runs the loop at the profile's fixed rate, counting
 //! overruns (ticks that started late). Stamps come from one monotonic clock started with
 //! the run, so `Inputs::now − stamp` is a true age and the staleness check works.
 //!
@@ -36,7 +36,7 @@ use crate::perception::RgbImage;
 use crate::robot::{DeviceId, HardwareError, Robot};
 use crate::schemas::{
     Agent, Behavior, CameraInput, CameraInputs, Inputs, Mission, MissionError, MotorOutput, OdometryReading, Outcome,
-    SensorInput, SensorInputs, Stamped, TetherReading,
+    SensorInput, SensorInputs, Stamped,
 };
 use crossbeam::channel::{Receiver, Sender, TrySendError, bounded};
 use std::sync::Arc;
@@ -51,7 +51,7 @@ pub struct RuntimeConfig {
     /// Stop after this long even if no behavior finished (`None`: run until finished or
     /// stopped through the [`StopHandle`]).
     pub max_duration: Option<Duration>,
-    /// Polling rate of encoders, tether and dock switch, Hz.
+    /// Polling rate of the encoders (or odometer) and the `[[sensors]]`, Hz.
     pub sensor_rate_hz: f64,
     /// A driver call still running after this long is declared blocked and ends the run;
     /// actuators that keep rejecting commands this long end it too. It is also how long
@@ -87,7 +87,7 @@ impl RuntimeConfig {
             return d.as_secs_f64();
         }
         let st = &config.staleness;
-        [st.camera, st.odometry, st.tether, st.dock_switch]
+        [st.camera, st.odometry]
             .into_iter()
             .chain(st.sensors.iter().copied())
             .flatten()
@@ -475,15 +475,13 @@ fn run_with<B: Behavior + ?Sized>(
         cameras_back.push(back_rx);
     }
 
-    // Slow sensors: odometry, dock switch and the [[sensors]] (their value buffers come
+    // Slow sensors: odometry and the [[sensors]] (their value buffers come
     // back through `values_back` to be reused). The buffer pool is filled up front and used
     // in turn (the channel is FIFO), so every buffer has grown to its sensor's size within
     // the first readings; a reading the loop has no room for gives its buffer back to the
     // pool instead of dropping it. Steady state then allocates nothing, even after the loop
     // falls behind.
     let (odo_tx, odo_rx) = bounded::<Stamped<OdometryReading>>(1);
-    let (teth_tx, teth_rx) = bounded::<Stamped<TetherReading>>(1);
-    let (dock_tx, dock_rx) = bounded::<Stamped<bool>>(1);
     let pool = 4 * n_sensors.max(1);
     let (values_tx, values_rx) = bounded::<(usize, f64, Vec<f64>)>(pool);
     let (values_back_tx, values_back_rx) = bounded::<Vec<f64>>(pool);
@@ -496,7 +494,6 @@ fn run_with<B: Behavior + ?Sized>(
         let sh = shared(&watch);
         let out = SensorOutputs {
             odometry: (odo_tx, odo_rx.clone()),
-            dock: (dock_tx, dock_rx.clone()),
             values: values_tx,
             values_back: (values_back_tx.clone(), values_back_rx),
         };
@@ -509,18 +506,18 @@ fn run_with<B: Behavior + ?Sized>(
         watches.push(watch);
     }
 
-    // Actuators (and the tether reel's sensor, which shares the device). Commands are
-    // latest-wins too, so a stuck actuator never blocks the loop.
+    // Actuators, each routed its kind's command. Commands are latest-wins too, so a stuck
+    // actuator never blocks the loop.
     let (cmd_tx, cmd_rx) = bounded::<(MotorOutput, bool)>(1);
     let health = Arc::new(ActuatorHealth::default());
     let (actuation_back_tx, actuation_back) = bounded(1);
     {
         let watch = Arc::new(Watch::default());
         let sh = shared(&watch);
-        let (health, cmd_rx, tether) = (health.clone(), cmd_rx.clone(), (teth_tx, teth_rx.clone()));
+        let (health, cmd_rx, kinds) = (health.clone(), cmd_rx.clone(), lp.config().devices.actuators.clone());
         spawn(
             "marsupial-actuators".into(),
-            Box::new(move || threads::actuators(actuation, sh, health, cmd_rx, tether, actuation_back_tx)),
+            Box::new(move || threads::actuators(actuation, &kinds, sh, health, cmd_rx, actuation_back_tx)),
         );
         watches.push(watch);
     }
@@ -535,8 +532,7 @@ fn run_with<B: Behavior + ?Sized>(
     let mut frames: Vec<Option<(f64, RgbImage)>> = (0..frame_rx.len()).map(|_| None).collect();
     let mut sensor_values: Vec<Option<(f64, Vec<f64>)>> = (0..n_sensors).map(|_| None).collect();
     let mut odometry = None;
-    let mut tether = None;
-    let mut dock_contact = None;
+    let sensor_kinds = lp.config().devices.sensors.clone();
     let mut stops = StopEvents::default();
     let mut next = Instant::now();
     loop {
@@ -558,12 +554,6 @@ fn run_with<B: Behavior + ?Sized>(
         while let Ok(o) = odo_rx.try_recv() {
             odometry = Some(o);
         }
-        while let Ok(t) = teth_rx.try_recv() {
-            tether = Some(t);
-        }
-        while let Ok(d) = dock_rx.try_recv() {
-            dock_contact = Some(d);
-        }
         let cams: CameraInputs<'_> = frames
             .iter()
             .map(|f| {
@@ -575,15 +565,20 @@ fn run_with<B: Behavior + ?Sized>(
             .collect();
         let sensors: SensorInputs<'_> = sensor_values
             .iter()
-            .map(|v| v.as_ref().map(|(stamp, values)| SensorInput { stamp: *stamp, values }))
+            .enumerate()
+            .map(|(i, v)| {
+                v.as_ref().map(|(stamp, values)| SensorInput {
+                    kind: sensor_kinds.get(i).map_or("", String::as_str),
+                    stamp: *stamp,
+                    values,
+                })
+            })
             .collect();
         let now = clock.now();
         let inputs = Inputs {
             now,
             cameras: &cams,
             odometry,
-            tether,
-            dock_contact,
             sensors: &sensors,
         };
         let started = Instant::now();

@@ -11,7 +11,7 @@ use crate::arbiter::lockstep::OdometrySource;
 use crate::kinematics::DriveModel;
 use crate::perception::RgbImage;
 use crate::robot::{ActuationDevices, Camera, DeviceId, HardwareError, SensingDevices};
-use crate::schemas::{MotorOutput, OdometryReading, Stamped, TetherReading};
+use crate::schemas::{MotorOutput, OdometryReading, Stamped};
 use crossbeam::channel::{Receiver, RecvTimeoutError, Sender};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -105,17 +105,16 @@ pub(super) fn camera(
     let _ = back.send(cam);
 }
 
-/// Where the sensor thread delivers: odometry and the dock switch latest-wins; each
-/// `[[sensors]]` reading as (index, stamp, values) with its buffer recycled through
-/// `values_back`.
+/// Where the sensor thread delivers: odometry latest-wins; each `[[sensors]]` reading
+/// (the tether reel and dock switch among them) as (index, stamp, values) with its buffer
+/// recycled through `values_back`.
 pub(super) struct SensorOutputs {
     pub(super) odometry: Latest<Stamped<OdometryReading>>,
-    pub(super) dock: Latest<Stamped<bool>>,
     pub(super) values: Sender<(usize, f64, Vec<f64>)>,
     pub(super) values_back: (Sender<Vec<f64>>, Receiver<Vec<f64>>),
 }
 
-/// Polls odometry (or integrates the encoders), the dock switch and the `[[sensors]]` at
+/// Polls odometry (or integrates the encoders) and the `[[sensors]]` at
 /// `period` until the run is over.
 pub(super) fn sensors(
     mut devices: SensingDevices,
@@ -143,15 +142,6 @@ pub(super) fn sensors(
                 }
                 Some(Err(e)) => sh.fault(DeviceId::one(kind), e),
                 None => {}
-            }
-            if let Some(d) = sensing.dock_sensor.as_mut() {
-                sh.watch.enter(DeviceId::one("dock_sensor"), t);
-                match d.in_contact() {
-                    Ok(c) => {
-                        send_latest(&out.dock.0, &out.dock.1, Stamped::new(t, c));
-                    }
-                    Err(e) => sh.fault(DeviceId::one("dock_sensor"), e),
-                }
             }
             for (i, sensor) in sensing.sensors.iter_mut().enumerate() {
                 let mut buf = out.values_back.1.try_recv().unwrap_or_default();
@@ -182,13 +172,14 @@ pub(super) fn sensors(
 }
 
 /// Applies each command (latest wins; `true` when it came from the behaviors rather than
-/// the runtime's own safe stop) and reads the tether reel, until the loop hangs up.
+/// the runtime's own safe stop) to the drive and the actuators of `kinds` (profile
+/// order), until the loop hangs up.
 pub(super) fn actuators(
     mut devices: ActuationDevices,
+    kinds: &[String],
     sh: Shared,
     health: Arc<ActuatorHealth>,
     commands: Receiver<(MotorOutput, bool)>,
-    tether: Latest<Stamped<TetherReading>>,
     back: Sender<ActuationDevices>,
 ) {
     loop {
@@ -202,6 +193,7 @@ pub(super) fn actuators(
                 let mut rejected_by = None;
                 devices.actuation().apply_watched(
                     &command,
+                    kinds,
                     |device| sh.watch.enter(device, sh.clock.now()),
                     |device, error| {
                         rejected_by.get_or_insert(device);
@@ -210,16 +202,6 @@ pub(super) fn actuators(
                 );
                 sh.watch.leave();
                 health.record(sh.clock.now(), rejected_by, from_behaviors);
-            }
-            if let Some(reel) = devices.tether.as_mut() {
-                sh.watch.enter(DeviceId::one("tether"), sh.clock.now());
-                match reel.read() {
-                    Ok(r) => {
-                        send_latest(&tether.0, &tether.1, Stamped::new(sh.clock.now(), r));
-                    }
-                    Err(e) => sh.fault(DeviceId::one("tether"), e),
-                }
-                sh.watch.leave();
             }
         });
         if let Err(message) = round {

@@ -199,13 +199,10 @@ impl Memory {
     /// A stopped base with its wheels braked, the reel taking up slack
     /// ([`Memory::take_up`]), feedback `phase`.
     pub fn hold(&self, phase: &'static str) -> Step {
-        let out = MotorOutput::stop().with_aux(crate::schemas::Auxiliary {
-            tether: Some(TetherCommand {
-                reel_rate: self.take_up(),
-                free_wheel: false,
-            }),
-            ..Default::default()
-        });
+        let out = MotorOutput::stop().with_aux(crate::schemas::Auxiliary::with(TetherCommand {
+            reel_rate: self.take_up(),
+            free_wheel: false,
+        }));
         Step::running(out, self.feedback(phase))
     }
 
@@ -240,26 +237,20 @@ impl Memory {
     /// ([`TAUT_CURRENT_A`]) it does not reel in (a current-limited reel: no tension sensor).
     pub fn drive(&self, drive: DriveCommand, reel_rate: f64, phase: &'static str) -> Step {
         let rate = self.wind_below(reel_rate, TAUT_CURRENT_A);
-        let out = MotorOutput::drive(drive).with_aux(crate::schemas::Auxiliary {
-            tether: Some(TetherCommand {
-                reel_rate: rate.clamp(-self.geometry.max_reel_rate, self.geometry.max_reel_rate),
-                free_wheel: false,
-            }),
-            ..Default::default()
-        });
+        let out = MotorOutput::drive(drive).with_aux(crate::schemas::Auxiliary::with(TetherCommand {
+            reel_rate: rate.clamp(-self.geometry.max_reel_rate, self.geometry.max_reel_rate),
+            free_wheel: false,
+        }));
         Step::running(out, self.feedback(phase))
     }
 
     /// The base stopped with its wheels in free rotation, the reel winding in at its top
     /// rate (pure reeling), feedback `phase`.
     pub fn free_reel(&self, phase: &'static str) -> Step {
-        let out = MotorOutput::stop().with_aux(crate::schemas::Auxiliary {
-            tether: Some(TetherCommand {
-                reel_rate: self.geometry.max_reel_rate,
-                free_wheel: true,
-            }),
-            ..Default::default()
-        });
+        let out = MotorOutput::stop().with_aux(crate::schemas::Auxiliary::with(TetherCommand {
+            reel_rate: self.geometry.max_reel_rate,
+            free_wheel: true,
+        }));
         Step::running(out, self.feedback(phase))
     }
 
@@ -293,7 +284,7 @@ impl SharedMemory for Memory {
         if let Some(o) = inputs.odometry {
             self.odo = o.value.pose;
         }
-        self.reel = inputs.tether.map(|t| t.value);
+        self.reel = inputs.tether().map(|t| t.value);
         if !self.looking {
             return;
         }
@@ -366,7 +357,12 @@ mod tests {
             motor_current_a: 0.0,
         });
         let step = m.hold("test");
-        let reel = step.output.aux.tether.expect("a reel command").reel_rate;
+        let reel = step
+            .output
+            .aux
+            .get::<TetherCommand>()
+            .expect("a reel command")
+            .reel_rate;
         assert_eq!(reel, m.geometry.max_reel_rate);
     }
 

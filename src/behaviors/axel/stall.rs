@@ -65,13 +65,10 @@ impl Behavior<Memory> for Stall {
         }
         let since = *self.since.get_or_insert(m.now);
         (m.now - since >= self.params.for_s).then(|| {
-            let out = MotorOutput::stop().with_aux(Auxiliary {
-                tether: Some(TetherCommand {
-                    reel_rate: 0.0,
-                    free_wheel: false,
-                }),
-                ..Default::default()
-            });
+            let out = MotorOutput::stop().with_aux(Auxiliary::with(TetherCommand {
+                reel_rate: 0.0,
+                free_wheel: false,
+            }));
             Step::done(Outcome::Failed(FailureReason::StuckContact), out, m.feedback("stalled"))
         })
     }

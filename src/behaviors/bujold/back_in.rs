@@ -52,7 +52,7 @@ impl Behavior<Memory> for BackIn {
             speed: m.geometry.drive_dir * p.speed_mps,
             distance: (est - m.rear_behind_camera).max(0.0) + self.depth + p.margin_m,
         };
-        Some(match dr.act(m.travelled(&self.mark)) {
+        Some(match dr.command(m.travelled(&self.mark)) {
             Some(cmd) => Step::running(
                 MotorOutput {
                     drive: cmd,

@@ -7,7 +7,7 @@ use crate::behaviors::common::motion::Motion;
 use crate::geometry::{Pose2, wrap_angle};
 use crate::perception::two_block_pose::FiducialView;
 use crate::schemas::{
-    Auxiliary, DriveCommand, MotionVector, MotorOutput, Posture, PotentialField, RatioSteering, Step,
+    Auxiliary, DriveCommand, MotionVector, MotorOutput, MotorSchema, Posture, PotentialField, RatioSteering, Step,
 };
 
 /// The approach motor schema the profile selects (`robot.approach`).
@@ -116,16 +116,10 @@ impl Motion for Memory {
 
 /// Lowered posture (backing in, leaving the pouch).
 pub fn lowered() -> Auxiliary {
-    Auxiliary {
-        posture: Some(Posture::Lowered),
-        ..Auxiliary::default()
-    }
+    Auxiliary::with(Posture::Lowered)
 }
 
 /// Raised posture (everywhere else).
 pub fn raised() -> Auxiliary {
-    Auxiliary {
-        posture: Some(Posture::Raised),
-        ..Auxiliary::default()
-    }
+    Auxiliary::with(Posture::Raised)
 }

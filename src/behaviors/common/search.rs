@@ -155,6 +155,6 @@ impl<M: Searching, W: SearchWatch<M>> Behavior<M> for Search<M, W> {
             first_sweep: p.first_sweep,
             doubling: p.doubling,
         };
-        Some(m.search_turn(rotation.act(t - p.settle_s), self.phase))
+        Some(m.search_turn(rotation.command(t - p.settle_s), self.phase))
     }
 }

@@ -24,7 +24,7 @@ impl DockingMemory for Memory {
     }
 
     fn docked(&mut self) -> Auxiliary {
-        self.aux.guides = Some(Guides::Closed);
+        self.aux.set(Guides::Closed);
         self.aux
     }
 

@@ -10,7 +10,7 @@
 
 use super::memory::Memory;
 use super::params::FinalParams;
-use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, Posture, Step};
+use crate::schemas::{ArmPosition, Behavior, FailureReason, Inputs, Lights, Outcome, Posture, Step};
 
 /// See the module docs.
 pub struct FinalApproach {
@@ -48,10 +48,10 @@ impl Behavior<Memory> for FinalApproach {
 
     fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         let dev = m.percept.view.map_or(0.0, |v| v.dev_px[1]);
-        m.aux.arm = Some(m.law.arm(dev));
-        m.aux.lights = Some(true);
+        m.aux.set(ArmPosition(m.law.arm(dev)));
+        m.aux.set(Lights(true));
         if let Some(p) = self.params.posture {
-            m.aux.posture = Some(p);
+            m.aux.set(p);
         }
         self.start = m.now;
         self.first = true;
@@ -67,9 +67,9 @@ impl Behavior<Memory> for FinalApproach {
             return Some(m.drive(m.law.twist(m.gains.final_speed_mps, omega), "state_6"));
         }
         // Time is up without the dock switch: stop, and retry from further out.
-        m.aux.lights = Some(false);
+        m.aux.set(Lights(false));
         if self.params.posture.is_some() {
-            m.aux.posture = Some(Posture::Raised);
+            m.aux.set(Posture::Raised);
         }
         m.retries += 1;
         if m.retries > self.max_retries {

@@ -305,10 +305,7 @@ impl SharedMemory for Memory {
                 self.pair_seen = false;
                 self.search_start = None;
                 self.settling = false;
-                self.aux = Auxiliary {
-                    guides: Some(Guides::Open),
-                    ..Auxiliary::default()
-                };
+                self.aux = Auxiliary::with(Guides::Open);
                 self.manoeuvres = 0;
                 self.plan = None;
                 self.perceiving = true;
