@@ -22,6 +22,7 @@ pub mod catalog;
 pub mod common;
 pub mod composed;
 pub mod krawler;
+pub mod leaf_args;
 pub mod raposa;
 pub mod registry;
 
