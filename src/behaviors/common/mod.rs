@@ -1,9 +1,15 @@
 //! Schemas any robot's tree can use. [`register`] adds those that read only the tick's
 //! inputs and their own params (`avoid_obstacles`) to a robot's registry under their plain
-//! names; the docking leaves every robot has (`imprint`, `dock_switch`, in [`docking`])
-//! reach the robot's perception through its memory's [`docking::DockingMemory`], and each
-//! robot registers them under its own names with its own settings. [`median`] is the
-//! median window both robots smooth their viewing-angle estimates with.
+//! names. The others reach the robot through small traits its memory implements, and each
+//! robot registers them under its own names with its own settings:
+//! * [`docking`]: `imprint` and `dock_switch`, over [`docking::DockingMemory`];
+//! * [`motion`]: the legs of a manoeuvre by odometry (turn to a heading, back off, drive
+//!   until abeam), over [`motion::Motion`], which a robot's profile sequences into its
+//!   manoeuvres;
+//! * [`search`]: the search turn until the target is acquired, over
+//!   [`search::Searching`].
+//!
+//! [`median`] is the median window both robots smooth their viewing-angle estimates with.
 
 pub mod avoid;
 pub mod docking;
