@@ -151,57 +151,25 @@ pub type AimFn<M> = Box<dyn Fn(&M) -> Aim + Send>;
 /// The point a [`DriveAbeam`] drives to, read from the memory each tick (`None`: none yet).
 pub type TargetFn<M> = Box<dyn Fn(&M) -> Option<Pose2> + Send>;
 
-/// Turn in place to the heading `aim` gives, then end with `event`; after `timeout_s`
-/// in the leg it ends with `event` too (a turn that cannot finish must not hold the
-/// manoeuvre forever).
-pub struct TurnTo<M> {
+/// What every leg keeps: its node name, feedback phase, time limit, hooks, and when it
+/// was entered.
+struct Leg<M> {
     name: String,
     phase: &'static str,
-    aim: AimFn<M>,
-    tolerance: Option<f64>,
     timeout_s: f64,
-    event: &'static str,
     hooks: Hooks<M>,
     started: f64,
 }
 
-impl<M: Motion> TurnTo<M> {
-    /// A leaf named `name` (feedback `phase`) turning to `aim` within `tolerance` rad
-    /// (`None`: the robot's controller decides), ending with `event`.
-    pub fn new(name: &str, phase: &'static str, aim: AimFn<M>, tolerance: Option<f64>, event: &'static str) -> Self {
+impl<M: Motion> Leg<M> {
+    fn new(name: &str, phase: &'static str) -> Self {
         Self {
             name: name.into(),
             phase,
-            aim,
-            tolerance,
             timeout_s: f64::INFINITY,
-            event,
             hooks: Hooks::default(),
             started: 0.0,
         }
-    }
-
-    /// Ends the turn with its event after `seconds` in the leg.
-    pub fn timeout(mut self, seconds: f64) -> Self {
-        self.timeout_s = seconds;
-        self
-    }
-
-    /// With `hooks`.
-    pub fn hooks(mut self, hooks: Hooks<M>) -> Self {
-        self.hooks = hooks;
-        self
-    }
-
-    fn end(&self, m: &mut M, event: &'static str) -> Step {
-        (self.hooks.end)(m);
-        m.hold(self.phase).with_event(event)
-    }
-}
-
-impl<M: Motion> Behavior<M> for TurnTo<M> {
-    fn name(&self) -> &str {
-        &self.name
     }
 
     fn enter(&mut self, m: &mut M, inputs: &Inputs<'_>) {
@@ -209,15 +177,80 @@ impl<M: Motion> Behavior<M> for TurnTo<M> {
         self.started = inputs.now;
     }
 
+    /// The leg has run longer than its time limit.
+    fn overran(&self, m: &M) -> bool {
+        m.now() - self.started > self.timeout_s
+    }
+
+    /// Runs the end hook and holds with `event`.
+    fn end(&self, m: &mut M, event: &'static str) -> Step {
+        (self.hooks.end)(m);
+        m.hold(self.phase).with_event(event)
+    }
+}
+
+/// The builder methods every leg shares.
+macro_rules! leg_builders {
+    () => {
+        /// Ends the leg with its event after `seconds` in it, done or not (a leg that
+        /// cannot finish must not hold the manoeuvre forever).
+        pub fn timeout(mut self, seconds: f64) -> Self {
+            self.leg.timeout_s = seconds;
+            self
+        }
+
+        /// With `hooks`.
+        pub fn hooks(mut self, hooks: Hooks<M>) -> Self {
+            self.leg.hooks = hooks;
+            self
+        }
+    };
+}
+
+/// Turn in place to the heading `aim` gives, then end with `event`; after `timeout_s`
+/// in the leg it ends with `event` too (a turn that cannot finish must not hold the
+/// manoeuvre forever).
+pub struct TurnTo<M> {
+    leg: Leg<M>,
+    aim: AimFn<M>,
+    tolerance: Option<f64>,
+    event: &'static str,
+}
+
+impl<M: Motion> TurnTo<M> {
+    /// A leaf named `name` (feedback `phase`) turning to `aim` within `tolerance` rad
+    /// (`None`: the robot's controller decides), ending with `event`.
+    pub fn new(name: &str, phase: &'static str, aim: AimFn<M>, tolerance: Option<f64>, event: &'static str) -> Self {
+        Self {
+            leg: Leg::new(name, phase),
+            aim,
+            tolerance,
+            event,
+        }
+    }
+
+    leg_builders!();
+}
+
+impl<M: Motion> Behavior<M> for TurnTo<M> {
+    fn name(&self) -> &str {
+        &self.leg.name
+    }
+
+    fn enter(&mut self, m: &mut M, inputs: &Inputs<'_>) {
+        self.leg.enter(m, inputs);
+    }
+
     fn tick(&mut self, m: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
-        (self.hooks.each)(m, inputs);
+        let leg = &self.leg;
+        (leg.hooks.each)(m, inputs);
         Some(match (self.aim)(m) {
-            Aim::Hold => m.hold(self.phase),
-            Aim::Reached(e) => self.end(m, e),
-            Aim::Heading(_) if m.now() - self.started > self.timeout_s => self.end(m, self.event),
-            Aim::Heading(h) => match m.turn_toward(h, self.tolerance, self.phase) {
+            Aim::Hold => m.hold(leg.phase),
+            Aim::Reached(e) => leg.end(m, e),
+            Aim::Heading(_) if leg.overran(m) => leg.end(m, self.event),
+            Aim::Heading(h) => match m.turn_toward(h, self.tolerance, leg.phase) {
                 Some(step) => step,
-                None => self.end(m, self.event),
+                None => leg.end(m, self.event),
             },
         })
     }
@@ -246,15 +279,11 @@ pub enum End<M> {
 /// as `end` says: Bujold's move-away, give-up and unjam drive-out, RAPOSA's retreat and
 /// its way out of the dead zone.
 pub struct BackOff<M> {
-    name: String,
-    phase: &'static str,
+    leg: Leg<M>,
     distance: Distance<M>,
     speed_mps: f64,
-    timeout_s: f64,
     end: End<M>,
-    hooks: Hooks<M>,
     mark: Pose2,
-    started: f64,
     goal: f64,
 }
 
@@ -263,40 +292,25 @@ impl<M: Motion> BackOff<M> {
     /// with no time limit.
     pub fn new(name: &str, phase: &'static str, distance: Distance<M>, speed_mps: f64, end: End<M>) -> Self {
         Self {
-            name: name.into(),
-            phase,
+            leg: Leg::new(name, phase),
             distance,
             speed_mps,
-            timeout_s: f64::INFINITY,
             end,
-            hooks: Hooks::default(),
             mark: Pose2::default(),
-            started: 0.0,
             goal: 0.0,
         }
     }
 
-    /// Ends the leg after `seconds` even short of its distance.
-    pub fn timeout(mut self, seconds: f64) -> Self {
-        self.timeout_s = seconds;
-        self
-    }
-
-    /// With `hooks`.
-    pub fn hooks(mut self, hooks: Hooks<M>) -> Self {
-        self.hooks = hooks;
-        self
-    }
+    leg_builders!();
 }
 
 impl<M: Motion> Behavior<M> for BackOff<M> {
     fn name(&self) -> &str {
-        &self.name
+        &self.leg.name
     }
 
     fn enter(&mut self, m: &mut M, inputs: &Inputs<'_>) {
-        (self.hooks.enter)(m);
-        self.started = inputs.now;
+        self.leg.enter(m, inputs);
         self.mark = m.odo();
         self.goal = match &self.distance {
             Distance::Fixed(d) => *d,
@@ -305,16 +319,17 @@ impl<M: Motion> Behavior<M> for BackOff<M> {
     }
 
     fn tick(&mut self, m: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
-        (self.hooks.each)(m, inputs);
-        if m.odo().distance(&self.mark) < self.goal && m.now() - self.started <= self.timeout_s {
-            return Some(m.back_off(self.speed_mps, self.phase));
+        let leg = &self.leg;
+        (leg.hooks.each)(m, inputs);
+        if m.odo().distance(&self.mark) < self.goal && !leg.overran(m) {
+            return Some(m.back_off(self.speed_mps, leg.phase));
         }
-        (self.hooks.end)(m);
         Some(match self.end {
-            End::Event(e) => m.hold(self.phase).with_event(e),
+            End::Event(e) => leg.end(m, e),
             End::Fail(why) => {
+                (leg.hooks.end)(m);
                 let reason = why(m);
-                m.hold(self.phase).finishing(Outcome::Failed(reason))
+                m.hold(leg.phase).finishing(Outcome::Failed(reason))
             }
         })
     }
