@@ -130,6 +130,16 @@ impl Session {
         image: &RgbImage,
         odometry: Option<Stamped<OdometryReading>>,
     ) -> Result<FrameOutput, ReplayError> {
+        // The tick's inputs, for the runners that take a tick's (the camera, odometry).
+        let cameras = [Some(CameraInput {
+            stamp: t,
+            image: image.view(),
+        })];
+        let inputs = Inputs {
+            odometry,
+            cameras: &cameras,
+            ..Inputs::empty(t)
+        };
         match &mut self.runner {
             Runner::Perception(Perception::TwoBlock(s)) => {
                 s.detector_mut().resize(image.width(), image.height());
@@ -149,15 +159,6 @@ impl Session {
                 })
             }
             Runner::Perception(Perception::Krawler(s)) => {
-                let cameras = [Some(CameraInput {
-                    stamp: t,
-                    image: image.view(),
-                })];
-                let inputs = Inputs {
-                    odometry,
-                    cameras: &cameras,
-                    ..Inputs::empty(t)
-                };
                 let p = s.perceive(&inputs);
                 Ok(FrameOutput {
                     percept: Some(ObservedPercept::Krawler(p.observation())),
@@ -166,15 +167,6 @@ impl Session {
                 })
             }
             Runner::Behavior(lp) => {
-                let cameras = [Some(CameraInput {
-                    stamp: t,
-                    image: image.view(),
-                })];
-                let inputs = Inputs {
-                    odometry,
-                    cameras: &cameras,
-                    ..Inputs::empty(t)
-                };
                 let out = lp.tick(&inputs);
                 let obs = lp.root().observe();
                 Ok(FrameOutput {
