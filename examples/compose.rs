@@ -202,7 +202,6 @@ type Mem = ToyMemory;
 
 /// `toy.search`: turn in place until the beacon is seen (event `seen`).
 struct Search {
-    name: String,
     params: SearchParams,
 }
 
@@ -214,9 +213,6 @@ struct SearchParams {
 }
 
 impl Behavior<Mem> for Search {
-    fn name(&self) -> &str {
-        &self.name
-    }
     fn tick(&mut self, m: &mut Mem, inputs: &Inputs<'_>) -> Option<Step> {
         let feedback = Feedback::new("search", inputs.now);
         if m.beacon.found {
@@ -234,7 +230,6 @@ impl Behavior<Mem> for Search {
 /// (avoid turned the robot aside, or the post hides it), it steers toward where the
 /// beacon was last seen, by odometry; event `lost` when unseen for `lost_after_s`.
 struct Steer {
-    name: String,
     params: SteerParams,
 }
 
@@ -250,9 +245,6 @@ struct SteerParams {
 }
 
 impl Behavior<Mem> for Steer {
-    fn name(&self) -> &str {
-        &self.name
-    }
     fn tick(&mut self, m: &mut Mem, inputs: &Inputs<'_>) -> Option<Step> {
         let feedback = Feedback::new("steer", inputs.now);
         let p = &self.params;
@@ -276,14 +268,10 @@ impl Behavior<Mem> for Steer {
 /// typed failure (`stuck_contact`); silent otherwise, so the priority passes on. It reads
 /// no memory, so it fits in any robot's tree.
 struct Bumper {
-    name: String,
     sensor: usize,
 }
 
 impl<M: ?Sized> Behavior<M> for Bumper {
-    fn name(&self) -> &str {
-        &self.name
-    }
     fn tick(&mut self, _mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
         let pressed = inputs.sensor(self.sensor)?.values.iter().any(|&v| v > 0.5);
         pressed.then(|| {
@@ -297,14 +285,9 @@ impl<M: ?Sized> Behavior<M> for Bumper {
 }
 
 /// `toy.docked`: the dock switch closed.
-struct Docked {
-    name: String,
-}
+struct Docked;
 
 impl<M: ?Sized> Behavior<M> for Docked {
-    fn name(&self) -> &str {
-        &self.name
-    }
     fn tick(&mut self, _mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
         inputs.docked_contact().then(|| {
             Step::done(
@@ -334,27 +317,20 @@ fn registry() -> Registry<Mem> {
     common::register(&mut r); // avoid_obstacles
     r.register_sensor_kind("bumper", check_bumper)
         .register("toy.search", |_: &Mem, a: &LeafArgs<'_>| {
-            Ok(Box::new(Search {
-                name: a.node.into(),
-                params: a.params()?,
-            }))
+            Ok(Box::new(Search { params: a.params()? }))
         })
         .register("toy.steer", |_: &Mem, a: &LeafArgs<'_>| {
-            Ok(Box::new(Steer {
-                name: a.node.into(),
-                params: a.params()?,
-            }))
+            Ok(Box::new(Steer { params: a.params()? }))
         })
         .register("toy.bumper", |_: &Mem, a: &LeafArgs<'_>| {
             a.no_params()?;
             Ok(Box::new(Bumper {
-                name: a.node.into(),
                 sensor: a.sensor("bumper")?,
             }))
         })
         .register("toy.docked", |_: &Mem, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(Docked { name: a.node.into() }))
+            Ok(Box::new(Docked))
         });
     r
 }

@@ -220,20 +220,14 @@ impl RobotKind for BeaconRover {
     fn leaves(&self, registry: &mut LeafRegistry<RoverMemory>) {
         registry
             .register("rover.search", |_: &RoverMemory, a: &LeafArgs<'_>| {
-                Ok(Box::new(Search {
-                    name: a.node.into(),
-                    params: a.params()?,
-                }))
+                Ok(Box::new(Search { params: a.params()? }))
             })
             .register("rover.back_in", |_: &RoverMemory, a: &LeafArgs<'_>| {
-                Ok(Box::new(BackIn {
-                    name: a.node.into(),
-                    params: a.params()?,
-                }))
+                Ok(Box::new(BackIn { params: a.params()? }))
             })
             .register("rover.docked", |_: &RoverMemory, a: &LeafArgs<'_>| {
                 a.no_params()?;
-                Ok(Box::new(Docked { name: a.node.into() }))
+                Ok(Box::new(Docked))
             });
     }
 }
@@ -241,7 +235,6 @@ impl RobotKind for BeaconRover {
 /// `rover.search`: turn toward the side the beacon was last seen on until it is seen
 /// (event `seen`).
 struct Search {
-    name: String,
     params: SearchParams,
 }
 
@@ -253,10 +246,6 @@ struct SearchParams {
 }
 
 impl Behavior<RoverMemory> for Search {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn tick(&mut self, m: &mut RoverMemory, inputs: &Inputs<'_>) -> Option<Step> {
         let feedback = Feedback::new("search", inputs.now);
         if m.beacon.found {
@@ -275,7 +264,6 @@ impl Behavior<RoverMemory> for Search {
 /// has filled `close_pixels` or more, the rover backs on straight, blind, for `blind_s`;
 /// otherwise event `lost` once it has been out of sight for `lost_after_s`.
 struct BackIn {
-    name: String,
     params: BackInParams,
 }
 
@@ -297,10 +285,6 @@ struct BackInParams {
 }
 
 impl Behavior<RoverMemory> for BackIn {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn tick(&mut self, m: &mut RoverMemory, inputs: &Inputs<'_>) -> Option<Step> {
         let feedback = Feedback::new("back_in", inputs.now);
         let p = &self.params;
@@ -324,15 +308,9 @@ impl Behavior<RoverMemory> for BackIn {
 
 /// `rover.docked`: the pouch's contact plate closed. It reads no memory, so it fits in
 /// any robot's tree.
-struct Docked {
-    name: String,
-}
+struct Docked;
 
 impl<M: ?Sized> Behavior<M> for Docked {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn tick(&mut self, _mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
         inputs.docked_contact().then(|| {
             Step::done(

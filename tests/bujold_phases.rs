@@ -154,7 +154,7 @@ fn search_is_jammed_when_turning_does_not_change_the_view() {
 fn approach_signals_the_dock_a_lost_target_and_an_off_axis_view() {
     let mut mem = memory();
     let total = mem.approach.steering.dock_total_px;
-    let mut a = approach::Approach::new("approach", &mem, ApproachParams::default(), total, 4).unwrap();
+    let mut a = approach::Approach::new(&mem, ApproachParams::default(), total, 4).unwrap();
     enter(&mut a, &mut mem, 0.0, at(1.0));
     assert_eq!(
         tick(&mut a, &mut mem, 0.1, at(1.0), Some(view(1.0, 0.0, 900))).status,
@@ -178,7 +178,7 @@ fn approach_signals_the_dock_a_lost_target_and_an_off_axis_view() {
 #[test]
 fn decide_backs_in_aligned_retries_misaligned_and_gives_up_when_out_of_retries() {
     let mut mem = memory();
-    let new = || decide::Decide::new("decide", DecideParams::default(), 0.02, 5f64.to_radians(), 1);
+    let new = || decide::Decide::new(DecideParams::default(), 0.02, 5f64.to_radians(), 1);
     let mut d = new();
     enter(&mut d, &mut mem, 0.0, at(0.4));
     for k in 1..5 {
@@ -218,7 +218,7 @@ fn decide_backs_in_aligned_retries_misaligned_and_gives_up_when_out_of_retries()
 fn back_in_drives_blind_and_lowered_then_reports_the_miss() {
     let mut mem = memory();
     mem.samples_distance = 0.38;
-    let mut b = back_in::BackIn::new("back_in", BackInParams::default(), 0.30);
+    let mut b = back_in::BackIn::new(BackInParams::default(), 0.30);
     enter(&mut b, &mut mem, 0.0, at(0.4));
     let s = tick(&mut b, &mut mem, 0.1, at(0.35), None);
     assert_eq!(s.output.aux.get::<Posture>(), Some(Posture::Lowered));
@@ -295,7 +295,7 @@ fn move_away_retries_and_give_up_fails_with_the_reason_left_in_memory() {
 #[test]
 fn departure_undocks_imprints_once_and_fails_without_an_imprint() {
     let mut mem = memory();
-    let mut u = departure::Undock::new("undock", UndockParams::default(), 0.30);
+    let mut u = departure::Undock::new(UndockParams::default(), 0.30);
     enter(&mut u, &mut mem, 0.0, at(-0.2));
     let s = tick(&mut u, &mut mem, 0.1, at(-0.1), None);
     assert_eq!(
@@ -303,7 +303,7 @@ fn departure_undocks_imprints_once_and_fails_without_an_imprint() {
         (Status::Running, Some(Posture::Lowered))
     );
     assert_eq!(tick(&mut u, &mut mem, 5.0, at(0.16), None).status, Status::Event("out"));
-    let mut d = departure::DriveOut::new("drive_out", DriveOutParams::default(), 0.6);
+    let mut d = departure::DriveOut::new(DriveOutParams::default(), 0.6);
     enter(&mut d, &mut mem, 5.0, at(0.16));
     assert_eq!(tick(&mut d, &mut mem, 6.0, at(0.3), None).status, Status::Running);
     assert_eq!(
@@ -311,7 +311,7 @@ fn departure_undocks_imprints_once_and_fails_without_an_imprint() {
         Status::Event("imprint")
     );
     // The imprint (here on no frames) failed: imprinting is tried again.
-    let mut i = Imprint::new("imprint", 0, 2, ImprintEnd::Event("imprinted"));
+    let mut i = Imprint::new(0, 2, ImprintEnd::Event("imprinted"));
     enter(&mut i, &mut mem, 9.0, at(0.41));
     assert_eq!(tick(&mut i, &mut mem, 9.1, at(0.41), None).status, Status::Running);
     assert_eq!(
@@ -332,7 +332,7 @@ fn departure_undocks_imprints_once_and_fails_without_an_imprint() {
     );
     // An imprint distance beyond the departure's: it ends without imprinting, and says so.
     mem.imprinted = false;
-    let mut far = departure::DriveOut::new("drive_out", DriveOutParams::default(), 2.0);
+    let mut far = departure::DriveOut::new(DriveOutParams::default(), 2.0);
     let end = tick(&mut far, &mut mem, 20.0, at(1.1), None).status;
     assert_eq!(end, Status::Done(Outcome::Failed(FailureReason::TargetNeverDetected)));
 }
@@ -340,7 +340,7 @@ fn departure_undocks_imprints_once_and_fails_without_an_imprint() {
 #[test]
 fn the_dock_switch_is_released_only_by_contact() {
     let mut mem = memory();
-    let mut c = DockSwitch::new("dock_switch");
+    let mut c = DockSwitch;
     assert!(c.tick(&mut mem, &Inputs::empty(0.0)).is_none());
     let mut inputs = Inputs::empty(0.1);
     let sensors = [Some(SensorInput {

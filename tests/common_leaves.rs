@@ -69,7 +69,7 @@ pub fn run<B: Behavior<Base>>(leaf: &mut B, base: &mut Base, ticks: usize) -> (S
 fn turn_to_reaches_the_heading_and_ends_with_its_event() {
     let mut base = Base::default();
     let aim: AimFn<Base> = Box::new(|_| Aim::Heading(1.0));
-    let mut leg = TurnTo::new("turn", "turn", aim, Some(0.02), "turned").hooks(Hooks {
+    let mut leg = TurnTo::new("turn", aim, Some(0.02), "turned").hooks(Hooks {
         end: |b: &mut Base| b.ends += 1,
         ..Hooks::default()
     });
@@ -85,7 +85,7 @@ fn turn_to_gives_up_after_its_timeout_and_holds_without_an_aim() {
     // A heading it never reaches (the base does not move: run() is bypassed).
     let mut base = Base::default();
     let aim: AimFn<Base> = Box::new(|_| Aim::Heading(2.0));
-    let mut leg = TurnTo::new("turn", "turn", aim, Some(0.01), "turned").timeout(0.5);
+    let mut leg = TurnTo::new("turn", aim, Some(0.01), "turned").timeout(0.5);
     leg.enter(&mut base, &Inputs::empty(0.0));
     let mut ended = None;
     for i in 1..20 {
@@ -103,7 +103,7 @@ fn turn_to_gives_up_after_its_timeout_and_holds_without_an_aim() {
         "ends on the first tick past 0.5 s"
     );
     let aim: AimFn<Base> = Box::new(|_| Aim::Hold);
-    let mut idle = TurnTo::new("idle", "idle", aim, None, "turned");
+    let mut idle = TurnTo::new("idle", aim, None, "turned");
     let (status, _) = run(&mut idle, &mut base, 30);
     assert_eq!(status, Status::Running, "no aim: it stands and waits");
 }
@@ -111,7 +111,7 @@ fn turn_to_gives_up_after_its_timeout_and_holds_without_an_aim() {
 #[test]
 fn back_off_covers_its_distance_or_its_time() {
     let mut base = Base::default();
-    let mut leg = BackOff::new("away", "away", Distance::Fixed(0.3), 0.1, End::Event("done"));
+    let mut leg = BackOff::new("away", Distance::Fixed(0.3), 0.1, End::Event("done"));
     let (status, ticks) = run(&mut leg, &mut base, 100);
     assert_eq!(status, Status::Event("done"));
     assert!((base.odo.x + 0.3).abs() < 1e-9, "backed 0.3 m: {}", base.odo.x);
@@ -119,14 +119,7 @@ fn back_off_covers_its_distance_or_its_time() {
     // The same leg bounded by 1 s ends short, failed for the memory's reason.
     let mut base = Base::default();
     let why: fn(&Base) -> FailureReason = |_| FailureReason::TargetLost;
-    let mut leg = BackOff::new(
-        "give_up",
-        "give_up",
-        Distance::AtEntry(Box::new(|_| 0.3)),
-        0.1,
-        End::Fail(why),
-    )
-    .timeout(1.0);
+    let mut leg = BackOff::new("give_up", Distance::AtEntry(Box::new(|_| 0.3)), 0.1, End::Fail(why)).timeout(1.0);
     let (status, _) = run(&mut leg, &mut base, 100);
     assert_eq!(status, Status::Done(Outcome::Failed(FailureReason::TargetLost)));
     assert!(base.odo.x > -0.15, "stopped by the time limit: {}", base.odo.x);
@@ -142,21 +135,13 @@ fn turn_drive_turn_reaches_a_staging_pose_from_many_starts() {
             ..Base::default()
         };
         let face_aim: AimFn<Base> = Box::new(move |b| face(&b.odo, &target, 0.03));
-        let (s, _) = run(
-            &mut TurnTo::new("face", "f", face_aim, Some(0.01), "faced"),
-            &mut base,
-            400,
-        );
+        let (s, _) = run(&mut TurnTo::new("f", face_aim, Some(0.01), "faced"), &mut base, 400);
         assert!(matches!(s, Status::Event("faced" | "arrived")), "{s:?}");
-        let mut drive = DriveAbeam::new("drive", "d", Box::new(move |_| Some(target)), 0.1, 0.1, 0.03, 0.005);
+        let mut drive = DriveAbeam::new("d", Box::new(move |_| Some(target)), 0.1, 0.1, 0.03, 0.005);
         let (s, _) = run(&mut drive, &mut base, 400);
         assert!(matches!(s, Status::Event("abeam" | "arrived")), "{s:?}");
         let align: AimFn<Base> = Box::new(move |_| Aim::Heading(target.theta));
-        let (s, _) = run(
-            &mut TurnTo::new("align", "a", align, Some(0.01), "aligned"),
-            &mut base,
-            400,
-        );
+        let (s, _) = run(&mut TurnTo::new("a", align, Some(0.01), "aligned"), &mut base, 400);
         assert_eq!(s, Status::Event("aligned"));
         let off = base.odo.distance(&target);
         assert!(off < 0.03, "from ({x}, {y}, {th}) ended {off} m off");
@@ -258,7 +243,7 @@ mod search {
     #[test]
     fn doubling_search_alternates_from_the_side_asked_and_times_out() {
         let mut r = Robot::default();
-        let (rates, end) = run(&mut Search::new("s", "s", params(), ()), &mut r, 200);
+        let (rates, end) = run(&mut Search::new("s", params(), ()), &mut r, 200);
         assert_eq!(end, Status::Done(Outcome::Failed(FailureReason::TargetNeverDetected)));
         assert_eq!(rates.len(), 100, "10 s of searching");
         assert!(
@@ -280,7 +265,7 @@ mod search {
             settle_s: 0.45,
             ..params()
         };
-        let (rates, end) = run(&mut Search::new("s", "s", p, ()), &mut r, 200);
+        let (rates, end) = run(&mut Search::new("s", p, ()), &mut r, 200);
         assert_eq!(end, Status::Event("acquired"));
         assert_eq!(rates.len(), 10);
         // 3 grace ticks; then 0.45 s from entry has passed only at 0.5 s: one more hold.
@@ -296,7 +281,7 @@ mod search {
             timeout_s: 0.95,
             ..params()
         };
-        let mut leaf = Search::new("s", "s", p, ());
+        let mut leaf = Search::new("s", p, ());
         let (first, end) = run(&mut leaf, &mut r, 6);
         assert_eq!((first.len(), end), (6, Status::Running));
         // Re-entered (a glimpse came and went): the clock runs on from the first entry.

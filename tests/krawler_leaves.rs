@@ -55,7 +55,7 @@ fn monitor(reference: Reference) -> SlipMonitor {
         reference,
         min_measured: 0.5,
     };
-    SlipMonitor::new("slip", params).unwrap()
+    SlipMonitor::new(params).unwrap()
 }
 
 #[test]
@@ -128,7 +128,7 @@ fn slip_monitor_bad_params_name_their_field() {
         reference: Reference::Command,
         min_measured,
     };
-    let e = |p| SlipMonitor::new("s", p).err().unwrap();
+    let e = |p| SlipMonitor::new(p).err().unwrap();
     assert!(e(p(0.0, 1.0, 0.5)).starts_with("params.threshold_rad"));
     assert!(e(p(0.3, f64::NAN, 0.5)).starts_with("params.window_s"));
     assert!(e(p(0.3, 1.0, 1.5)).starts_with("params.min_measured"));
@@ -140,7 +140,7 @@ fn traverse(speed_mps: f64, turn_rate_dps: f64, duration_s: Option<f64>) -> Trav
         turn_rate_dps,
         duration_s,
     };
-    Traverse::new("traverse", params).unwrap()
+    Traverse::new(params).unwrap()
 }
 
 #[test]
@@ -176,7 +176,7 @@ fn a_turning_traverse_commands_a_twist() {
 fn halt_stops_and_ends_stuck() {
     let mut m = memory_of_the_shipped_krawler();
     m.commanded_rate = 1.0;
-    let s = Halt::new("halt").tick(&mut m, &Inputs::empty(1.0)).unwrap();
+    let s = Halt.tick(&mut m, &Inputs::empty(1.0)).unwrap();
     assert_eq!(s.status, Status::Done(Outcome::Failed(FailureReason::StuckContact)));
     assert_eq!((s.output, m.commanded_rate), (MotorOutput::stop(), 0.0));
 }
@@ -184,14 +184,11 @@ fn halt_stops_and_ends_stuck() {
 #[test]
 fn traverse_bad_params_name_their_field() {
     let e = |v, w, d| {
-        Traverse::new(
-            "t",
-            TraverseParams {
-                speed_mps: v,
-                turn_rate_dps: w,
-                duration_s: d,
-            },
-        )
+        Traverse::new(TraverseParams {
+            speed_mps: v,
+            turn_rate_dps: w,
+            duration_s: d,
+        })
         .err()
         .unwrap()
     };

@@ -151,14 +151,14 @@ fn servo_states_steer_on_what_they_see() {
         .seven_state;
     // State 1 near the pyramid: slower than the far speed, turning against x_dev; the
     // camera looks back, so "toward the pyramid" is body-backward.
-    let mut s1 = servo::Approach::new("approach");
+    let mut s1 = servo::Approach;
     let step = tick(&mut s1, &mut mem, 0.1, at(1.0), seen(0.6, Some(5.0), [20.0, 0.0], true));
     assert_eq!(step.status, Status::Running);
     let t = twist(&step);
     assert!(t.v < 0.0 && -t.v < g.far_speed_mps, "{t:?}");
     assert!((t.omega - -g.k_ang * 20.0).abs() < 1e-12, "{t:?}");
     // State 3: a lone ellipse far away, at the far speed.
-    let mut s3 = servo::FarEllipse::new("far_ellipse");
+    let mut s3 = servo::FarEllipse;
     let t = twist(&tick(
         &mut s3,
         &mut mem,
@@ -173,7 +173,7 @@ fn servo_states_steer_on_what_they_see() {
         DriveCommand::Stop
     );
     // State 4: turn toward the blue edges; creep only within `centred_px` of the centre.
-    let mut s4 = servo::BlueOnly::new("blue_only", BlueOnlyParams::default());
+    let mut s4 = servo::BlueOnly::new(BlueOnlyParams::default());
     let mut blue = nothing();
     blue.detection.blue = Some(blue_at(80));
     let t = twist(&tick(&mut s4, &mut mem, 0.4, at(1.0), blue));
@@ -183,7 +183,7 @@ fn servo_states_steer_on_what_they_see() {
     assert_eq!(t.v, 0.0, "20 px off: turn only");
     assert!((t.omega - -g.k_ang * 20.0).abs() < 1e-12);
     let wide = BlueOnlyParams { centred_px: 30.0 };
-    let mut s4 = servo::BlueOnly::new("blue_only", wide);
+    let mut s4 = servo::BlueOnly::new(wide);
     assert_eq!(
         twist(&tick(&mut s4, &mut mem, 0.6, at(1.0), blue)).v,
         -g.final_speed_mps
@@ -223,7 +223,7 @@ fn search_waits_its_grace_frames_turns_away_from_the_last_turn_and_times_out() {
 fn align_plans_counts_and_hands_over_already_turning() {
     let mut mem = memory();
     mem.settling = true;
-    let mut a = align::Align::new("align");
+    let mut a = align::Align;
     // No pair, no plan.
     let step = tick(&mut a, &mut mem, 0.1, at(1.0), seen(1.5, None, [0.0, 0.0], false));
     assert_eq!(step.status, Status::Running);
@@ -263,7 +263,7 @@ fn at_bearing(bearing: f64, dev_x: f64) -> PyramidPercept {
 #[test]
 fn rotate_7_measures_the_rotation_by_vision_and_resets_the_odometry_frame() {
     let mut mem = planned(17.0);
-    let mut r = rotate7::Rotate7::new("rotate_7");
+    let mut r = rotate7::Rotate7::default();
     enter(&mut r, &mut mem, 0.0, at(1.0), at_bearing(0.0, 0.0));
     // 0.05 rad per frame toward a 17° (0.297 rad) goal, tolerance 2°: the predictor stops
     // at 0.25 rad turned (next frame would reach 0.30).
@@ -300,7 +300,7 @@ fn rotate_7_measures_the_rotation_by_vision_and_resets_the_odometry_frame() {
 #[test]
 fn rotate_7_stops_before_the_image_edge_and_gives_up_when_lost() {
     let mut mem = planned(40.0);
-    let mut r = rotate7::Rotate7::new("rotate_7");
+    let mut r = rotate7::Rotate7::default();
     enter(&mut r, &mut mem, 0.0, at(1.0), at_bearing(0.0, 50.0));
     // 0.05 rad is 18 px at f = 361 px: 50 + 18 passes 80 − 10 px.
     assert_eq!(
@@ -392,14 +392,14 @@ fn final_runs_the_state_1_law_once_then_creeps_and_retries() {
     let g = marsupial::behaviors::catalog::tuning::<marsupial::behaviors::raposa::Raposa>(&profile())
         .unwrap()
         .seven_state;
-    let mut f = final_approach::FinalApproach::new("final", 3);
+    let mut f = final_approach::FinalApproach::new(3);
     let near = seen(0.28, Some(3.0), [4.0, 10.0], true);
     enter(&mut f, &mut mem, 5.0, at(0.5), near);
     let aux = mem.aux;
     assert_eq!(aux.get::<ArmPosition>(), Some(ArmPosition(-g.k_arm * 10.0)));
     assert_eq!(aux.get::<Lights>(), Some(Lights(true)));
     let first = tick(&mut f, &mut mem, 5.0, at(0.5), near);
-    let mut approach = servo::Approach::new("approach");
+    let mut approach = servo::Approach;
     assert_eq!(first.output, tick(&mut approach, &mut mem, 5.0, at(0.5), near).output);
     assert_eq!(first.output.aux.get::<Lights>(), Some(Lights(true)));
     let t = twist(&tick(&mut f, &mut mem, 5.1, at(0.5), near));
@@ -462,7 +462,7 @@ fn back_aways_leave_by_their_distance_then_clear() {
 #[test]
 fn departure_drives_out_to_the_imprint_distance_then_imprints() {
     let mut mem = memory();
-    let mut d = departure::Depart::new("depart", &mem);
+    let mut d = departure::Depart::new(&mem);
     // Docked, the camera is 0.1 m from the ball; it imprints from 0.6 m.
     let step = tick(&mut d, &mut mem, 0.1, at(0.0), nothing());
     assert!(twist(&step).v > 0.0, "body forward: {step:?}");
@@ -475,7 +475,7 @@ fn departure_drives_out_to_the_imprint_distance_then_imprints() {
     // (no camera), so the departure fails.
     // As `raposa.imprint` is registered.
     let frames = mem.source.imprint_frames_wanted();
-    let mut im = Imprint::new("imprint", 1, frames, ImprintEnd::Outcome);
+    let mut im = Imprint::new(1, frames, ImprintEnd::Outcome);
     enter(&mut im, &mut mem, 0.3, at(0.5), nothing());
     for k in 1..=5 {
         assert_eq!(
@@ -493,7 +493,7 @@ fn departure_drives_out_to_the_imprint_distance_then_imprints() {
 #[test]
 fn the_dock_switch_closes_the_guides_and_docks() {
     let mut mem = memory();
-    let mut s = DockSwitch::new("dock_switch");
+    let mut s = DockSwitch;
     assert!(s.tick(&mut mem, &Inputs::empty(0.0)).is_none());
     let mut i = Inputs::empty(0.1);
     let sensors = [Some(SensorInput {

@@ -254,11 +254,9 @@ fn gripper_registry(
 ) -> marsupial::behaviors::registry::Registry<()> {
     use marsupial::behaviors::registry::{LeafArgs, Registry};
     use marsupial::schemas::{Behavior, Inputs, Step};
+    // No `name`: the tree names it by its node.
     struct Grip;
     impl Behavior for Grip {
-        fn name(&self) -> &str {
-            "grip"
-        }
         fn tick(&mut self, _mem: &mut (), _: &Inputs<'_>) -> Option<Step> {
             None
         }
@@ -283,6 +281,8 @@ fn a_registered_actuator_kind_is_checked_and_found_by_its_leaf() {
               [[actuators]]\nname = \"claw\"\nkind = \"gripper\"\nparams = { force_n = 20.0 }\n";
     assert!(registry.build(&gripper_profile(ok), &()).is_ok());
     assert_eq!(*found.lock().unwrap(), Some(0), "the first entry of the kind");
+    let leaf = registry.build_node(&gripper_profile(ok), "grip", &()).unwrap();
+    assert_eq!(leaf.name(), "grip", "a leaf is named by its node");
     // Params the kind refuses, at their entry.
     let weak = ok.replace("force_n = 20.0", "force_n = 0.0");
     let e = registry.build(&gripper_profile(&weak), &()).err().unwrap();

@@ -8,8 +8,10 @@ use serde::de::DeserializeOwned;
 
 /// What a factory gets to build one leaf.
 pub struct LeafArgs<'a> {
-    /// The node's name in the tree: the leaf must report it as its [`Behavior::name`](crate::schemas::Behavior::name)
-    /// (sequencers find their states, and traces name them, by it).
+    /// The node's name in the tree. The tree names the leaf by it (its
+    /// [`Behavior::name`](crate::schemas::Behavior::name): sequencers find their states,
+    /// and traces name them, by it), so a factory need not hand it to the leaf; a leaf
+    /// whose feedback names its node takes [`LeafArgs::phase`].
     pub node: &'a str,
     /// The node's `params` table.
     pub params: &'a toml::Table,

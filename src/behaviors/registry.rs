@@ -11,12 +11,11 @@
 //! use marsupial::behaviors::registry::{LeafArgs, Registry};
 //! use marsupial::schemas::{Behavior, Feedback, Inputs, MotorOutput, Step};
 //!
-//! struct Creep(String, f64);
-//! // Reads no memory, so it fits in any robot's tree.
+//! struct Creep(f64);
+//! // Reads no memory, so it fits in any robot's tree; the tree names it by its node.
 //! impl<M: ?Sized> Behavior<M> for Creep {
-//!     fn name(&self) -> &str { &self.0 }
 //!     fn tick(&mut self, _mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
-//!         Some(Step::running(MotorOutput::twist(self.1, 0.0), Feedback::new("creep", inputs.now)))
+//!         Some(Step::running(MotorOutput::twist(self.0, 0.0), Feedback::new("creep", inputs.now)))
 //!     }
 //! }
 //!
@@ -27,7 +26,7 @@
 //! let mut registry: Registry<()> = Registry::new();
 //! registry.register("my.creep", |_: &(), args: &LeafArgs<'_>| {
 //!     let p: CreepParams = args.params()?;
-//!     Ok(Box::new(Creep(args.node.to_string(), p.speed_mps)))
+//!     Ok(Box::new(Creep(p.speed_mps)))
 //! });
 //! assert!(registry.names().any(|n| n == "my.creep"));
 //! ```
@@ -36,7 +35,7 @@ use crate::arbiter::{Next, Priority, Selector, Sequencer, VectorSum};
 use crate::config::ConfigError;
 use crate::profile::Profile;
 use crate::profile::tree::{FINISH, Lead, NodeSpec, TreeSpec};
-use crate::schemas::Behavior;
+use crate::schemas::{Behavior, Inputs, Step};
 use std::collections::BTreeMap;
 
 pub use super::leaf_args::{LeafArgs, SelectorArgs};
@@ -139,8 +138,8 @@ impl<M: 'static> Registry<M> {
     ///
     /// # Errors
     /// [`ConfigError::Invalid`] naming the profile's line for an absent tree, an unknown
-    /// schema, params a schema refuses, or a leaf that misreports its name. (The tree's
-    /// structure was checked when the profile loaded.)
+    /// schema, or params a schema refuses. (The tree's structure was checked when the
+    /// profile loaded.)
     pub fn build(&self, profile: &Profile, memory: &M) -> Result<Box<dyn Behavior<M>>, ConfigError> {
         let Some(tree) = &profile.behavior.tree else {
             return Err(profile.problems(vec![(
@@ -224,14 +223,10 @@ impl<M: 'static> Registry<M> {
                     profile,
                 };
                 match factory(memory, &args) {
-                    Ok(b) if b.name() == name => Some(b),
-                    Ok(b) => {
-                        problems.push((
-                            format!("{path}.schema"),
-                            format!("schema `{schema}` named its leaf `{}`, expected `{name}`", b.name()),
-                        ));
-                        None
-                    }
+                    Ok(leaf) => Some(Box::new(Named {
+                        name: name.to_owned(),
+                        leaf,
+                    })),
                     Err(e) => {
                         let at = if e.starts_with("params") && !params.is_empty() {
                             format!("{path}.params")
@@ -316,6 +311,34 @@ impl<M: 'static> Registry<M> {
                 Some(Box::new(seq))
             }
         }
+    }
+}
+
+/// A leaf as the tree holds it: named by its node (sequencers find their states, and
+/// traces name them, by it), everything else the leaf's own.
+struct Named<M: 'static> {
+    name: String,
+    leaf: Box<dyn Behavior<M>>,
+}
+
+impl<M: 'static> Behavior<M> for Named<M> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn tick(&mut self, mem: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
+        self.leaf.tick(mem, inputs)
+    }
+    fn reset(&mut self) {
+        self.leaf.reset()
+    }
+    fn enter(&mut self, mem: &mut M, inputs: &Inputs<'_>) {
+        self.leaf.enter(mem, inputs)
+    }
+    fn start(&mut self, state: &str) -> bool {
+        self.leaf.start(state)
+    }
+    fn explain(&self, out: &mut Vec<crate::arbiter::NodeTrace>) {
+        self.leaf.explain(out)
     }
 }
 

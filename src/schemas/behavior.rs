@@ -181,8 +181,21 @@ impl Step {
 /// Implementations must be deterministic functions of their state, the memory and the
 /// inputs.
 pub trait Behavior<M: ?Sized = ()>: Send {
-    /// A short name for logs and decisions.
-    fn name(&self) -> &str;
+    /// A short name for logs and decisions: sequencers find their states by it, and
+    /// decision traces name children by it.
+    ///
+    /// A tree built by a [`Registry`](crate::behaviors::registry::Registry) names each
+    /// leaf by its node (whatever the leaf would say), so a leaf written for a profile's
+    /// tree need not implement this. The default is the type's own name: the last
+    /// segment of its path in [`std::any::type_name`] (`Align`; a generic type keeps its
+    /// arguments as `type_name` writes them). A behavior used
+    /// outside a registry-built tree (put straight into a
+    /// [`Sequencer`](crate::arbiter::Sequencer) or [`Priority`](crate::arbiter::Priority)
+    /// by hand, as the examples and tests may) should override it when something finds
+    /// it by name or reads a trace of it.
+    fn name(&self) -> &str {
+        short_type_name(std::any::type_name::<Self>())
+    }
     /// Runs one tick with the tree's memory.
     fn tick(&mut self, mem: &mut M, inputs: &Inputs<'_>) -> Option<Step>;
     /// Returns to the initial state.
@@ -227,6 +240,15 @@ impl<M: ?Sized, B: Behavior<M> + ?Sized> Behavior<M> for Box<B> {
     fn explain(&self, out: &mut Vec<crate::arbiter::NodeTrace>) {
         (**self).explain(out)
     }
+}
+
+/// The last segment of a type's own path (`a::b::Search<a::c::Memory>` is
+/// `Search<a::c::Memory>`): the default [`Behavior::name`].
+fn short_type_name(full: &'static str) -> &'static str {
+    // A generic type keeps its arguments' full paths; its own path ends before the `<`.
+    let head = full.find('<').unwrap_or(full.len());
+    let start = full[..head].rfind("::").map_or(0, |i| i + 2);
+    &full[start..]
 }
 
 /// The basic schema-theoretic behavior: perceive, test the releaser on the percept, act.
@@ -306,5 +328,40 @@ impl Percept for Presence {
     }
     fn found(&self) -> bool {
         self.found
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Plain;
+    impl Behavior for Plain {
+        fn tick(&mut self, _mem: &mut (), _inputs: &Inputs<'_>) -> Option<Step> {
+            None
+        }
+    }
+
+    struct Generic<T>(T);
+    impl<T: Send> Behavior for Generic<T> {
+        fn tick(&mut self, _mem: &mut (), _inputs: &Inputs<'_>) -> Option<Step> {
+            None
+        }
+    }
+
+    #[test]
+    fn the_default_name_is_the_types_own() {
+        assert_eq!(Plain.name(), "Plain");
+        assert_eq!(Box::new(Plain).name(), "Plain", "a box says what it holds");
+        assert_eq!(
+            Generic(Presence {
+                stamp: 0.0,
+                found: false
+            })
+            .name(),
+            "Generic<marsupial::schemas::behavior::Presence>"
+        );
+        assert_eq!(short_type_name("a::b::C<d::E<f::G>>"), "C<d::E<f::G>>");
+        assert_eq!(short_type_name("C"), "C");
     }
 }

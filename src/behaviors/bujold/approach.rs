@@ -23,26 +23,19 @@ use crate::schemas::{Behavior, DriveCommand, Inputs, MotionVector, MotorOutput, 
 
 /// See the module docs.
 pub struct Approach {
-    name: String,
     params: ApproachParams,
     dock_total_px: f64,
     max_retries: u32,
 }
 
 impl Approach {
-    /// A leaf named `name` of a tree over `mem` (read here for its approach); at the dock
+    /// The leaf of a tree over `mem` (read here for its approach); at the dock
     /// at `dock_total_px`, repositioning at most `max_retries` times per docking.
     ///
     /// # Errors
     /// A message when `output = "vector"` but the memory's approach has no potential
     /// field.
-    pub fn new(
-        name: &str,
-        mem: &Memory,
-        params: ApproachParams,
-        dock_total_px: f64,
-        max_retries: u32,
-    ) -> Result<Self, String> {
+    pub fn new(mem: &Memory, params: ApproachParams, dock_total_px: f64, max_retries: u32) -> Result<Self, String> {
         if params.output == ApproachOutput::Vector && mem.approach.field.is_none() {
             return Err(
                 "params.output: `vector` needs robot.approach = \"potential_field\" (ratio steering has no vector)"
@@ -50,7 +43,6 @@ impl Approach {
             );
         }
         Ok(Self {
-            name: name.into(),
             params,
             dock_total_px,
             max_retries,
@@ -84,10 +76,6 @@ impl Approach {
 }
 
 impl Behavior<Memory> for Approach {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
     fn tick(&mut self, m: &mut Memory, inputs: &Inputs<'_>) -> Option<Step> {

@@ -14,17 +14,15 @@ use crate::schemas::{Behavior, DeadReckoning, FailureReason, Inputs, MotorOutput
 
 /// See the module docs.
 pub struct BackIn {
-    name: String,
     params: BackInParams,
     depth: f64,
     mark: Pose2,
 }
 
 impl BackIn {
-    /// A leaf named `name`; `depth` is the pouch's depth, m.
-    pub fn new(name: &str, params: BackInParams, depth: f64) -> Self {
+    /// The leaf; `depth` is the pouch's depth, m.
+    pub fn new(params: BackInParams, depth: f64) -> Self {
         Self {
-            name: name.into(),
             params,
             depth,
             mark: Pose2::default(),
@@ -33,10 +31,6 @@ impl BackIn {
 }
 
 impl Behavior<Memory> for BackIn {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         self.mark = m.odo;
     }

@@ -69,7 +69,6 @@ fn heading_margin(margin: f64, retries: u32, max_retries: u32) -> f64 {
 
 /// See the module docs.
 pub struct Decide {
-    name: String,
     params: DecideParams,
     tol_lateral: f64,
     tol_heading: f64,
@@ -79,10 +78,9 @@ pub struct Decide {
 }
 
 impl Decide {
-    /// A leaf named `name` with the profile's success tolerances (m, rad).
-    pub fn new(name: &str, params: DecideParams, tol_lateral: f64, tol_heading: f64, max_retries: u32) -> Self {
+    /// The leaf, with the profile's success tolerances (m, rad).
+    pub fn new(params: DecideParams, tol_lateral: f64, tol_heading: f64, max_retries: u32) -> Self {
         Self {
-            name: name.into(),
             samples: Vec::with_capacity(params.frames.max(1)),
             params,
             tol_lateral,
@@ -94,10 +92,6 @@ impl Decide {
 }
 
 impl Behavior<Memory> for Decide {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, _mem: &mut Memory, inputs: &Inputs<'_>) {
         self.started = inputs.now;
         self.samples.clear();

@@ -10,27 +10,18 @@ use crate::schemas::{Behavior, DriveCommand, FailureReason, Inputs, MotorOutput,
 /// `bujold.undock`: drive out of the pouch front first, lowered, until clear of it;
 /// event `out`.
 pub struct Undock {
-    name: String,
     params: UndockParams,
     depth: f64,
 }
 
 impl Undock {
-    /// A leaf named `name`; `depth` is the pouch's depth, m.
-    pub fn new(name: &str, params: UndockParams, depth: f64) -> Self {
-        Self {
-            name: name.into(),
-            params,
-            depth,
-        }
+    /// The leaf; `depth` is the pouch's depth, m.
+    pub fn new(params: UndockParams, depth: f64) -> Self {
+        Self { params, depth }
     }
 }
 
 impl Behavior<Memory> for Undock {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         // Departure distances are measured from where it began.
         m.departure_mark = m.odo;
@@ -58,28 +49,19 @@ impl Behavior<Memory> for Undock {
 /// distance (once), then done at the departure distance: completed when the imprint
 /// succeeded, failed (target never detected) otherwise.
 pub struct DriveOut {
-    name: String,
     params: DriveOutParams,
     /// Travel from the departure's start at which to imprint, m.
     imprint_at: f64,
 }
 
 impl DriveOut {
-    /// A leaf named `name`; imprints `imprint_at` m from where the departure began.
-    pub fn new(name: &str, params: DriveOutParams, imprint_at: f64) -> Self {
-        Self {
-            name: name.into(),
-            params,
-            imprint_at,
-        }
+    /// The leaf, imprinting `imprint_at` m from where the departure began.
+    pub fn new(params: DriveOutParams, imprint_at: f64) -> Self {
+        Self { params, imprint_at }
     }
 }
 
 impl Behavior<Memory> for DriveOut {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
     fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {

@@ -46,17 +46,16 @@ pub fn register(registry: &mut Registry<Memory>) {
     let depth = |a: &LeafArgs<'_>| a.profile.dock.map(|d| d.depth_m).ok_or("needs [dock]");
     registry
         .register("bujold.undock", move |_: &Memory, a: &LeafArgs<'_>| {
-            Ok(Box::new(departure::Undock::new(a.node, a.params()?, depth(a)?)))
+            Ok(Box::new(departure::Undock::new(a.params()?, depth(a)?)))
         })
         .register("bujold.drive_out", |_: &Memory, a: &LeafArgs<'_>| {
             let imprint_at = imprint_distance(a.profile).ok_or("needs [dock] and a camera")?;
-            Ok(Box::new(departure::DriveOut::new(a.node, a.params()?, imprint_at)))
+            Ok(Box::new(departure::DriveOut::new(a.params()?, imprint_at)))
         })
         .register("bujold.imprint", |_: &Memory, a: &LeafArgs<'_>| {
             a.no_params()?;
             // Samples from its first tick; the departure goes on whether it worked.
             Ok(Box::new(Imprint::new(
-                a.node,
                 0,
                 a.profile.perception.imprint.frames,
                 ImprintEnd::Event("imprinted"),
@@ -73,7 +72,7 @@ pub fn register(registry: &mut Registry<Memory>) {
                 timeout_s: a.profile.behavior.search_timeout_s,
             };
             let watch = search::JamWatch::new(a.params()?);
-            Ok(Box::new(Search::new(a.node, "search", params, watch)))
+            Ok(Box::new(Search::new("search", params, watch)))
         })
         // Unjamming: turn back to the heading the close dock began with (turning back
         // over the ground just swept is free), then drive out front first; the search
@@ -84,13 +83,12 @@ pub fn register(registry: &mut Registry<Memory>) {
             let p: TurnParams = a.params()?;
             let aim: AimFn<Memory> = Box::new(|m| Aim::Heading(m.start_heading.unwrap_or(m.odo.theta)));
             let tol = Some(p.heading_tolerance_deg.to_radians());
-            let leg = TurnTo::new(a.node, a.phase(), aim, tol, "turned").timeout(p.timeout_s);
+            let leg = TurnTo::new(a.phase(), aim, tol, "turned").timeout(p.timeout_s);
             Ok(Box::new(leg.hooks(observing())))
         })
         .register("bujold.unjam_out", |_: &Memory, a: &LeafArgs<'_>| {
             let p: BackOffParams = a.params()?;
             let leg = BackOff::new(
-                a.node,
                 a.phase(),
                 Distance::Fixed(p.distance_m),
                 p.speed_mps,
@@ -102,18 +100,11 @@ pub fn register(registry: &mut Registry<Memory>) {
         .register("bujold.approach", |m: &Memory, a: &LeafArgs<'_>| {
             let dock_total = m.approach.steering.dock_total_px;
             let retries = a.profile.behavior.max_retries;
-            Ok(Box::new(approach::Approach::new(
-                a.node,
-                m,
-                a.params()?,
-                dock_total,
-                retries,
-            )?))
+            Ok(Box::new(approach::Approach::new(m, a.params()?, dock_total, retries)?))
         })
         .register("bujold.decide", |_: &Memory, a: &LeafArgs<'_>| {
             let s = &a.profile.success;
             Ok(Box::new(decide::Decide::new(
-                a.node,
                 a.params()?,
                 s.lateral_tolerance_m,
                 s.heading_tolerance_deg.to_radians(),
@@ -121,7 +112,7 @@ pub fn register(registry: &mut Registry<Memory>) {
             )))
         })
         .register("bujold.back_in", move |_: &Memory, a: &LeafArgs<'_>| {
-            Ok(Box::new(back_in::BackIn::new(a.node, a.params()?, depth(a)?)))
+            Ok(Box::new(back_in::BackIn::new(a.params()?, depth(a)?)))
         })
         // "Move away and retry" (seed 004 §V), and giving up: every failure close to
         // the dock first backs off the entrance, then stops, failed with the reason the
@@ -129,7 +120,6 @@ pub fn register(registry: &mut Registry<Memory>) {
         .register("bujold.move_away", |_: &Memory, a: &LeafArgs<'_>| {
             let p: BackOffParams = a.params()?;
             let leg = BackOff::new(
-                a.node,
                 "move_away",
                 Distance::Fixed(p.distance_m),
                 p.speed_mps,
@@ -140,12 +130,12 @@ pub fn register(registry: &mut Registry<Memory>) {
         .register("bujold.give_up", |_: &Memory, a: &LeafArgs<'_>| {
             let p: BackOffParams = a.params()?;
             let why = End::Fail(|m: &Memory| m.failing.unwrap_or(FailureReason::Timeout));
-            let leg = BackOff::new(a.node, "give_up", Distance::Fixed(p.distance_m), p.speed_mps, why);
+            let leg = BackOff::new("give_up", Distance::Fixed(p.distance_m), p.speed_mps, why);
             Ok(Box::new(leg.timeout(p.timeout_s.unwrap_or(20.0))))
         })
         .register("bujold.dock_switch", |_: &Memory, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(DockSwitch::new(a.node)))
+            Ok(Box::new(DockSwitch))
         });
     reposition::register(registry);
 }

@@ -100,26 +100,20 @@ pub fn register(registry: &mut Registry<Memory>) {
         .register("bujold.clear", |m: &Memory, a: &LeafArgs<'_>| {
             let p: BackOffParams = a.params()?;
             let speed = m.approach.steering.speed;
-            let leg = BackOff::new(
-                a.node,
-                a.phase(),
-                Distance::Fixed(p.distance_m),
-                speed,
-                End::Event("cleared"),
-            );
+            let leg = BackOff::new(a.phase(), Distance::Fixed(p.distance_m), speed, End::Event("cleared"));
             Ok(Box::new(leg.timeout(p.timeout_s.unwrap_or(f64::INFINITY))))
         })
         .register("bujold.face", |_: &Memory, a: &LeafArgs<'_>| {
             let p: FaceParams = a.params()?;
             let aim: AimFn<Memory> = Box::new(move |m| m.staging.map_or(Aim::Hold, |s| face(&m.odo, &s, p.arrive_m)));
             let tol = Some(p.heading_tolerance_deg.to_radians());
-            Ok(Box::new(TurnTo::new(a.node, a.phase(), aim, tol, "faced")))
+            Ok(Box::new(TurnTo::new(a.phase(), aim, tol, "faced")))
         })
         .register("bujold.drive", |m: &Memory, a: &LeafArgs<'_>| {
             let d: DriveParams = a.params()?;
             let s = &m.approach.steering;
             let target = Box::new(|m: &Memory| m.staging);
-            let leg = DriveAbeam::new(a.node, a.phase(), target, s.speed, s.tick_s, d.arrive_m, d.abeam_m);
+            let leg = DriveAbeam::new(a.phase(), target, s.speed, s.tick_s, d.arrive_m, d.abeam_m);
             Ok(Box::new(leg))
         })
         .register("bujold.align", |_: &Memory, a: &LeafArgs<'_>| {
@@ -135,7 +129,7 @@ pub fn register(registry: &mut Registry<Memory>) {
             };
             let tol = Some(t.heading_tolerance_deg.to_radians());
             Ok(Box::new(
-                TurnTo::new(a.node, a.phase(), aim, tol, "aligned")
+                TurnTo::new(a.phase(), aim, tol, "aligned")
                     .timeout(t.timeout_s)
                     .hooks(forget),
             ))

@@ -49,7 +49,6 @@ impl Default for AvoidParams {
 
 /// See the module docs.
 pub struct AvoidLeaf {
-    name: String,
     sensor: usize,
     beams: RangeParams,
     schema: AvoidObstacles,
@@ -58,10 +57,9 @@ pub struct AvoidLeaf {
 }
 
 impl AvoidLeaf {
-    /// A leaf named `name` reading sensor `sensor` (a range finder with `beams`).
-    pub fn new(name: &str, sensor: usize, beams: RangeParams, params: AvoidParams) -> Self {
+    /// A leaf reading sensor `sensor` (a range finder with `beams`).
+    pub fn new(sensor: usize, beams: RangeParams, params: AvoidParams) -> Self {
         Self {
-            name: name.into(),
             sensor,
             beams,
             schema: AvoidObstacles {
@@ -100,16 +98,12 @@ impl AvoidLeaf {
         }
         let i = a.sensor(RANGE_KIND)?;
         let beams = RangeParams::from_table(&a.profile.sensors[i].params)?;
-        Ok(Self::new(a.node, i, beams, p))
+        Ok(Self::new(i, beams, p))
     }
 }
 
 /// Reads no tree memory: it fits in any robot's tree.
 impl<M: ?Sized> Behavior<M> for AvoidLeaf {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn reset(&mut self) {
         self.side = None;
     }

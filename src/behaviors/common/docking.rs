@@ -38,7 +38,6 @@ pub enum ImprintEnd {
 /// first frames after stopping may still be blurred by the motion), then feeds `frames`
 /// ticks' camera frames to the imprinter, and ends as `end` says.
 pub struct Imprint {
-    name: String,
     settle: u32,
     frames: u32,
     end: ImprintEnd,
@@ -46,10 +45,9 @@ pub struct Imprint {
 }
 
 impl Imprint {
-    /// A leaf named `name`.
-    pub fn new(name: &str, settle: u32, frames: u32, end: ImprintEnd) -> Self {
+    /// A leaf settling `settle` ticks, sampling `frames`, ending as `end` says.
+    pub fn new(settle: u32, frames: u32, end: ImprintEnd) -> Self {
         Self {
-            name: name.into(),
             settle,
             frames,
             end,
@@ -59,10 +57,6 @@ impl Imprint {
 }
 
 impl<M: DockingMemory> Behavior<M> for Imprint {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, _mem: &mut M, _inputs: &Inputs<'_>) {
         self.ticks = 0;
     }
@@ -95,22 +89,10 @@ impl<M: DockingMemory> Behavior<M> for Imprint {
 
 /// `dock_switch`: see the module docs. Released only when the dock's contact sensor reads
 /// closed.
-pub struct DockSwitch {
-    name: String,
-}
-
-impl DockSwitch {
-    /// A leaf named `name`.
-    pub fn new(name: &str) -> Self {
-        Self { name: name.into() }
-    }
-}
+#[derive(Debug, Clone, Copy, Default)]
+pub struct DockSwitch;
 
 impl<M: DockingMemory> Behavior<M> for DockSwitch {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn tick(&mut self, m: &mut M, inputs: &Inputs<'_>) -> Option<Step> {
         inputs.docked_contact().then(|| {
             let aux = m.docked();

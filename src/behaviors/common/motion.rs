@@ -151,10 +151,9 @@ pub type AimFn<M> = Box<dyn Fn(&M) -> Aim + Send>;
 /// The point a [`DriveAbeam`] drives to, read from the memory each tick (`None`: none yet).
 pub type TargetFn<M> = Box<dyn Fn(&M) -> Option<Pose2> + Send>;
 
-/// What every leg keeps: its node name, feedback phase, time limit, hooks, and when it
-/// was entered.
+/// What every leg keeps: its feedback phase, time limit, hooks, and when it was
+/// entered.
 struct Leg<M> {
-    name: String,
     phase: &'static str,
     timeout_s: f64,
     hooks: Hooks<M>,
@@ -162,9 +161,8 @@ struct Leg<M> {
 }
 
 impl<M: Motion> Leg<M> {
-    fn new(name: &str, phase: &'static str) -> Self {
+    fn new(phase: &'static str) -> Self {
         Self {
-            name: name.into(),
             phase,
             timeout_s: f64::INFINITY,
             hooks: Hooks::default(),
@@ -218,11 +216,11 @@ pub struct TurnTo<M> {
 }
 
 impl<M: Motion> TurnTo<M> {
-    /// A leaf named `name` (feedback `phase`) turning to `aim` within `tolerance` rad
-    /// (`None`: the robot's controller decides), ending with `event`.
-    pub fn new(name: &str, phase: &'static str, aim: AimFn<M>, tolerance: Option<f64>, event: &'static str) -> Self {
+    /// A leaf (feedback `phase`) turning to `aim` within `tolerance` rad (`None`: the
+    /// robot's controller decides), ending with `event`.
+    pub fn new(phase: &'static str, aim: AimFn<M>, tolerance: Option<f64>, event: &'static str) -> Self {
         Self {
-            leg: Leg::new(name, phase),
+            leg: Leg::new(phase),
             aim,
             tolerance,
             event,
@@ -233,10 +231,6 @@ impl<M: Motion> TurnTo<M> {
 }
 
 impl<M: Motion> Behavior<M> for TurnTo<M> {
-    fn name(&self) -> &str {
-        &self.leg.name
-    }
-
     fn enter(&mut self, m: &mut M, inputs: &Inputs<'_>) {
         self.leg.enter(m, inputs);
     }
@@ -288,11 +282,11 @@ pub struct BackOff<M> {
 }
 
 impl<M: Motion> BackOff<M> {
-    /// A leaf named `name` (feedback `phase`) backing off `distance` at `speed_mps`,
-    /// with no time limit.
-    pub fn new(name: &str, phase: &'static str, distance: Distance<M>, speed_mps: f64, end: End<M>) -> Self {
+    /// A leaf (feedback `phase`) backing off `distance` at `speed_mps`, with no time
+    /// limit.
+    pub fn new(phase: &'static str, distance: Distance<M>, speed_mps: f64, end: End<M>) -> Self {
         Self {
-            leg: Leg::new(name, phase),
+            leg: Leg::new(phase),
             distance,
             speed_mps,
             end,
@@ -305,10 +299,6 @@ impl<M: Motion> BackOff<M> {
 }
 
 impl<M: Motion> Behavior<M> for BackOff<M> {
-    fn name(&self) -> &str {
-        &self.leg.name
-    }
-
     fn enter(&mut self, m: &mut M, inputs: &Inputs<'_>) {
         self.leg.enter(m, inputs);
         self.mark = m.odo();
@@ -341,7 +331,6 @@ impl<M: Motion> Behavior<M> for BackOff<M> {
 /// reached exactly), slowing so as not to overshoot in one tick. Ends with `abeam`, or
 /// with `arrived` once within `arrive_m` of the point.
 pub struct DriveAbeam<M> {
-    name: String,
     phase: &'static str,
     target: TargetFn<M>,
     speed_mps: f64,
@@ -351,10 +340,9 @@ pub struct DriveAbeam<M> {
 }
 
 impl<M: Motion> DriveAbeam<M> {
-    /// A leaf named `name` (feedback `phase`) driving at up to `speed_mps` (the loop
-    /// ticks every `tick_s`) toward the point `target` reads (`None`: stand still).
+    /// A leaf (feedback `phase`) driving at up to `speed_mps` (the loop ticks every
+    /// `tick_s`) toward the point `target` reads (`None`: stand still).
     pub fn new(
-        name: &str,
         phase: &'static str,
         target: TargetFn<M>,
         speed_mps: f64,
@@ -363,7 +351,6 @@ impl<M: Motion> DriveAbeam<M> {
         abeam_m: f64,
     ) -> Self {
         Self {
-            name: name.into(),
             phase,
             target,
             speed_mps,
@@ -375,10 +362,6 @@ impl<M: Motion> DriveAbeam<M> {
 }
 
 impl<M: Motion> Behavior<M> for DriveAbeam<M> {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn tick(&mut self, m: &mut M, _inputs: &Inputs<'_>) -> Option<Step> {
         let Some(target) = (self.target)(m) else {
             return Some(m.hold(self.phase));

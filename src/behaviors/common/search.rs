@@ -79,7 +79,6 @@ pub struct SearchParams {
 
 /// The search leaf (see the module docs).
 pub struct Search<M, W = ()> {
-    name: String,
     phase: &'static str,
     params: SearchParams,
     watch: W,
@@ -90,11 +89,9 @@ pub struct Search<M, W = ()> {
 }
 
 impl<M: Searching, W: SearchWatch<M>> Search<M, W> {
-    /// A leaf named `name` (feedback `phase`) searching by `params`, stopped early by
-    /// `watch`.
-    pub fn new(name: &str, phase: &'static str, params: SearchParams, watch: W) -> Self {
+    /// A leaf (feedback `phase`) searching by `params`, stopped early by `watch`.
+    pub fn new(phase: &'static str, params: SearchParams, watch: W) -> Self {
         Self {
-            name: name.into(),
             phase,
             params,
             watch,
@@ -114,10 +111,6 @@ impl<M: Searching, W: SearchWatch<M>> Search<M, W> {
 }
 
 impl<M: Searching, W: SearchWatch<M>> Behavior<M> for Search<M, W> {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, m: &mut M, inputs: &Inputs<'_>) {
         (self.on_enter)(m);
         self.entered = inputs.now;

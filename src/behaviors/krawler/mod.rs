@@ -147,14 +147,14 @@ impl RobotKind for Krawler {
     fn leaves(&self, registry: &mut LeafRegistry<KrawlerMemory>) {
         registry
             .register("krawler.traverse", |_: &KrawlerMemory, a: &LeafArgs<'_>| {
-                Ok(Box::new(traverse::Traverse::new(a.node, a.params()?)?))
+                Ok(Box::new(traverse::Traverse::new(a.params()?)?))
             })
             .register("krawler.slip_monitor", |_: &KrawlerMemory, a: &LeafArgs<'_>| {
-                Ok(Box::new(slip::SlipMonitor::new(a.node, a.params()?)?))
+                Ok(Box::new(slip::SlipMonitor::new(a.params()?)?))
             })
             .register("krawler.halt", |_: &KrawlerMemory, a: &LeafArgs<'_>| {
                 a.no_params()?;
-                Ok(Box::new(traverse::Halt::new(a.node)))
+                Ok(Box::new(traverse::Halt))
             });
     }
 }

@@ -75,18 +75,17 @@ struct Window {
 
 /// `krawler.slip_monitor` (see the module docs).
 pub struct SlipMonitor {
-    name: String,
     params: SlipParams,
     window: Option<Window>,
     last_tick: Option<f64>,
 }
 
 impl SlipMonitor {
-    /// The monitor of node `name`.
+    /// The monitor with `params`.
     ///
     /// # Errors
     /// Names the field of a threshold, window or fraction out of range.
-    pub fn new(name: &str, params: SlipParams) -> Result<Self, String> {
+    pub fn new(params: SlipParams) -> Result<Self, String> {
         let p = &params;
         if !(p.threshold_rad.is_finite() && p.threshold_rad > 0.0) {
             return Err(format!(
@@ -107,7 +106,6 @@ impl SlipMonitor {
             ));
         }
         Ok(Self {
-            name: name.into(),
             params,
             window: None,
             last_tick: None,
@@ -121,10 +119,6 @@ fn mean_theta(m: &KrawlerMemory) -> f64 {
 }
 
 impl Behavior<KrawlerMemory> for SlipMonitor {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn reset(&mut self) {
         self.window = None;
         self.last_tick = None;

@@ -24,18 +24,17 @@ pub struct TraverseParams {
 
 /// `krawler.traverse` (see the module docs).
 pub struct Traverse {
-    name: String,
     params: TraverseParams,
     started: Option<f64>,
 }
 
 impl Traverse {
-    /// The leaf of node `name`.
+    /// The leaf with `params`.
     ///
     /// # Errors
     /// Names the field of a speed, rate or duration that is not a finite number (or a
     /// duration that is not positive).
-    pub fn new(name: &str, params: TraverseParams) -> Result<Self, String> {
+    pub fn new(params: TraverseParams) -> Result<Self, String> {
         if !params.speed_mps.is_finite() {
             return Err(format!(
                 "params.speed_mps: expected a number of m/s, got {}",
@@ -53,19 +52,11 @@ impl Traverse {
         {
             return Err(format!("params.duration_s: expected a positive number of s, got {d}"));
         }
-        Ok(Self {
-            name: name.into(),
-            params,
-            started: None,
-        })
+        Ok(Self { params, started: None })
     }
 }
 
 impl Behavior<KrawlerMemory> for Traverse {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn reset(&mut self) {
         self.started = None;
     }
@@ -90,22 +81,10 @@ impl Behavior<KrawlerMemory> for Traverse {
 }
 
 /// `krawler.halt` (see the module docs).
-pub struct Halt {
-    name: String,
-}
-
-impl Halt {
-    /// The leaf of node `name`.
-    pub fn new(name: &str) -> Self {
-        Self { name: name.into() }
-    }
-}
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Halt;
 
 impl Behavior<KrawlerMemory> for Halt {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn tick(&mut self, m: &mut KrawlerMemory, inputs: &Inputs<'_>) -> Option<Step> {
         m.commanded_rate = 0.0;
         Some(Step::done(

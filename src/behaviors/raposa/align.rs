@@ -9,22 +9,10 @@ use super::region2::{plan, robot_in_ball_frame};
 use crate::schemas::{Behavior, Inputs, Step};
 
 /// See the module docs.
-pub struct Align {
-    name: String,
-}
-
-impl Align {
-    /// A leaf named `name`.
-    pub fn new(name: &str) -> Self {
-        Self { name: name.into() }
-    }
-}
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Align;
 
 impl Behavior<Memory> for Align {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
     fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {

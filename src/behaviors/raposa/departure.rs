@@ -14,7 +14,6 @@ use crate::schemas::{Behavior, Inputs, Step};
 
 /// `raposa.depart`: see the module docs.
 pub struct Depart {
-    name: String,
     /// Where to stop, straight ahead of where the departure began: m along the body.
     travel: f64,
     /// Odometry where the departure began (odometry is not reset between missions: on
@@ -23,14 +22,13 @@ pub struct Depart {
 }
 
 impl Depart {
-    /// A leaf named `name`, its travel read from `mem` (the robot's memory at build time).
-    pub fn new(name: &str, mem: &Memory) -> Self {
+    /// The leaf, its travel read from `mem` (the robot's memory at build time).
+    pub fn new(mem: &Memory) -> Self {
         // Docked, the camera is `docked_distance` from the target (the ball at the socket,
         // or the flap over the pouch the robot sits in), and the body's forward direction
         // leads away from it.
         let travel = (mem.source.imprint_distance() - mem.docked_distance).max(0.0);
         Self {
-            name: name.into(),
             travel,
             from: Pose2::default(),
         }
@@ -38,10 +36,6 @@ impl Depart {
 }
 
 impl Behavior<Memory> for Depart {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         self.from = m.odo;
     }

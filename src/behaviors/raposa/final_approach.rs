@@ -14,7 +14,6 @@ use crate::schemas::{ArmPosition, Behavior, FailureReason, Inputs, Lights, Outco
 
 /// See the module docs.
 pub struct FinalApproach {
-    name: String,
     max_retries: u32,
     params: FinalParams,
     start: f64,
@@ -22,10 +21,9 @@ pub struct FinalApproach {
 }
 
 impl FinalApproach {
-    /// A leaf named `name`, failing after `max_retries` retries, with the default params.
-    pub fn new(name: &str, max_retries: u32) -> Self {
+    /// The leaf, failing after `max_retries` retries, with the default params.
+    pub fn new(max_retries: u32) -> Self {
         Self {
-            name: name.into(),
             max_retries,
             params: FinalParams::default(),
             start: 0.0,
@@ -42,10 +40,6 @@ impl FinalApproach {
 }
 
 impl Behavior<Memory> for FinalApproach {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         let dev = m.percept.view.map_or(0.0, |v| v.dev_px[1]);
         m.aux.set(ArmPosition(m.law.arm(dev)));

@@ -34,22 +34,10 @@ pub fn rotate_phi(m: &Memory) -> Aim {
 }
 
 /// `raposa.travel`: see the module docs.
-pub struct Travel {
-    name: String,
-}
-
-impl Travel {
-    /// A leaf named `name`.
-    pub fn new(name: &str) -> Self {
-        Self { name: name.into() }
-    }
-}
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Travel;
 
 impl Behavior<Memory> for Travel {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         look_away(m);
     }

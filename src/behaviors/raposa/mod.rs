@@ -78,33 +78,33 @@ pub fn register(registry: &mut Registry<Memory>) {
     registry
         .register("raposa.depart", |m: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(departure::Depart::new(a.node, m)))
+            Ok(Box::new(departure::Depart::new(m)))
         })
         .register("raposa.imprint", |m: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
             // The first frame after stopping is skipped (motion blur); the imprint's
             // result is the departure's.
             let frames = m.source.imprint_frames_wanted();
-            Ok(Box::new(Imprint::new(a.node, 1, frames, ImprintEnd::Outcome)))
+            Ok(Box::new(Imprint::new(1, frames, ImprintEnd::Outcome)))
         })
         .register("raposa.dock_switch", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(DockSwitch::new(a.node)))
+            Ok(Box::new(DockSwitch))
         })
         .register("raposa.approach", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(servo::Approach::new(a.node)))
+            Ok(Box::new(servo::Approach))
         })
         .register("raposa.align", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(align::Align::new(a.node)))
+            Ok(Box::new(align::Align))
         })
         .register("raposa.far_ellipse", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(servo::FarEllipse::new(a.node)))
+            Ok(Box::new(servo::FarEllipse))
         })
         .register("raposa.blue_only", |_: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(servo::BlueOnly::new(a.node, a.params()?)))
+            Ok(Box::new(servo::BlueOnly::new(a.params()?)))
         })
         .register("raposa.search", move |m: &Ctx, a: &LeafArgs<'_>| {
             let p: params::SearchParams = a.params()?;
@@ -113,11 +113,11 @@ pub fn register(registry: &mut Registry<Memory>) {
                 resume_clock: true,
                 ..slow_search(m, a)
             };
-            Ok(Box::new(Search::new(a.node, "state_5", search, ())))
+            Ok(Box::new(Search::new("state_5", search, ())))
         })
         .register("raposa.final", |_: &Ctx, a: &LeafArgs<'_>| {
             Ok(Box::new(
-                final_approach::FinalApproach::new(a.node, a.profile.behavior.max_retries).with_params(a.params()?),
+                final_approach::FinalApproach::new(a.profile.behavior.max_retries).with_params(a.params()?),
             ))
         })
         // The back-aways (latched): body forward for the backward camera at the far
@@ -134,18 +134,18 @@ pub fn register(registry: &mut Registry<Memory>) {
                 let socket = m.percept.view.map_or(0.0, |v| v.ball_distance_m - m.socket_inset);
                 (m.gains.dead_zone_exit_m - socket).max(p.min_distance_m)
             }));
-            Ok(Box::new(back_away(a.node, "leave_dead_zone", exit, m)))
+            Ok(Box::new(back_away("leave_dead_zone", exit, m)))
         })
         .register("raposa.probe", |_: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(probe::Probe::new(a.node, a.params()?)))
+            Ok(Box::new(probe::Probe::new(a.params()?)))
         })
         .register("raposa.retreat", |m: &Ctx, a: &LeafArgs<'_>| {
             let p: params::RetreatParams = a.params()?;
-            Ok(Box::new(back_away(a.node, "retreat", Distance::Fixed(p.distance_m), m)))
+            Ok(Box::new(back_away("retreat", Distance::Fixed(p.distance_m), m)))
         })
         .register("raposa.rotate_7", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(rotate7::Rotate7::new(a.node)))
+            Ok(Box::new(rotate7::Rotate7::default()))
         })
         .register("raposa.rotate_odo", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
@@ -155,12 +155,12 @@ pub fn register(registry: &mut Registry<Memory>) {
                 ..Hooks::default()
             };
             Ok(Box::new(
-                TurnTo::new(a.node, "state_2_rotate", aim, None, "rotated").hooks(hooks),
+                TurnTo::new("state_2_rotate", aim, None, "rotated").hooks(hooks),
             ))
         })
         .register("raposa.travel", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(manoeuvre::Travel::new(a.node)))
+            Ok(Box::new(manoeuvre::Travel))
         })
         .register("raposa.rotate_phi", |_: &Ctx, a: &LeafArgs<'_>| {
             a.no_params()?;
@@ -171,7 +171,7 @@ pub fn register(registry: &mut Registry<Memory>) {
                 ..Hooks::default()
             };
             Ok(Box::new(
-                TurnTo::new(a.node, "state_2_rotate_phi", aim, None, "facing").hooks(hooks),
+                TurnTo::new("state_2_rotate_phi", aim, None, "facing").hooks(hooks),
             ))
         })
         // After the region-II manoeuvre, which ends facing where the pyramid should be:
@@ -185,9 +185,7 @@ pub fn register(registry: &mut Registry<Memory>) {
                 ..slow_search(m, a)
             };
             let see_again = |m: &mut Ctx| m.blind = false;
-            Ok(Box::new(
-                Search::new(a.node, "state_2_look", look, ()).on_enter(see_again),
-            ))
+            Ok(Box::new(Search::new("state_2_look", look, ()).on_enter(see_again)))
         })
         .register_selector("raposa.seven_state", |_: &Ctx, a| {
             Ok(Box::new(selector::SevenState::new(a)?))
@@ -213,12 +211,12 @@ fn slow_search(m: &Memory, a: &LeafArgs<'_>) -> SearchParams {
 }
 
 /// A back-away leg at the far speed, ending with `cleared` and the tracking forgotten.
-fn back_away(node: &str, phase: &'static str, distance: Distance<Memory>, m: &Memory) -> BackOff<Memory> {
+fn back_away(phase: &'static str, distance: Distance<Memory>, m: &Memory) -> BackOff<Memory> {
     let forget = Hooks {
         end: |m: &mut Memory| m.source.reset(),
         ..Hooks::default()
     };
-    BackOff::new(node, phase, distance, m.gains.far_speed_mps, End::Event("cleared")).hooks(forget)
+    BackOff::new(phase, distance, m.gains.far_speed_mps, End::Event("cleared")).hooks(forget)
 }
 
 /// Builds RAPOSA's robot from a profile with a `pyramid` fiducial (or a

@@ -21,17 +21,13 @@ use crate::schemas::{Behavior, Inputs, Step};
 
 /// See the module docs.
 pub struct Probe {
-    name: String,
     params: ProbeParams,
 }
 
 impl Probe {
-    /// A leaf named `name`.
-    pub fn new(name: &str, params: ProbeParams) -> Self {
-        Self {
-            name: name.into(),
-            params,
-        }
+    /// The leaf with `params`.
+    pub fn new(params: ProbeParams) -> Self {
+        Self { params }
     }
 }
 
@@ -42,10 +38,6 @@ pub fn probe_angle(k: u32, step: f64) -> f64 {
 }
 
 impl Behavior<Memory> for Probe {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
     fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {

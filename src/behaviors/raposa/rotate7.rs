@@ -11,8 +11,8 @@ use crate::geometry::Pose2;
 use crate::schemas::{Behavior, Inputs, Step};
 
 /// See the module docs.
+#[derive(Debug, Clone, Copy, Default)]
 pub struct Rotate7 {
-    name: String,
     /// Angle turned so far toward −β, rad.
     rotated: f64,
     /// The ball's bearing in the last frame it was seen, rad.
@@ -23,24 +23,7 @@ pub struct Rotate7 {
     lost: u32,
 }
 
-impl Rotate7 {
-    /// A leaf named `name`.
-    pub fn new(name: &str) -> Self {
-        Self {
-            name: name.into(),
-            rotated: 0.0,
-            last_bearing: 0.0,
-            last_step: 0.0,
-            lost: 0,
-        }
-    }
-}
-
 impl Behavior<Memory> for Rotate7 {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     /// Starts from this tick's view (the one the plan was made from).
     fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         m.blind = false;

@@ -9,22 +9,10 @@ use crate::schemas::{Behavior, Inputs, Step};
 
 /// `raposa.approach`, state 1 (region I): the servo law on the ellipse, constant speed
 /// beyond `far_distance_m`, v = K_lin·√(A₁/A) closer, ω = −K_ang·x_dev.
-pub struct Approach {
-    name: String,
-}
-
-impl Approach {
-    /// A leaf named `name`.
-    pub fn new(name: &str) -> Self {
-        Self { name: name.into() }
-    }
-}
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Approach;
 
 impl Behavior<Memory> for Approach {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
     fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
@@ -34,22 +22,10 @@ impl Behavior<Memory> for Approach {
 
 /// `raposa.far_ellipse`, state 3: a lone ellipse far away, approached at the constant far
 /// speed until the blue edges join it (the paper does not say how).
-pub struct FarEllipse {
-    name: String,
-}
-
-impl FarEllipse {
-    /// A leaf named `name`.
-    pub fn new(name: &str) -> Self {
-        Self { name: name.into() }
-    }
-}
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FarEllipse;
 
 impl Behavior<Memory> for FarEllipse {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
     fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
@@ -61,25 +37,17 @@ impl Behavior<Memory> for FarEllipse {
 /// pyramid's own body): turn toward them, and creep at the final speed once they are
 /// within `centred_px` of the image centre.
 pub struct BlueOnly {
-    name: String,
     params: BlueOnlyParams,
 }
 
 impl BlueOnly {
-    /// A leaf named `name`.
-    pub fn new(name: &str, params: BlueOnlyParams) -> Self {
-        Self {
-            name: name.into(),
-            params,
-        }
+    /// The leaf with `params`.
+    pub fn new(params: BlueOnlyParams) -> Self {
+        Self { params }
     }
 }
 
 impl Behavior<Memory> for BlueOnly {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, _mem: &mut Memory, _inputs: &Inputs<'_>) {}
 
     fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
