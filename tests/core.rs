@@ -7,6 +7,7 @@
 mod common;
 
 mod arbiter;
+mod axel_cycle;
 mod bujold_phases;
 mod common_leaves;
 mod components_prop;

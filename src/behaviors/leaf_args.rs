@@ -13,6 +13,9 @@ pub struct LeafArgs<'a> {
     /// and traces name them, by it), so a factory need not hand it to the leaf; a leaf
     /// whose feedback names its node takes [`LeafArgs::phase`].
     pub node: &'a str,
+    /// The name of the node this leaf is a child of (the sequencer or arbiter it is a
+    /// state or child of); `None` at the top of what is built.
+    pub parent: Option<&'a str>,
     /// The node's `params` table.
     pub params: &'a toml::Table,
     /// The whole profile (geometry, limits, perception).
@@ -63,6 +66,13 @@ impl LeafArgs<'_> {
     /// (the legs of a manoeuvre) reports the node it runs as.
     pub fn phase(&self) -> &'static str {
         intern(self.node)
+    }
+
+    /// The phase a leg of a larger manoeuvre reports: its parent's name, interned as
+    /// [`LeafArgs::phase`] is (the node's own name at the top of what is built). Axel's
+    /// settle, look and step legs all report the sensing phase they are the cycle of.
+    pub fn parent_phase(&self) -> &'static str {
+        intern(self.parent.unwrap_or(self.node))
     }
 
     /// Refuses params for a schema that takes none.

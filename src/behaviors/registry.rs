@@ -152,7 +152,7 @@ impl<M: 'static> Registry<M> {
         check_devices("sensors", "sensor", sensors, &self.sensor_kinds, &mut problems);
         let actuators = profile.actuators.iter().map(|d| (&d.kind, &d.params));
         check_devices("actuators", "actuator", actuators, &self.actuator_kinds, &mut problems);
-        let root = self.node(tree, &tree.root, profile, memory, &mut problems, 0);
+        let root = self.node(tree, &tree.root, None, profile, memory, &mut problems, 0);
         match root {
             Some(r) if problems.is_empty() => Ok(r),
             _ => Err(profile.problems(problems)),
@@ -168,7 +168,7 @@ impl<M: 'static> Registry<M> {
     pub fn build_node(&self, profile: &Profile, name: &str, memory: &M) -> Result<Box<dyn Behavior<M>>, ConfigError> {
         let mut problems = Vec::new();
         let built = match &profile.behavior.tree {
-            Some(tree) => self.node(tree, name, profile, memory, &mut problems, 0),
+            Some(tree) => self.node(tree, name, None, profile, memory, &mut problems, 0),
             None => {
                 problems.push((
                     "behavior".into(),
@@ -183,10 +183,12 @@ impl<M: 'static> Registry<M> {
         }
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn node(
         &self,
         tree: &TreeSpec,
         name: &str,
+        parent: Option<&str>,
         profile: &Profile,
         memory: &M,
         problems: &mut Vec<(String, String)>,
@@ -204,7 +206,7 @@ impl<M: 'static> Registry<M> {
         let children = |problems: &mut Vec<(String, String)>| -> Vec<Option<Box<dyn Behavior<M>>>> {
             spec.children()
                 .iter()
-                .map(|c| self.node(tree, c, profile, memory, problems, depth + 1))
+                .map(|c| self.node(tree, c, Some(name), profile, memory, problems, depth + 1))
                 .collect()
         };
         match spec {
@@ -219,6 +221,7 @@ impl<M: 'static> Registry<M> {
                 };
                 let args = LeafArgs {
                     node: name,
+                    parent,
                     params,
                     profile,
                 };

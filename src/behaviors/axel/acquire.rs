@@ -25,11 +25,11 @@
 //! into it. A reel step restarts the search's clock: it is progress, and the steps
 //! end once the tether is within range.
 
-use super::cycle::{Cycle, CycleParams, Decision};
+use super::look::{Decision, Look};
 use super::memory::{Memory, Trust, ViewLimits};
 use crate::geometry::Pose2;
 use crate::kinematics::two_arc::{Arc, Polar};
-use crate::schemas::{Behavior, FailureReason, Inputs, Outcome, Step};
+use crate::schemas::{Behavior, Inputs, Step};
 use serde::Deserialize;
 
 /// `axel.acquire`'s params.
@@ -38,8 +38,8 @@ use serde::Deserialize;
 pub struct AcquireParams {
     /// Each turn between looks, degrees (below the cameras' 90° view, so views overlap).
     pub turn_deg: f64,
-    /// The sense-plan-act timing.
-    pub cycle: CycleParams,
+    /// Longest look for a trusted pose, s.
+    pub look_s: f64,
     /// What a pose must be to count as found.
     pub trust: Trust,
     /// Recovery steps (turn back, close in) from the last fix before sweeping.
@@ -62,7 +62,7 @@ impl Default for AcquireParams {
     fn default() -> Self {
         Self {
             turn_deg: 30.0,
-            cycle: CycleParams::default(),
+            look_s: 1.2,
             trust: Trust::default(),
             recover_steps: 3,
             step_m: 1.0,
@@ -111,26 +111,24 @@ pub fn recovery(at: &Pose2, near: f64, range: f64, step: f64) -> Option<Decision
     None
 }
 
-/// See the module docs.
+/// See the module docs: the look of the search's cycle (event `acquired` with a trusted
+/// pose). Its phase's clock ([`Memory::gave_up`]) is started by the phase's first
+/// `axel.settle` with `search = true`, and restarted here by each reel step.
 pub struct Acquire {
     name: String,
+    phase: &'static str,
     params: AcquireParams,
-    timeout_s: f64,
-    cycle: Cycle,
-    since: f64,
-    recovered: u32,
+    look: Look,
 }
 
 impl Acquire {
-    /// A leaf named `name` giving up after `timeout_s`.
-    pub fn new(name: &str, params: AcquireParams, timeout_s: f64) -> Self {
+    /// A leaf named `name` in phase `phase`.
+    pub fn new(name: &str, phase: &'static str, params: AcquireParams) -> Self {
         Self {
             name: name.into(),
+            phase,
             params,
-            timeout_s,
-            cycle: Cycle::new(params.cycle, params.trust),
-            since: 0.0,
-            recovered: 0,
+            look: Look::new(params.look_s, params.trust),
         }
     }
 }
@@ -140,33 +138,22 @@ impl Behavior<Memory> for Acquire {
         &self.name
     }
 
-    fn enter(&mut self, _mem: &mut Memory, inputs: &Inputs<'_>) {
-        self.since = inputs.now;
-        self.recovered = 0;
-        self.cycle.restart(inputs.now);
+    fn enter(&mut self, m: &mut Memory, inputs: &Inputs<'_>) {
+        self.look.enter(m, inputs.now);
     }
 
     fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
-        if m.now - self.since > self.timeout_s {
-            let why = if m.seen {
-                FailureReason::TargetLost
-            } else {
-                FailureReason::TargetNeverDetected
-            };
-            return Some(m.hold("acquire").finishing(Outcome::Failed(why)));
+        if let Some(end) = m.gave_up(self.phase) {
+            return Some(end);
         }
         let p = self.params;
-        let recovered = &mut self.recovered;
-        // A reel step is progress, not search: the search's clock restarts with it (the
-        // steps are bounded: each shortens the tether until it is within range).
-        let since = &mut self.since;
-        Some(self.cycle.tick(m, "acquire", |m, seen| match seen {
+        Some(self.look.tick(m, self.phase, |m, seen| match seen {
             Some(s) => {
                 m.search_sign = Polar::from_pose(&s.pose).bearing().signum();
                 Decision::Event("acquired")
             }
             None => {
-                let back = m.reckoned().filter(|_| *recovered < p.recover_steps).and_then(|at| {
+                let back = m.reckoned().filter(|_| m.looks.steps < p.recover_steps).and_then(|at| {
                     // Sweep on toward the side the module should lie on.
                     let b = Polar::from_pose(&at).bearing();
                     if b.abs() > 1e-3 {
@@ -180,11 +167,14 @@ impl Behavior<Memory> for Acquire {
                     .and_then(|f| reel_closer(f, p.view.range_m, p.step_m));
                 match (back, reel) {
                     (Some(d), _) => {
-                        *recovered += 1;
+                        m.looks.steps += 1;
                         d
                     }
+                    // A reel step is progress, not search: the search's clock restarts
+                    // with it (the steps are bounded: each shortens the tether until it
+                    // is within range).
                     (None, Some(length)) => {
-                        *since = m.now;
+                        m.looks.began = m.now;
                         Decision::Reel(length)
                     }
                     (None, None) => Decision::Turn(p.turn_deg.to_radians() * m.search_sign),

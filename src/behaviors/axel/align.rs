@@ -21,7 +21,7 @@
 //! trusted pose for `lost_looks` looks, to the acquisition (event `lost`).
 
 use super::approach::{one_step, spiral};
-use super::cycle::{Cycle, CycleParams, Decision};
+use super::look::{Decision, Look};
 use super::memory::{Memory, Sighting, Trust, ViewLimits};
 use crate::geometry::{Pose2, wrap_angle};
 use crate::kinematics::two_arc::{Arc, Polar, plan};
@@ -45,8 +45,8 @@ pub struct AlignParams {
     pub far_margin_m: f64,
     /// Looks without a trusted pose before the module counts as lost.
     pub lost_looks: u32,
-    /// The sense-plan-act timing.
-    pub cycle: CycleParams,
+    /// Longest look for a trusted pose, s.
+    pub look_s: f64,
     /// What a pose must be to be planned on.
     pub trust: Trust,
     /// Where every plan must keep the module: inside the view by a margin, within the
@@ -74,7 +74,7 @@ impl Default for AlignParams {
             reverse_m: 0.6,
             far_margin_m: 0.3,
             lost_looks: 3,
-            cycle: CycleParams::default(),
+            look_s: 1.2,
             trust: Trust::default(),
             view: ViewLimits::default(),
             spiral_beyond_m: 0.5,
@@ -85,23 +85,24 @@ impl Default for AlignParams {
 }
 
 /// See the module docs.
+///
+/// The steps driven to finish a plan inside the arrival circle since the rover last
+/// arrived there are the phase's [`Looks::steps`](super::look::Looks::steps).
 pub struct Align {
     name: String,
+    phase: &'static str,
     params: AlignParams,
-    cycle: Cycle,
-    /// Steps driven to finish a plan inside the arrival circle since the rover last
-    /// arrived there.
-    finishing: u32,
+    look: Look,
 }
 
 impl Align {
-    /// A leaf named `name`.
-    pub fn new(name: &str, params: AlignParams) -> Self {
+    /// A leaf named `name` in phase `phase`.
+    pub fn new(name: &str, phase: &'static str, params: AlignParams) -> Self {
         Self {
             name: name.into(),
+            phase,
             params,
-            cycle: Cycle::new(params.cycle, params.trust),
-            finishing: 0,
+            look: Look::new(params.look_s, params.trust),
         }
     }
 }
@@ -131,7 +132,7 @@ fn tip_at_mouth(pose: &Pose2, arm: f64) -> f64 {
     ty + tx / -c * s
 }
 
-fn decide(m: &mut Memory, p: &AlignParams, finishing: &mut u32, s: Sighting) -> Decision {
+fn decide(m: &mut Memory, p: &AlignParams, s: Sighting) -> Decision {
     let g = m.geometry;
     let polar = Polar::from_pose(&s.pose);
     if polar.r > g.regions.alignment_radius + p.far_margin_m {
@@ -156,10 +157,10 @@ fn decide(m: &mut Memory, p: &AlignParams, finishing: &mut u32, s: Sighting) -> 
     // Inside the arrival circle a plan is driven only to finish a turn (bounded); outside
     // it, the count starts over.
     let may_plan = if at_look {
-        *finishing += 1;
-        *finishing <= p.finish_steps
+        m.looks.steps += 1;
+        m.looks.steps <= p.finish_steps
     } else {
-        *finishing = 0;
+        m.looks.steps = 0;
         !past
     };
     let planned = if may_plan {
@@ -224,19 +225,20 @@ impl Behavior<Memory> for Align {
         &self.name
     }
 
-    fn enter(&mut self, _mem: &mut Memory, inputs: &Inputs<'_>) {
-        self.cycle.begin(inputs.now);
-        self.finishing = 0;
+    fn enter(&mut self, m: &mut Memory, inputs: &Inputs<'_>) {
+        self.look.enter(m, inputs.now);
     }
 
     fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
+        if let Some(end) = m.gave_up(self.phase) {
+            return Some(end);
+        }
         let p = self.params;
-        let finishing = &mut self.finishing;
-        Some(self.cycle.tick_seeing(
+        Some(self.look.tick_seeing(
             m,
-            "align",
+            self.phase,
             p.lost_looks,
-            |m, s| decide(m, &p, finishing, s),
+            |m, s| decide(m, &p, s),
             |m, s| past_unseen(m, &p, s),
         ))
     }
@@ -297,13 +299,13 @@ mod tests {
                 m.geometry.gate_lateral,
                 m.geometry.gate_heading
             ));
-            let mut finishing = 0;
+            m.looks.steps = 0;
             let mut pose = start;
             // Driving what it plans (exactly, as if no slip) brings it into the gate
             // within the budget, with no retry spent.
             let mut committed = false;
             for _ in 0..=p.finish_steps {
-                match decide(&mut m, &p, &mut finishing, stereo(pose)) {
+                match decide(&mut m, &p, stereo(pose)) {
                     Decision::Arc { arc, from } => pose = arc.end(&from),
                     Decision::Event("aligned") => {
                         committed = true;
@@ -317,15 +319,15 @@ mod tests {
         }
         // With the budget spent, a misaligned arrival reverses and spends a retry.
         let start = Pose2::new(look_x + 0.05, 0.0, PI + 7f64.to_radians());
-        let mut finishing = p.finish_steps;
-        match decide(&mut m, &p, &mut finishing, stereo(start)) {
+        m.looks.steps = p.finish_steps;
+        match decide(&mut m, &p, stereo(start)) {
             Decision::Arc { arc, .. } => assert_eq!((arc.curvature, arc.length), (0.0, -p.reverse_m)),
             d => panic!("expected a reverse, got {d:?}"),
         }
         assert_eq!(m.retries, 1);
         // Leaving the arrival circle starts the count over.
-        let _ = decide(&mut m, &p, &mut finishing, stereo(Pose2::new(look_x + 0.4, 0.0, PI)));
-        assert_eq!(finishing, 0);
+        let _ = decide(&mut m, &p, stereo(Pose2::new(look_x + 0.4, 0.0, PI)));
+        assert_eq!(m.looks.steps, 0);
     }
 
     #[test]

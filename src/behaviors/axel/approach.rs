@@ -8,7 +8,7 @@
 //! mating radius on the axis instead; when no plan keeps the module in view it spirals in
 //! toward the axis (the private `spiral`): the module held at a fixed bearing, straight steps.
 
-use super::cycle::{Cycle, CycleParams, Decision};
+use super::look::{Decision, Look};
 use super::memory::{Memory, Trust, ViewLimits};
 use crate::geometry::{Pose2, wrap_angle};
 use crate::kinematics::two_arc::{Arc, PlanParams, Polar, Region, TwoArc, keeps_in_view, plan};
@@ -26,8 +26,8 @@ pub struct ApproachParams {
     pub inside_m: f64,
     /// Looks without a trusted pose before the module counts as lost.
     pub lost_looks: u32,
-    /// The sense-plan-act timing.
-    pub cycle: CycleParams,
+    /// Longest look for a trusted pose, s.
+    pub look_s: f64,
     /// What a pose must be to be planned on.
     pub trust: Trust,
     /// Where every plan must keep the module: inside the view by a margin, within the
@@ -43,7 +43,7 @@ impl Default for ApproachParams {
             step_m: 1.5,
             inside_m: 0.5,
             lost_looks: 3,
-            cycle: CycleParams::default(),
+            look_s: 1.2,
             trust: Trust::default(),
             view: ViewLimits::default(),
             spiral_deg: 30.0,
@@ -124,17 +124,19 @@ pub(super) fn spiral(pose: &Pose2, spiral: f64, step: f64, params: &PlanParams) 
 /// See the module docs.
 pub struct Approach {
     name: String,
+    phase: &'static str,
     params: ApproachParams,
-    cycle: Cycle,
+    look: Look,
 }
 
 impl Approach {
-    /// A leaf named `name`.
-    pub fn new(name: &str, params: ApproachParams) -> Self {
+    /// A leaf named `name` in phase `phase`.
+    pub fn new(name: &str, phase: &'static str, params: ApproachParams) -> Self {
         Self {
             name: name.into(),
+            phase,
             params,
-            cycle: Cycle::new(params.cycle, params.trust),
+            look: Look::new(params.look_s, params.trust),
         }
     }
 }
@@ -144,15 +146,18 @@ impl Behavior<Memory> for Approach {
         &self.name
     }
 
-    fn enter(&mut self, _mem: &mut Memory, inputs: &Inputs<'_>) {
-        self.cycle.begin(inputs.now);
+    fn enter(&mut self, m: &mut Memory, inputs: &Inputs<'_>) {
+        self.look.enter(m, inputs.now);
     }
 
     fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
+        if let Some(end) = m.gave_up(self.phase) {
+            return Some(end);
+        }
         let p = self.params;
-        Some(self.cycle.tick_seeing(
+        Some(self.look.tick_seeing(
             m,
-            "approach",
+            self.phase,
             p.lost_looks,
             |m, s| {
                 let g = m.geometry;

@@ -9,6 +9,8 @@
 //! quality figures. A schema trusts a sighting only by its quality ([`Trust`]).
 
 pub use super::geometry::Geometry;
+use super::legs::Motion;
+use super::look::Looks;
 use super::stereo::Perception;
 use super::tuning::AxelRobot;
 use crate::behaviors::composed::SharedMemory;
@@ -17,7 +19,8 @@ use crate::kinematics::two_arc::PlanParams;
 use crate::perception::circles::PoseSource;
 use crate::profile::Profile;
 use crate::schemas::{
-    AgentStats, DriveCommand, Feedback, Inputs, Mission, MissionError, MotorOutput, Step, TetherCommand, TetherReading,
+    AgentStats, DriveCommand, FailureReason, Feedback, Inputs, Mission, MissionError, MotorOutput, Outcome, Step,
+    TetherCommand, TetherReading,
 };
 use serde::Deserialize;
 
@@ -159,6 +162,10 @@ pub struct Memory {
     /// The last trusted sighting's module-frame pose and the odometry pose at it: where
     /// the module is believed to be once it is lost ([`Memory::reckoned`]).
     pub last_fix: Option<(Pose2, Pose2)>,
+    /// What the running phase's looks have counted.
+    pub looks: Looks,
+    /// The motion the last look decided, until `axel.step` takes it.
+    pub step: Option<Motion>,
 }
 
 impl Memory {
@@ -193,6 +200,8 @@ impl Memory {
             seen: false,
             commit: None,
             last_fix: None,
+            looks: Looks::new(0.0, f64::INFINITY),
+            step: None,
         })
     }
 
@@ -267,6 +276,21 @@ impl Memory {
         Some(dead_reckon(&at, &odo, &self.odo))
     }
 
+    /// The docking's end when the running phase's clock has run past its limit
+    /// ([`Looks::limit`]): `target_lost` when a trusted pose was seen this docking,
+    /// `target_never_detected` otherwise, stopped; `None` while time is left.
+    pub fn gave_up(&self, phase: &'static str) -> Option<Step> {
+        let overran = self.now - self.looks.began > self.looks.limit;
+        overran.then(|| {
+            let why = if self.seen {
+                FailureReason::TargetLost
+            } else {
+                FailureReason::TargetNeverDetected
+            };
+            self.hold(phase).finishing(Outcome::Failed(why))
+        })
+    }
+
     /// Feedback for `phase` with this docking's retries.
     pub fn feedback(&self, phase: &'static str) -> Feedback {
         Feedback {
@@ -311,6 +335,8 @@ impl SharedMemory for Memory {
         self.seen = false;
         self.commit = None;
         self.last_fix = None;
+        self.looks = Looks::new(0.0, f64::INFINITY);
+        self.step = None;
         Ok(())
     }
 
