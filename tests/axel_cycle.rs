@@ -140,7 +140,11 @@ fn looks_without_a_trusted_pose_are_counted_across_cycles_until_lost() {
     };
     // `lost_looks = 3` looks of up to look_s (1.2 s), each after a settle (0.6 s).
     assert_eq!(lost.0, "lost");
-    assert!(lost.1 > 3.0 * 1.8 - 1e-9 && lost.1 < 3.0 * 1.8 + 4.0 * DT, "lost at {}", lost.1);
+    assert!(
+        lost.1 > 3.0 * 1.8 - 1e-9 && lost.1 < 3.0 * 1.8 + 4.0 * DT,
+        "lost at {}",
+        lost.1
+    );
     assert_eq!(m.looks.unseen, 3);
     assert_eq!(m.arcs, 0);
 }
@@ -163,7 +167,11 @@ fn the_search_gives_up_on_its_clock_in_whichever_leg_is_running() {
             assert!(t < limit + 1.0, "{s:?} at {t}");
         };
         assert_eq!(end.0, Outcome::Failed(FailureReason::TargetNeverDetected));
-        assert!(end.1 > limit && end.1 <= limit + DT + 1e-9, "limit {limit}: failed at {}", end.1);
+        assert!(
+            end.1 > limit && end.1 <= limit + DT + 1e-9,
+            "limit {limit}: failed at {}",
+            end.1
+        );
     }
 }
 

@@ -152,7 +152,7 @@ impl<M: 'static> Registry<M> {
         check_devices("sensors", "sensor", sensors, &self.sensor_kinds, &mut problems);
         let actuators = profile.actuators.iter().map(|d| (&d.kind, &d.params));
         check_devices("actuators", "actuator", actuators, &self.actuator_kinds, &mut problems);
-        let root = self.node(tree, &tree.root, None, profile, memory, &mut problems, 0);
+        let root = self.node(tree, Site::top(&tree.root), profile, memory, &mut problems);
         match root {
             Some(r) if problems.is_empty() => Ok(r),
             _ => Err(profile.problems(problems)),
@@ -168,7 +168,7 @@ impl<M: 'static> Registry<M> {
     pub fn build_node(&self, profile: &Profile, name: &str, memory: &M) -> Result<Box<dyn Behavior<M>>, ConfigError> {
         let mut problems = Vec::new();
         let built = match &profile.behavior.tree {
-            Some(tree) => self.node(tree, name, None, profile, memory, &mut problems, 0),
+            Some(tree) => self.node(tree, Site::top(name), profile, memory, &mut problems),
             None => {
                 problems.push((
                     "behavior".into(),
@@ -183,17 +183,15 @@ impl<M: 'static> Registry<M> {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn node(
         &self,
         tree: &TreeSpec,
-        name: &str,
-        parent: Option<&str>,
+        at: Site<'_>,
         profile: &Profile,
         memory: &M,
         problems: &mut Vec<(String, String)>,
-        depth: usize,
     ) -> Option<Box<dyn Behavior<M>>> {
+        let Site { name, parent, depth } = at;
         let path = format!("behavior.tree.nodes.{name}");
         let Some(spec) = tree.nodes.get(name) else {
             problems.push((path, format!("no node named `{name}`")));
@@ -206,7 +204,14 @@ impl<M: 'static> Registry<M> {
         let children = |problems: &mut Vec<(String, String)>| -> Vec<Option<Box<dyn Behavior<M>>>> {
             spec.children()
                 .iter()
-                .map(|c| self.node(tree, c, Some(name), profile, memory, problems, depth + 1))
+                .map(|c| {
+                    let at = Site {
+                        name: c,
+                        parent: Some(name),
+                        depth: depth + 1,
+                    };
+                    self.node(tree, at, profile, memory, problems)
+                })
                 .collect()
         };
         match spec {
@@ -313,6 +318,26 @@ impl<M: 'static> Registry<M> {
                 }
                 Some(Box::new(seq))
             }
+        }
+    }
+}
+
+/// Where in the tree a node is being built: its name, the node it is a child of, and
+/// how deep (a tree that contains itself is refused past its node count).
+#[derive(Clone, Copy)]
+struct Site<'a> {
+    name: &'a str,
+    parent: Option<&'a str>,
+    depth: usize,
+}
+
+impl<'a> Site<'a> {
+    /// The top of what is built.
+    fn top(name: &'a str) -> Self {
+        Self {
+            name,
+            parent: None,
+            depth: 0,
         }
     }
 }

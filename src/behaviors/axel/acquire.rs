@@ -115,17 +115,15 @@ pub fn recovery(at: &Pose2, near: f64, range: f64, step: f64) -> Option<Decision
 /// pose). Its phase's clock ([`Memory::gave_up`]) is started by the phase's first
 /// `axel.settle` with `search = true`, and restarted here by each reel step.
 pub struct Acquire {
-    name: String,
     phase: &'static str,
     params: AcquireParams,
     look: Look,
 }
 
 impl Acquire {
-    /// A leaf named `name` in phase `phase`.
-    pub fn new(name: &str, phase: &'static str, params: AcquireParams) -> Self {
+    /// A leaf in phase `phase`.
+    pub fn new(phase: &'static str, params: AcquireParams) -> Self {
         Self {
-            name: name.into(),
             phase,
             params,
             look: Look::new(params.look_s, params.trust),
@@ -134,10 +132,6 @@ impl Acquire {
 }
 
 impl Behavior<Memory> for Acquire {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, m: &mut Memory, inputs: &Inputs<'_>) {
         self.look.enter(m, inputs.now);
     }

@@ -89,17 +89,15 @@ impl Default for AlignParams {
 /// The steps driven to finish a plan inside the arrival circle since the rover last
 /// arrived there are the phase's [`Looks::steps`](super::look::Looks::steps).
 pub struct Align {
-    name: String,
     phase: &'static str,
     params: AlignParams,
     look: Look,
 }
 
 impl Align {
-    /// A leaf named `name` in phase `phase`.
-    pub fn new(name: &str, phase: &'static str, params: AlignParams) -> Self {
+    /// A leaf in phase `phase`.
+    pub fn new(phase: &'static str, params: AlignParams) -> Self {
         Self {
-            name: name.into(),
             phase,
             params,
             look: Look::new(params.look_s, params.trust),
@@ -221,10 +219,6 @@ fn past_unseen(m: &mut Memory, p: &AlignParams, s: Sighting) -> Option<Decision>
 }
 
 impl Behavior<Memory> for Align {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, m: &mut Memory, inputs: &Inputs<'_>) {
         self.look.enter(m, inputs.now);
     }

@@ -123,17 +123,15 @@ pub(super) fn spiral(pose: &Pose2, spiral: f64, step: f64, params: &PlanParams) 
 
 /// See the module docs.
 pub struct Approach {
-    name: String,
     phase: &'static str,
     params: ApproachParams,
     look: Look,
 }
 
 impl Approach {
-    /// A leaf named `name` in phase `phase`.
-    pub fn new(name: &str, phase: &'static str, params: ApproachParams) -> Self {
+    /// A leaf in phase `phase`.
+    pub fn new(phase: &'static str, params: ApproachParams) -> Self {
         Self {
-            name: name.into(),
             phase,
             params,
             look: Look::new(params.look_s, params.trust),
@@ -142,10 +140,6 @@ impl Approach {
 }
 
 impl Behavior<Memory> for Approach {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, m: &mut Memory, inputs: &Inputs<'_>) {
         self.look.enter(m, inputs.now);
     }

@@ -70,7 +70,6 @@ impl Default for SettleParams {
 /// `axel.settle`: the base stopped, the reel taking up slack, for `settle_s`; then event
 /// `settled`.
 pub struct Settle {
-    name: String,
     phase: &'static str,
     settle_s: f64,
     /// The phase's time limit, s, set as it starts (`starts_phase`).
@@ -79,12 +78,11 @@ pub struct Settle {
 }
 
 impl Settle {
-    /// A leaf named `name` in phase `phase`, giving up after `search_timeout_s` when
+    /// A leaf in phase `phase`, giving up after `search_timeout_s` when
     /// `params` make it a search.
-    pub fn new(name: &str, phase: &'static str, params: SettleParams, search_timeout_s: f64) -> Self {
+    pub fn new(phase: &'static str, params: SettleParams, search_timeout_s: f64) -> Self {
         let limit = if params.search { search_timeout_s } else { f64::INFINITY };
         Self {
-            name: name.into(),
             phase,
             settle_s: params.settle_s,
             limit: params.starts_phase.then_some(limit),
@@ -94,10 +92,6 @@ impl Settle {
 }
 
 impl Behavior<Memory> for Settle {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, m: &mut Memory, inputs: &Inputs<'_>) {
         self.since = inputs.now;
         if let Some(limit) = self.limit {
@@ -122,27 +116,18 @@ impl Behavior<Memory> for Settle {
 /// it is entered) until odometry or the reel's reading says it is done; then event
 /// `done`, stopped. Entered with no motion decided, it ends at once.
 pub struct StepLeg {
-    name: String,
     phase: &'static str,
     motion: Option<Motion>,
 }
 
 impl StepLeg {
-    /// A leaf named `name` in phase `phase`.
-    pub fn new(name: &str, phase: &'static str) -> Self {
-        Self {
-            name: name.into(),
-            phase,
-            motion: None,
-        }
+    /// A leaf in phase `phase`.
+    pub fn new(phase: &'static str) -> Self {
+        Self { phase, motion: None }
     }
 }
 
 impl Behavior<Memory> for StepLeg {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         self.motion = m.step.take();
     }

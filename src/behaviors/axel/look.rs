@@ -192,7 +192,8 @@ fn start(m: &mut Memory, decision: Decision, phase: &'static str) -> Step {
                 left: angle.abs(),
                 last: m.odo.theta,
             });
-            m.drive(DriveCommand::Turn { omega }, m.take_up(), phase).with_event("step")
+            m.drive(DriveCommand::Turn { omega }, m.take_up(), phase)
+                .with_event("step")
         }
         Decision::Reel(length) => start_reel(m, length, phase),
         Decision::Event(e) => m.hold(phase).with_event(e),

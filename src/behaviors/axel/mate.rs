@@ -40,7 +40,6 @@ impl Default for MateParams {
 /// `axel.mate_close`: the blind drive (see the module docs); event `closed` with the tip
 /// at the standoff, or the docking failed without a committed pose to mate from.
 pub struct Close {
-    name: String,
     params: MateParams,
     /// Path left to drive, m, and the odometry pose it was measured at.
     left: f64,
@@ -49,10 +48,9 @@ pub struct Close {
 }
 
 impl Close {
-    /// A leaf named `name`.
-    pub fn new(name: &str, params: MateParams) -> Self {
+    /// A leaf with `params`.
+    pub fn new(params: MateParams) -> Self {
         Self {
-            name: name.into(),
             params,
             left: 0.0,
             last: Pose2::default(),
@@ -62,10 +60,6 @@ impl Close {
 }
 
 impl Behavior<Memory> for Close {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         let g = m.geometry;
         let Some(at) = m.commit else {
@@ -106,25 +100,16 @@ impl Behavior<Memory> for Close {
 /// `robot.two_arc.reel_in_m` short of the exposed length with the tip at the mouth; then
 /// docked (see the module docs).
 pub struct Reel {
-    name: String,
     until: f64,
 }
 
-impl Reel {
-    /// A leaf named `name`.
-    pub fn new(name: &str) -> Self {
-        Self {
-            name: name.into(),
-            until: f64::INFINITY,
-        }
+impl Default for Reel {
+    fn default() -> Self {
+        Self { until: f64::INFINITY }
     }
 }
 
 impl Behavior<Memory> for Reel {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn enter(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) {
         // The exposed length with the tip at the mouth, less the reel-in.
         let g = m.geometry;

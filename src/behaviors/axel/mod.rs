@@ -51,35 +51,35 @@ pub use memory::Memory;
 pub fn register(registry: &mut Registry<Memory>) {
     registry
         .register("axel.acquire", |_: &Memory, a: &LeafArgs<'_>| {
-            Ok(Box::new(acquire::Acquire::new(a.node, a.parent_phase(), a.params()?)))
+            Ok(Box::new(acquire::Acquire::new(a.parent_phase(), a.params()?)))
         })
         .register("axel.approach", |_: &Memory, a: &LeafArgs<'_>| {
-            Ok(Box::new(approach::Approach::new(a.node, a.parent_phase(), a.params()?)))
+            Ok(Box::new(approach::Approach::new(a.parent_phase(), a.params()?)))
         })
         .register("axel.align", |_: &Memory, a: &LeafArgs<'_>| {
-            Ok(Box::new(align::Align::new(a.node, a.parent_phase(), a.params()?)))
+            Ok(Box::new(align::Align::new(a.parent_phase(), a.params()?)))
         })
         .register("axel.settle", |_: &Memory, a: &LeafArgs<'_>| {
             let timeout = a.profile.behavior.search_timeout_s;
-            Ok(Box::new(legs::Settle::new(a.node, a.parent_phase(), a.params()?, timeout)))
+            Ok(Box::new(legs::Settle::new(a.parent_phase(), a.params()?, timeout)))
         })
         .register("axel.step", |_: &Memory, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(legs::StepLeg::new(a.node, a.parent_phase())))
+            Ok(Box::new(legs::StepLeg::new(a.parent_phase())))
         })
         .register("axel.mate_close", |_: &Memory, a: &LeafArgs<'_>| {
-            Ok(Box::new(mate::Close::new(a.node, a.params()?)))
+            Ok(Box::new(mate::Close::new(a.params()?)))
         })
         .register("axel.mate_reel", |_: &Memory, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(mate::Reel::new(a.node)))
+            Ok(Box::new(mate::Reel::default()))
         })
         .register("axel.stall", |_: &Memory, a: &LeafArgs<'_>| {
-            Ok(Box::new(stall::Stall::new(a.node, a.params()?)))
+            Ok(Box::new(stall::Stall::new(a.params()?)))
         })
         .register("axel.reel", |_: &Memory, a: &LeafArgs<'_>| {
             a.no_params()?;
-            Ok(Box::new(reel::Reel::new(a.node)))
+            Ok(Box::new(reel::Reel))
         });
 }
 

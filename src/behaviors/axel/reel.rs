@@ -14,22 +14,9 @@ use super::memory::Memory;
 use crate::schemas::{Behavior, Inputs, Step};
 
 /// See the module docs.
-pub struct Reel {
-    name: String,
-}
-
-impl Reel {
-    /// A leaf named `name`.
-    pub fn new(name: &str) -> Self {
-        Self { name: name.into() }
-    }
-}
+pub struct Reel;
 
 impl Behavior<Memory> for Reel {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn tick(&mut self, m: &mut Memory, _inputs: &Inputs<'_>) -> Option<Step> {
         Some(m.free_reel("reel"))
     }

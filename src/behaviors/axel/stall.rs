@@ -32,27 +32,18 @@ impl Default for StallParams {
 
 /// See the module docs.
 pub struct Stall {
-    name: String,
     params: StallParams,
     since: Option<f64>,
 }
 
 impl Stall {
-    /// A leaf named `name`.
-    pub fn new(name: &str, params: StallParams) -> Self {
-        Self {
-            name: name.into(),
-            params,
-            since: None,
-        }
+    /// A guard with `params`.
+    pub fn new(params: StallParams) -> Self {
+        Self { params, since: None }
     }
 }
 
 impl Behavior<Memory> for Stall {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
     fn reset(&mut self) {
         self.since = None;
     }
