@@ -15,8 +15,9 @@
 //! build's `share/nav2_msgs/*/*.json`, whose type descriptions carry today's fields; and
 //! the messages those reference (`geometry_msgs/msg/PoseStamped`, `std_msgs/msg/Header`,
 //! `builtin_interfaces/msg/Time` and `Duration`, `unique_identifier_msgs/msg/UUID`,
-//! `service_msgs/msg/ServiceEventInfo`) from the same files. Computed only, by the same
-//! algorithm: `action_msgs/msg/GoalStatusArray` and `action_msgs/srv/CancelGoal`.
+//! `service_msgs/msg/ServiceEventInfo`) from the same files. Computed only (no published
+//! value found): `action_msgs/msg/GoalStatusArray` and `action_msgs/srv/CancelGoal`, which
+//! a second implementation of the algorithm, the Python peer's, computes alike.
 
 use super::type_hash::{Field, FieldType, TypeDescription, field, service_hash, time, type_hash};
 

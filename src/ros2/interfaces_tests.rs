@@ -163,3 +163,19 @@ fn every_interface_hashes() {
         assert!(i.hash.starts_with("RIHS01_") && i.hash.len() == 71, "{i:?}");
     }
 }
+
+/// Computed only (no published value was found): pinned so a change shows, and the same
+/// values come out of the Python peer's own implementation of REP-2011's hashing
+/// (`tests/peer/nav2_peer.py`, `type_hash`), whose cancel call the node answers only when
+/// they agree.
+#[test]
+fn action_msgs_hashes_are_pinned() {
+    assert_eq!(
+        cancel_goal().hash,
+        "RIHS01_573d8b0a534451d7bc2ac8c5ffde8ac14b8593b7001175d0cd6516dcbeb8689a"
+    );
+    assert_eq!(
+        goal_status_array().hash,
+        "RIHS01_6c1684b00f177d37438febe6e709fc4e2b0d4248dca4854946f9ed8b30cda83e"
+    );
+}

@@ -246,6 +246,18 @@ mod tests {
                 .starts_with("2/robot1/camera/image_raw/")
         );
         assert!(node("/robot1").key("/cmd_vel", &twist).starts_with("2/cmd_vel/"));
+        // Nav2's action and service, with the hashes a Nav2 build publishes.
+        let dock = interfaces::action(interfaces::DOCK_ROBOT);
+        assert_eq!(
+            node("").key("dock_robot/_action/send_goal", &dock.send_goal),
+            "2/dock_robot/_action/send_goal/nav2_msgs::action::dds_::DockRobot_SendGoal_/\
+             RIHS01_9e60155a1fb741109942c5c7dc21ae0e0db771eaf55d0cfc768bae57a95f3454"
+        );
+        assert_eq!(
+            node("/robot1").key("docking_server/reload_database", &interfaces::reload_dock_database()),
+            "2/robot1/docking_server/reload_database/nav2_msgs::srv::dds_::ReloadDockDatabase_/\
+             RIHS01_3fa9aa056bcc0dfcd10dbd1f61a215f600c82db832dccfdd98e55cf27ad502e6"
+        );
     }
 
     #[test]

@@ -13,10 +13,14 @@ Usage: nav2_peer.py LOCATOR DOMAIN DOCK_ID
   DOCK_ID  the dock to dock at
 
 It undocks (UndockRobot), waits, docks by dock_id (DockRobot), checking that feedback
-states come in a docking's order, then sends an unknown dock_id and checks
-DOCK_NOT_IN_DB with a message naming `dock_id`. Exit code 0 when every check holds.
+states come in a docking's order, sends an unknown dock_id and checks DOCK_NOT_IN_DB
+with a message naming `dock_id`, then starts an undocking and cancels it
+(`action_msgs/srv/CancelGoal`, whose hash it computes itself by REP-2011's rules, as
+`rosidl_generator_type_description` does: no published value was found for it). Exit
+code 0 when every check holds.
 """
 
+import hashlib
 import json
 import os
 import struct
@@ -34,10 +38,75 @@ HASH = {
     "UndockRobot_GetResult": "RIHS01_116641408dd0a5bbb7f0cb61d4519061884c7fcc70ca78b0f89779459cf04263",
 }
 
+
+
+def fld(name, type_id, nested="", capacity=0):
+    t = {"type_id": type_id, "capacity": capacity, "string_capacity": 0, "nested_type_name": nested}
+    return {"name": name, "type": t}
+
+
+def type_hash(top, library):
+    """REP-2011 (RIHS01): SHA-256 of the JSON of the type's description and every type it
+    reaches, sorted by name, default values left out."""
+    refs, queue = {}, [f["type"]["nested_type_name"] for f in top["fields"]]
+    while queue:
+        n = queue.pop()
+        if n and n not in refs:
+            refs[n] = library[n]
+            queue += [f["type"]["nested_type_name"] for f in library[n]["fields"]]
+    doc = {"type_description": top, "referenced_type_descriptions": [refs[k] for k in sorted(refs)]}
+    text = json.dumps(doc, separators=(", ", ": "))
+    return "RIHS01_" + hashlib.sha256(text.encode()).hexdigest()
+
+
+def cancel_goal_hash():
+    """`action_msgs/srv/CancelGoal`: request `GoalInfo goal_info`; response `int8
+    return_code`, `GoalInfo[] goals_canceling`; and the service's event message."""
+    NESTED, INT8, UINT8, INT32, UINT32, INT64, UINT8_ARRAY = 1, 2, 3, 6, 7, 8, 51
+    NESTED_BOUNDED, NESTED_SEQUENCE = 97, 145
+    srv = "action_msgs/srv/CancelGoal"
+    lib = {
+        "builtin_interfaces/msg/Time": [fld("sec", INT32), fld("nanosec", UINT32)],
+        "unique_identifier_msgs/msg/UUID": [fld("uuid", UINT8_ARRAY, capacity=16)],
+        "action_msgs/msg/GoalInfo": [
+            fld("goal_id", NESTED, "unique_identifier_msgs/msg/UUID"),
+            fld("stamp", NESTED, "builtin_interfaces/msg/Time"),
+        ],
+        "service_msgs/msg/ServiceEventInfo": [
+            fld("event_type", UINT8),
+            fld("stamp", NESTED, "builtin_interfaces/msg/Time"),
+            fld("client_gid", UINT8_ARRAY, capacity=16),
+            fld("sequence_number", INT64),
+        ],
+        srv + "_Request": [fld("goal_info", NESTED, "action_msgs/msg/GoalInfo")],
+        srv + "_Response": [
+            fld("return_code", INT8),
+            fld("goals_canceling", NESTED_SEQUENCE, "action_msgs/msg/GoalInfo"),
+        ],
+        srv + "_Event": [
+            fld("info", NESTED, "service_msgs/msg/ServiceEventInfo"),
+            fld("request", NESTED_BOUNDED, srv + "_Request", 1),
+            fld("response", NESTED_BOUNDED, srv + "_Response", 1),
+        ],
+    }
+    library = {k: {"type_name": k, "fields": v} for k, v in lib.items()}
+    top = {
+        "type_name": srv,
+        "fields": [
+            fld("request_message", NESTED, srv + "_Request"),
+            fld("response_message", NESTED, srv + "_Response"),
+            fld("event_message", NESTED, srv + "_Event"),
+        ],
+    }
+    return type_hash(top, library)
+
+
+HASH["CancelGoal"] = cancel_goal_hash()
+
 # DockRobot.action constants.
 NAV_TO_STAGING_POSE, INITIAL_PERCEPTION, CONTROLLING, WAIT_FOR_CHARGE, RETRY = 1, 2, 3, 4, 5
 DOCK_NOT_IN_DB = 901
-STATUS_SUCCEEDED, STATUS_ABORTED = 4, 6
+STATUS_SUCCEEDED, STATUS_CANCELED, STATUS_ABORTED = 4, 5, 6
 
 
 class Writer:
@@ -224,7 +293,21 @@ def main():
                 r,
             )
         )
-        print(f"peer: {time.time() - t0:.1f} s")
+        # A cancel stops an undocking: CancelGoal accepts (return code 0), the result is
+        # CANCELED.
+        gid = c.send("undock_robot", "UndockRobot", undock_goal(90.0))
+        time.sleep(1.0)
+        w = Writer()
+        w.raw(gid)
+        w.put("i", 0)
+        w.put("I", 0)
+        key = c.key("undock_robot/_action/cancel_goal", "CancelGoal", "action_msgs", "srv")
+        code = Reader(c.call(key, w.b, 5.0)).get("b")
+        r = c.result("undock_robot", "UndockRobot", gid, False, 20.0)
+        checks.append(
+            ("a cancel ends the undocking CANCELED", code == 0 and r["status"] == STATUS_CANCELED, (code, r))
+        )
+        print(f"peer: {time.time() - t0:.1f} s; CancelGoal hash computed here: {HASH['CancelGoal']}")
     ok = True
     for name, passed, detail in checks:
         print(f"{'ok  ' if passed else 'FAIL'} {name}: {detail}")
