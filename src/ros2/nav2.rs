@@ -56,9 +56,10 @@ pub mod error {
 ///   `reposition*`, RAPOSA's region-II plan `region_2`, `rotate_7`, `rotate_odo`,
 ///   `travel`, `rotate_phi`): `NAV_TO_STAGING_POSE`;
 /// * searching and looking (`search`, `unjam*`, `look`, `probe`, `leave_dead_zone`,
-///   Axel's `acquire`) and Bujold's `decide` (a look at the fiducial before backing in):
+///   Axel's `acquire`, whose cycle's legs `acquire_start`, `_look`, `_step` and
+///   `_settle` report it) and Bujold's `decide` (a look at the fiducial before backing in):
 ///   `INITIAL_PERCEPTION`;
-/// * servoing and the final entry (`approach*`, `avoid`, `back_in`, `servo`, `align`,
+/// * servoing and the final entry (`approach*`, `avoid`, `back_in`, `servo`, `align*`,
 ///   `far_ellipse`, `blue_only`, `final`, Axel's `mate*`): `CONTROLLING`;
 /// * the dock contact that subsumes every phase (`dock_switch`; Axel's `stall` guard):
 ///   `WAIT_FOR_CHARGE`;
@@ -90,14 +91,26 @@ pub const PHASE_STATES: &[(&str, u16)] = &[
     ("probe", state::INITIAL_PERCEPTION),
     ("leave_dead_zone", state::INITIAL_PERCEPTION),
     ("acquire", state::INITIAL_PERCEPTION),
+    ("acquire_start", state::INITIAL_PERCEPTION),
+    ("acquire_look", state::INITIAL_PERCEPTION),
+    ("acquire_step", state::INITIAL_PERCEPTION),
+    ("acquire_settle", state::INITIAL_PERCEPTION),
     ("decide", state::INITIAL_PERCEPTION),
     ("approach", state::CONTROLLING),
+    ("approach_start", state::CONTROLLING),
+    ("approach_look", state::CONTROLLING),
+    ("approach_step", state::CONTROLLING),
+    ("approach_settle", state::CONTROLLING),
     ("approach_field", state::CONTROLLING),
     ("approach_near", state::CONTROLLING),
     ("avoid", state::CONTROLLING),
     ("back_in", state::CONTROLLING),
     ("servo", state::CONTROLLING),
     ("align", state::CONTROLLING),
+    ("align_start", state::CONTROLLING),
+    ("align_look", state::CONTROLLING),
+    ("align_step", state::CONTROLLING),
+    ("align_settle", state::CONTROLLING),
     ("far_ellipse", state::CONTROLLING),
     ("blue_only", state::CONTROLLING),
     ("final", state::CONTROLLING),
