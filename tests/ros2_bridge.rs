@@ -1,7 +1,8 @@
 //! The ROS 2 bridge end to end, with the simulator as a second Zenoh participant: it
 //! publishes the rendered frames, odometry and the dock switch in `rmw_zenoh`'s keys and
 //! CDR, applies the `cmd_vel` and `posture` it receives (Bujold declares those), and
-//! calls the node's `undock_robot` and `dock_robot` actions.
+//! calls the node's `undock_robot` and `dock_robot` actions (Nav2's `UndockRobot` and
+//! `DockRobot`) and its `reload_database` service.
 //!
 //! Network: the node listens on `tcp/127.0.0.1:0` (a port the OS chooses) and the
 //! simulator connects to exactly that locator; multicast scouting is off on both.
@@ -9,243 +10,33 @@
 //! Everything runs on the wall clock (the threaded runtime and the simulator's physics in
 //! real time), so a docking takes about as long as the robot's.
 
-use marsupial::arbiter::runtime::StopHandle;
 use marsupial::behaviors::agent_for;
-use marsupial::msgs::cdr::CdrReader;
-use marsupial::perception::RgbImage;
-use marsupial::robot::Camera;
 use marsupial::ros2::client::ActionClient;
-use marsupial::ros2::devices::command_of;
 use marsupial::ros2::interfaces;
-use marsupial::ros2::keys::{Attachment, NodeName, gid, now_ns};
-use marsupial::ros2::messages::{
-    DockGoal, Goal, GoalFeedback, Twist, UndockGoal, encode_image, encode_odometry, stamp,
-};
-use marsupial::ros2::node::encode_bool;
-use marsupial::ros2::{BridgeConfig, Ros2Node, zenoh_config};
-use marsupial::schemas::{DOCK_CONTACT_KIND, DeviceCommand, DeviceReading, DockContact, POSTURE_KIND, Posture};
+use marsupial::ros2::keys::NodeName;
+use marsupial::ros2::messages::Twist;
+use marsupial::ros2::nav2::{error, state};
+use marsupial::ros2::nav2_msgs::{DockFeedback, DockRobotGoal, Goal, UndockRobotGoal};
 
-/// Index of the profile's device of kind `kind` (the sim robot's devices are in profile order).
-fn device(kinds: &[String], kind: &str) -> usize {
-    kinds.iter().position(|k| k == kind).expect("the profile declares it")
-}
-use marsupial::sim::campaign::{self, Prepared};
-use marsupial::sim::robot::{SimCamera, SimDevices, SimRobot};
+use marsupial::sim::campaign::Prepared;
 use marsupial::sim::run::{Recording, docked_robot, run_one};
-use marsupial::sim::scenario::Scenario;
-use std::path::Path;
 use std::sync::{Arc, Mutex};
-use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 use zenoh::Wait;
 
-fn table1() -> Prepared {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/bujold-table1.toml");
-    campaign::prepare(Scenario::load(&path).unwrap()).unwrap()
-}
-
-/// A node for `prepared`'s robot, listening on a loopback port the OS chooses, in its own
-/// ROS domain (so tests running side by side never meet).
-fn node(prepared: &Prepared, domain: u32) -> (Ros2Node, NodeName, String) {
-    let profile = prepared.profile_for(&prepared.runs[0]);
-    let mut config = BridgeConfig::for_profile(&profile);
-    config.node.domain = domain;
-    config.listen = vec!["tcp/127.0.0.1:0".to_owned()];
-    config.connect = Vec::new();
-    let name = config.node.clone();
-    let node = Ros2Node::start(&profile, config).unwrap();
-    let locator = node
-        .locators()
-        .into_iter()
-        .find(|l| l.starts_with("tcp/127.0.0.1:"))
-        .expect("the node listens on loopback");
-    assert!(!locator.ends_with(":0"), "the OS chose a port: {locator}");
-    (node, name, locator)
-}
-
-/// A Zenoh session that connects to `locator` only.
-fn session(locator: &str) -> zenoh::Session {
-    zenoh::open(zenoh_config(&[], &[locator.to_owned()]).unwrap())
-        .wait()
-        .unwrap()
-}
-
-/// What the simulator does with a payload the node sent.
-type OnPayload = Box<dyn Fn(&[u8]) + Send + Sync>;
-
-/// The simulator's side of the wire.
-struct Simulator {
-    stop: StopHandle,
-    threads: Vec<JoinHandle<()>>,
-    _subs: Vec<zenoh::pubsub::Subscriber<()>>,
-    /// Frames published.
-    frames: Arc<Mutex<u64>>,
-}
-
-impl Simulator {
-    /// Publishes `sim`'s camera at the loop's rate and its odometry and dock switch at
-    /// 50 Hz, runs its physics in real time, and applies what the node commands. With
-    /// `camera_stops_after`, the camera falls silent after that many frames.
-    fn start(session: &zenoh::Session, node: &NodeName, sim: &SimRobot, camera_stops_after: Option<u64>) -> Self {
-        let stop = StopHandle::new();
-        let mut threads = Vec::new();
-        let frames = Arc::new(Mutex::new(0));
-        let mut robot = sim.robot(&SimDevices::default()).unwrap();
-        let kinds = sim.with(|s| s.profile().loop_config().devices);
-        let rate = sim.with(|s| s.profile().loop_.rate_hz);
-        let publisher = |name: &str, ty: &interfaces::Interface| {
-            let key = node.key(name, ty);
-            (session.declare_publisher(key.clone()).wait().unwrap(), gid(&key))
-        };
-        let put = |p: &zenoh::pubsub::Publisher<'static>, g: [u8; 16], seq: i64, buf: &[u8]| {
-            let att = Attachment {
-                sequence_number: seq,
-                source_timestamp: now_ns(),
-                gid: g,
-            };
-            // A put after the test closed the session fails, and does not matter.
-            let _ = p.put(buf.to_vec()).attachment(att.encode()).wait();
-        };
-
-        // Physics on the wall clock.
-        {
-            let (sim, stop) = (sim.clone(), stop.clone());
-            threads.push(std::thread::spawn(move || {
-                while !stop.is_stopped() {
-                    if sim.run_physics(|| stop.is_stopped()).is_some() {
-                        // Docked or caught: hold until the test places the robot again.
-                        std::thread::sleep(Duration::from_millis(20));
-                    }
-                }
-            }));
-        }
-        // The camera, rendered at the loop's rate.
-        {
-            let (image, g) = publisher("camera/image_raw", &interfaces::image());
-            let mut camera = SimCamera::new(sim.clone(), 0);
-            let (stop, frames) = (stop.clone(), frames.clone());
-            threads.push(std::thread::spawn(move || {
-                let (w, h) = camera.resolution();
-                let mut frame = RgbImage::new(w, h);
-                let mut buf = Vec::new();
-                let period = Duration::from_secs_f64(1.0 / rate);
-                let mut next = Instant::now();
-                let mut n = 0;
-                while !stop.is_stopped() {
-                    if camera_stops_after.is_none_or(|k| n < k) && camera.capture(&mut frame).is_ok() {
-                        encode_image(
-                            &mut buf,
-                            stamp(now_ns()),
-                            "camera",
-                            w as u32,
-                            h as u32,
-                            frame.as_bytes(),
-                        );
-                        n += 1;
-                        put(&image, g, n as i64, &buf);
-                        *frames.lock().unwrap() = n;
-                    }
-                    next += period;
-                    if let Some(d) = next.checked_duration_since(Instant::now()) {
-                        std::thread::sleep(d);
-                    }
-                }
-            }));
-        }
-        // Odometry and the dock switch.
-        {
-            let (odom, go) = publisher("odom", &interfaces::odometry());
-            let (switch, gs) = publisher("dock_contact", &interfaces::message("std_msgs/msg/Bool"));
-            let mut odometer = robot.odometer.take().unwrap();
-            let mut plates = robot.sensors.swap_remove(device(&kinds.sensors, DOCK_CONTACT_KIND));
-            let stop = stop.clone();
-            threads.push(std::thread::spawn(move || {
-                let mut buf = Vec::new();
-                let mut seq = 0;
-                while !stop.is_stopped() {
-                    seq += 1;
-                    if let Ok(o) = odometer.read() {
-                        encode_odometry(&mut buf, stamp(now_ns()), o.pose, o.twist.v, o.twist.omega);
-                        put(&odom, go, seq, &buf);
-                    }
-                    let mut v = Vec::new();
-                    if let Some(c) = plates.read(&mut v).ok().and_then(|()| DockContact::decode(&v)) {
-                        put(&switch, gs, seq, &encode_bool(c.0));
-                    }
-                    std::thread::sleep(Duration::from_millis(20));
-                }
-            }));
-        }
-        // What the node commands.
-        let drive = Arc::new(Mutex::new(robot.drive));
-        // Bujold's actuators: her posture (she has no guides: the node publishes none).
-        let posture = robot.actuators.swap_remove(device(&kinds.actuators, POSTURE_KIND));
-        let posture = Arc::new(Mutex::new(posture));
-        let subscribe = |name: &str, ty: &interfaces::Interface, f: OnPayload| {
-            session
-                .declare_subscriber(node.key(name, ty))
-                .callback(move |s| f(&s.payload().to_bytes()))
-                .wait()
-                .unwrap()
-        };
-        let string = interfaces::message("std_msgs/msg/String");
-        let text = |b: &[u8]| CdrReader::new(b).and_then(|mut r| r.string("data").map(str::to_owned));
-        let subs = vec![
-            subscribe(
-                "cmd_vel",
-                &interfaces::twist(),
-                Box::new(move |b| {
-                    let t = Twist::decode(b).expect("cmd_vel decodes");
-                    drive.lock().unwrap().apply(&command_of(t)).unwrap();
-                }),
-            ),
-            subscribe(
-                "posture",
-                &string,
-                Box::new(move |b| {
-                    let p = match text(b).unwrap().as_str() {
-                        "lowered" => Posture::Lowered,
-                        _ => Posture::Raised,
-                    };
-                    posture.lock().unwrap().apply(p.encode().values()).unwrap();
-                }),
-            ),
-        ];
-        Self {
-            stop,
-            threads,
-            _subs: subs,
-            frames,
-        }
-    }
-
-    fn end(self) {
-        self.stop.stop();
-        for t in self.threads {
-            t.join().unwrap();
-        }
-    }
-}
-
-/// Sends `goal`, retrying while the simulator's session is still connecting.
-fn send(client: &ActionClient, goal: &Goal) -> [u8; 16] {
-    let deadline = Instant::now() + Duration::from_secs(20);
-    loop {
-        match client.send(goal, Duration::from_secs(2)) {
-            Ok(id) => return id,
-            Err(e) if Instant::now() < deadline => {
-                eprintln!("retrying the goal: {e}");
-                std::thread::sleep(Duration::from_millis(200));
-            }
-            Err(e) => panic!("the node never took the goal: {e}"),
-        }
-    }
-}
+#[path = "ros2_bridge/calls.rs"]
+mod calls;
+#[path = "ros2_bridge/python_peer.rs"]
+mod python_peer;
+#[path = "ros2_bridge/simulator.rs"]
+mod simulator;
+use calls::{dock_at, node, send, session, table1, undock};
+use simulator::Simulator;
 
 /// Run `index` of Table I over the bridge: undock (imprinting on the way out), be placed
-/// at the run's start, dock. Returns the docking's outcome and the phases its feedback
-/// named.
-fn dock_over_the_bridge(prepared: &Prepared, index: usize, domain: u32) -> (String, Vec<GoalFeedback>, bool) {
+/// at the run's start, dock by the profile's dock id. Returns the docking's `error_msg`
+/// (its typed outcome), the feedback it sent, and whether the plates closed.
+fn dock_over_the_bridge(prepared: &Prepared, index: usize, domain: u32) -> (String, Vec<DockFeedback>, bool) {
     let spec = &prepared.runs[index];
     let sim = docked_robot(prepared, spec);
     let (node, name, locator) = node(prepared, domain);
@@ -253,11 +44,11 @@ fn dock_over_the_bridge(prepared: &Prepared, index: usize, domain: u32) -> (Stri
     let simulator = Simulator::start(&sess, &name, &sim, None);
     let client = ActionClient::new(&sess, name.clone());
 
-    let undock = send(&client, &Goal::Undock(UndockGoal { max_time: 90.0 }));
-    let r = client.result(&undock, false, Duration::from_secs(120)).unwrap();
+    let out = send(&client, &undock());
+    let r = client.result(&out, false, Duration::from_secs(120)).unwrap();
     assert_eq!(
-        (r.outcome.as_str(), r.success, r.status),
-        ("completed", true, 4),
+        (r.error_msg.as_str(), r.success, r.status, r.error_code),
+        ("completed", true, 4, 0),
         "run {index}: {r:?}"
     );
 
@@ -265,23 +56,12 @@ fn dock_over_the_bridge(prepared: &Prepared, index: usize, domain: u32) -> (Stri
     sim.with(|s| s.place(spec.start.pose, false));
     let feedback = Arc::new(Mutex::new(Vec::new()));
     let seen = feedback.clone();
-    let _fb = client
-        .on_feedback(true, move |_, f| seen.lock().unwrap().push(f))
-        .unwrap();
-    let timeout = prepared.loaded.scenario.timeout_s as f32;
-    let dock = send(
-        &client,
-        &Goal::Dock(DockGoal {
-            dock_hint: None,
-            max_time: timeout,
-        }),
-    );
+    let _fb = client.on_feedback(move |_, f| seen.lock().unwrap().push(f)).unwrap();
+    let dock_id = prepared.profile_for(spec).name;
+    let dock = send(&client, &dock_at(&dock_id));
     // A second goal while one runs is rejected.
-    assert!(
-        client
-            .send(&Goal::Undock(UndockGoal::default()), Duration::from_secs(2))
-            .is_err()
-    );
+    assert!(client.send(&undock(), Duration::from_secs(2)).is_err());
+    let timeout = prepared.loaded.scenario.timeout_s as f32;
     let r = client
         .result(&dock, true, Duration::from_secs_f32(timeout + 30.0))
         .unwrap();
@@ -289,7 +69,7 @@ fn dock_over_the_bridge(prepared: &Prepared, index: usize, domain: u32) -> (Stri
     simulator.end();
     node.shutdown();
     let fb = feedback.lock().unwrap().clone();
-    (r.outcome, fb, docked)
+    (r.error_msg, fb, docked)
 }
 
 /// Held by every test that runs a simulated robot on the wall clock. One such robot, its
@@ -318,33 +98,50 @@ fn bujold_docks_over_the_bridge_from_three_starts_as_in_process() {
             "run {index} ({}): bridge {outcome} (plates closed: {docked}), in process {} after {:.1} s",
             spec.start.label, reference.outcome, reference.time_s
         );
-        // The phases the feedback named, each with the time it began (for a failure's log).
-        let mut trail: Vec<String> = Vec::new();
-        let mut last = "";
+        // The states the feedback named, each with the time it began (for a failure's log).
+        let mut trail: Vec<(u16, f64)> = Vec::new();
         for f in &feedback {
-            if f.phase != last {
-                last = &f.phase;
-                trail.push(format!("{:.1} s {last}", f.elapsed_ns as f64 * 1e-9));
+            if trail.last().is_none_or(|(s, _)| *s != f.state) {
+                trail.push((f.state, f.docking_time_ns as f64 * 1e-9));
             }
         }
-        eprintln!("run {index}: over the bridge {}", trail.join(", "));
+        eprintln!("run {index}: over the bridge, Nav2 states {trail:?}");
         assert_eq!(outcome, "docked", "run {index}");
         assert!(docked, "run {index}: the plates closed");
         assert_eq!(
             reference.outcome, outcome,
             "run {index}: the same outcome as in process"
         );
-        // Feedback named the docking's phases, with time running on.
+        // Feedback came in Nav2's states, in a docking's order, with time running on: it
+        // looks for the dock (or drives to the staging pose) before it controls onto it.
         assert!(feedback.len() >= 3, "run {index}: {} feedback messages", feedback.len());
-        assert!(feedback.windows(2).all(|w| w[0].elapsed_ns <= w[1].elapsed_ns));
-        let phases: std::collections::BTreeSet<&str> = feedback.iter().map(|f| f.phase.as_str()).collect();
-        assert!(phases.len() >= 2, "run {index}: phases {phases:?}");
+        assert!(
+            feedback
+                .windows(2)
+                .all(|w| w[0].docking_time_ns <= w[1].docking_time_ns)
+        );
+        assert!(
+            feedback.iter().all(|f| f.state <= state::RETRY),
+            "run {index}: {trail:?}"
+        );
+        let first = |s: u16| trail.iter().position(|(x, _)| *x == s);
+        let controlling = first(state::CONTROLLING).expect("it controlled onto the dock");
+        let started = trail.iter().find(|(s, _)| *s != state::NONE).map(|(s, _)| *s);
+        assert!(
+            matches!(started, Some(state::INITIAL_PERCEPTION | state::NAV_TO_STAGING_POSE)),
+            "run {index}: began with {started:?}: {trail:?}"
+        );
+        assert!(
+            first(state::INITIAL_PERCEPTION).is_none_or(|p| p < controlling),
+            "run {index}: perceived before controlling: {trail:?}"
+        );
     }
 }
 
 /// A camera that falls silent puts the robot in a safe stop (the runtime's staleness
-/// limit), reported in the feedback; a cancel then ends the goal `canceled`, the status
-/// topic follows it there, and the last command on `cmd_vel` is a stop.
+/// limit), reported in the feedback as Nav2's `NONE` state; a cancel then ends the goal
+/// `canceled`, the status topic follows it there (and a late subscriber still reads
+/// it), and the last command on `cmd_vel` is a stop.
 #[test]
 fn a_silent_camera_safe_stops_and_a_cancel_ends_the_goal() {
     let _one_at_a_time = real_time();
@@ -365,15 +162,13 @@ fn a_silent_camera_safe_stops_and_a_cancel_ends_the_goal() {
     let client = ActionClient::new(&sess, name.clone());
     let feedback = Arc::new(Mutex::new(Vec::new()));
     let fb = feedback.clone();
-    let _fb = client
-        .on_feedback(true, move |_, f| fb.lock().unwrap().push(f))
-        .unwrap();
+    let _fb = client.on_feedback(move |_, f| fb.lock().unwrap().push(f)).unwrap();
     let statuses = Arc::new(Mutex::new(Vec::new()));
     let st = statuses.clone();
     let _st = client
         .on_status(true, move |goals| st.lock().unwrap().push(goals))
         .unwrap();
-    let id = send(&client, &Goal::Dock(DockGoal::default()));
+    let id = send(&client, &dock_at(&prepared.profile_for(spec).name));
     // The behavior runs while frames come, then the camera falls silent and the safe stop
     // is reported.
     let deadline = Instant::now() + Duration::from_secs(20);
@@ -385,7 +180,7 @@ fn a_silent_camera_safe_stops_and_a_cancel_ends_the_goal() {
     let stopped = || {
         feedback.lock().unwrap()[silent_from..]
             .iter()
-            .any(|f| f.phase == "safe_stop")
+            .any(|f| f.state == state::NONE)
     };
     while !stopped() {
         assert!(
@@ -398,13 +193,13 @@ fn a_silent_camera_safe_stops_and_a_cancel_ends_the_goal() {
     assert!(
         feedback.lock().unwrap()[..silent_from]
             .iter()
-            .any(|f| f.phase != "safe_stop"),
+            .any(|f| f.state != state::NONE),
         "the behavior ran while frames came: {:?}",
         feedback.lock().unwrap()
     );
     assert_eq!(client.cancel(&id, true, Duration::from_secs(5)).unwrap(), 0);
     let r = client.result(&id, true, Duration::from_secs(10)).unwrap();
-    assert_eq!((r.status, r.success, r.outcome.as_str()), (5, false, "canceled"));
+    assert_eq!((r.status, r.success, r.error_msg.as_str()), (5, false, "canceled"));
     std::thread::sleep(Duration::from_millis(200));
     assert_eq!(
         *last_cmd.lock().unwrap(),
@@ -427,6 +222,12 @@ fn a_silent_camera_safe_stops_and_a_cancel_ends_the_goal() {
         at(2) < at(3) && at(3) < at(5) && at(2).is_some() && codes.last() == Some(&5),
         "status codes {codes:?}"
     );
+    // The status is transient-local: a subscriber joining now still reads the goal's end.
+    let late = client.latest_status(true, Duration::from_secs(5)).unwrap();
+    assert!(
+        late.is_some_and(|g| g.iter().any(|(g, _, c)| *g == id && *c == 5)),
+        "the cached status"
+    );
     // A finished goal cannot be canceled, and an unknown one has no result.
     assert_eq!(client.cancel(&id, true, Duration::from_secs(5)).unwrap(), 3);
     let unknown = client.result(&[7; 16], true, Duration::from_secs(5)).unwrap();
@@ -435,8 +236,8 @@ fn a_silent_camera_safe_stops_and_a_cancel_ends_the_goal() {
     node.shutdown();
 }
 
-/// The keys the node declares are the ones `rmw_zenoh` would use for the same names, and
-/// nothing answers outside its domain.
+/// The keys the node declares are the ones `rmw_zenoh` would use for the same names, its
+/// liveliness tokens carry each entity's QoS, and nothing answers outside its domain.
 #[test]
 fn the_node_answers_in_its_own_domain_only() {
     let prepared = table1();
@@ -448,14 +249,128 @@ fn the_node_answers_in_its_own_domain_only() {
         Vec::new(),
         "the client session listens on nothing"
     );
+    let tokens: Vec<String> = sess
+        .liveliness()
+        .get("@ros2_lv/61/**")
+        .timeout(Duration::from_secs(5))
+        .wait()
+        .unwrap()
+        .iter()
+        .filter_map(|r| r.result().ok().map(|s| s.key_expr().to_string()))
+        .collect();
+    let token = |part: &str| {
+        tokens
+            .iter()
+            .find(|t| t.contains(part))
+            .unwrap_or_else(|| panic!("no token with `{part}` in {tokens:#?}"))
+            .clone()
+    };
+    let dock = interfaces::action(interfaces::DOCK_ROBOT);
+    let status = token("/MP/%/%/docking_server/%dock_robot%_action%status/");
+    assert!(status.ends_with("/::,1:,:,:,,"), "transient-local, depth 1: {status}");
+    let send_goal = token("/SS/%/%/docking_server/%dock_robot%_action%send_goal/");
+    assert!(
+        send_goal.ends_with(&format!(
+            "/nav2_msgs::action::dds_::DockRobot_SendGoal_/{}/:2:,10:,:,:,,",
+            dock.send_goal.hash
+        )),
+        "{send_goal}"
+    );
+    let feedback = token("%dock_robot%_action%feedback/");
+    assert!(feedback.ends_with("/:2:,10:,:,:,,"), "{feedback}");
+    let reload = token("/SS/%/%/docking_server/%docking_server%reload_database/");
+    assert!(
+        reload.contains(&format!(
+            "/nav2_msgs::srv::dds_::ReloadDockDatabase_/{}/",
+            interfaces::reload_dock_database().hash
+        )),
+        "{reload}"
+    );
+    assert!(token("%undock_robot%_action%get_result/").contains("UndockRobot_GetResult_"));
     let other = NodeName {
         domain: 62,
         ..name.clone()
     };
     let stranger = ActionClient::new(&sess, other);
-    let err = stranger
-        .send(&Goal::Undock(UndockGoal::default()), Duration::from_millis(500))
-        .unwrap_err();
+    let err = stranger.send(&undock(), Duration::from_millis(500)).unwrap_err();
     assert!(err.to_string().contains("no answer"), "{err}");
+    node.shutdown();
+}
+
+/// Bad goals end at once with Nav2's error code and a message naming the field, and
+/// `reload_database` adds a file's docks (or refuses a malformed file, changing nothing).
+#[test]
+fn bad_goals_get_nav2_codes_and_reloads_read_the_file() {
+    let prepared = table1();
+    let (node, name, locator) = node(&prepared, 63);
+    let sess = session(&locator);
+    let client = ActionClient::new(&sess, name);
+    let unknown = send(&client, &dock_at("kitchen"));
+    let r = client.result(&unknown, true, Duration::from_secs(10)).unwrap();
+    assert_eq!(
+        (r.status, r.success, r.error_code),
+        (6, false, error::DOCK_NOT_IN_DB),
+        "{r:?}"
+    );
+    assert!(r.error_msg.contains("dock_id `kitchen`"), "{}", r.error_msg);
+    let mut by_pose = DockRobotGoal {
+        use_dock_id: false,
+        ..DockRobotGoal::default()
+    };
+    by_pose.dock_pose.frame_id = "map".into();
+    let id = send(&client, &Goal::Dock(by_pose));
+    let r = client.result(&id, true, Duration::from_secs(10)).unwrap();
+    assert_eq!(r.error_code, error::DOCK_NOT_VALID, "{r:?}");
+    assert!(
+        r.error_msg.contains("dock_pose.header.frame_id `map`"),
+        "{}",
+        r.error_msg
+    );
+    // The status topic's cache holds the aborted goal for a late subscriber.
+    let late = client.latest_status(true, Duration::from_secs(5)).unwrap();
+    assert!(late.is_some_and(|g| g.iter().any(|(g, _, c)| *g == id && *c == 6)));
+
+    let dir = std::env::temp_dir().join(format!("marsupial-ros2-docks-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = dir.join("docks.yaml");
+    std::fs::write(&good, "docks:\n  shed:\n    frame: map\n    pose: [4.0, 1.0, 0.0]\n").unwrap();
+    let bad = dir.join("bad.yaml");
+    std::fs::write(&bad, "docks:\n  barn:\n    pose: [4.0]\n").unwrap();
+    assert!(
+        client
+            .reload_docks(good.to_str().unwrap(), Duration::from_secs(5))
+            .unwrap()
+    );
+    assert!(
+        !client
+            .reload_docks(bad.to_str().unwrap(), Duration::from_secs(5))
+            .unwrap()
+    );
+    assert!(
+        !client
+            .reload_docks("/nonexistent/docks.yaml", Duration::from_secs(5))
+            .unwrap()
+    );
+    // `shed` is now known (but in a frame the node cannot resolve); `barn` never came.
+    let r = client
+        .result(&send(&client, &dock_at("shed")), true, Duration::from_secs(10))
+        .unwrap();
+    assert_eq!(r.error_code, error::DOCK_NOT_VALID, "{r:?}");
+    assert!(r.error_msg.contains("dock `shed`'s frame `map`"), "{}", r.error_msg);
+    let r = client
+        .result(&send(&client, &dock_at("barn")), true, Duration::from_secs(10))
+        .unwrap();
+    assert_eq!(r.error_code, error::DOCK_NOT_IN_DB, "{r:?}");
+    // An undocking of another dock type is not valid.
+    let other = Goal::Undock(UndockRobotGoal {
+        dock_type: "charger".into(),
+        ..UndockRobotGoal::default()
+    });
+    let r = client
+        .result(&send(&client, &other), false, Duration::from_secs(10))
+        .unwrap();
+    assert_eq!(r.error_code, error::DOCK_NOT_VALID, "{r:?}");
+    assert!(r.error_msg.contains("dock_type `charger`"), "{}", r.error_msg);
+    std::fs::remove_dir_all(&dir).unwrap();
     node.shutdown();
 }

@@ -134,9 +134,11 @@ enum Command {
     /// Speaks `rmw_zenoh`'s key expressions and CDR: subscribes to the camera image(s),
     /// odometry and the dock switch, publishes cmd_vel (and the posture, dock_guides and
     /// lights the profile declares),
-    /// and serves the actions dock_robot and undock_robot (marsupial_msgs/action/Dock and
-    /// Undock, after Nav2's DockRobot and UndockRobot). Multicast scouting is off: it
-    /// talks to the endpoints given and nothing else.
+    /// and serves Nav2's docking interface: the actions dock_robot
+    /// (nav2_msgs/action/DockRobot) and undock_robot (nav2_msgs/action/UndockRobot) and
+    /// the service reload_database (nav2_msgs/srv/ReloadDockDatabase); no ROS 2 package
+    /// of ours is needed to call them. Multicast scouting is off: it talks to the
+    /// endpoints given and nothing else.
     #[cfg(feature = "ros2")]
     Ros2(super::ros2::Ros2Options),
     /// Print the phase timeline of a run from its decision trace (`dock --trace`).

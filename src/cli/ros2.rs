@@ -22,8 +22,9 @@ pub struct Ros2Options {
     /// The node's namespace (`/robot1`).
     #[arg(long, default_value = "")]
     pub namespace: String,
-    /// The node's name.
-    #[arg(long, default_value = "marsupial")]
+    /// The node's name: Nav2's docking server is `docking_server`, whose
+    /// `reload_database` service clients then find where Nav2's is.
+    #[arg(long, default_value = "docking_server")]
     pub name: String,
     /// Zenoh endpoint to connect to: the `rmw_zenoh` router (`ros2 run rmw_zenoh_cpp
     /// rmw_zenohd`) listens on tcp/127.0.0.1:7447. Repeat for several; `none` for none.
@@ -48,6 +49,15 @@ pub struct Ros2Options {
     /// Velocity command topic (geometry_msgs/msg/Twist).
     #[arg(long, default_value = "cmd_vel")]
     pub cmd_vel_topic: String,
+    /// The odometry frame: the one frame a DockRobot goal's `dock_pose` (or a dock of the
+    /// database) may be in (the node has no transforms).
+    #[arg(long, default_value = "odom")]
+    pub odom_frame: String,
+    /// A dock database to read at start (Nav2's YAML shape: `docks:`, then per dock id its
+    /// `type`, `frame` and `pose: [x, y, yaw]`), beside the profile's own dock, whose id
+    /// is the profile's name.
+    #[arg(long, value_name = "FILE")]
+    pub dock_database: Option<PathBuf>,
     /// Stamp frames on arrival instead of trusting their header stamps (for cameras
     /// whose clock is not synchronised with this machine's).
     #[arg(long)]
@@ -125,6 +135,8 @@ pub fn config(opts: &Ros2Options, profile: &Profile) -> Result<BridgeConfig, Ros
     c.dock_contact = optional(&opts.dock_topic);
     c.cmd_vel = opts.cmd_vel_topic.clone();
     c.trust_stamps = !opts.stamp_on_arrival;
+    c.odom_frame = opts.odom_frame.clone();
+    c.dock_database = opts.dock_database.clone();
     Ok(c)
 }
 
@@ -159,9 +171,11 @@ pub fn run_with(
     )?;
     writeln!(
         out,
-        "actions: {} and {}",
+        "actions: {} (nav2_msgs/action/DockRobot, dock_id `{}`) and {} (UndockRobot); service {}",
         config.node.qualify("dock_robot"),
-        config.node.qualify("undock_robot")
+        profile.name,
+        config.node.qualify("undock_robot"),
+        config.node.qualify(&format!("{}/reload_database", config.node.name))
     )?;
     out.flush()?;
     match opts.run_for {
@@ -198,6 +212,11 @@ mod tests {
         assert_eq!(c.connect, ["tcp/127.0.0.1:7447"]);
         assert_eq!(c.cameras[0].topic, "camera/image_raw");
         assert_eq!((c.odometry.as_deref(), c.cmd_vel.as_str()), (Some("odom"), "cmd_vel"));
+        assert_eq!(
+            (c.node.name.as_str(), c.odom_frame.as_str()),
+            ("docking_server", "odom")
+        );
+        assert_eq!(c.dock_database, None);
     }
 
     #[test]

@@ -1,19 +1,27 @@
-//! Calling the node's actions from Rust, as `ros2 action send_goal` would: send a goal,
-//! follow its feedback, wait for its result, or cancel it. The tests use it; so can a
-//! mission planner written in Rust that shares the node's Zenoh network.
+//! Calling the node's Nav2 actions and its dock database service from Rust, as
+//! `ros2 action send_goal` and `ros2 service call` would: send a goal, follow its
+//! feedback and status, wait for its result, cancel it, reload the docks. The tests use
+//! it; so can a mission planner written in Rust that shares the node's Zenoh network.
 
 use super::interfaces::{self, ActionInterfaces};
 use super::keys::{Attachment, NodeName, gid, now_ns};
 use super::messages::{
-    Goal, GoalFeedback, GoalId, GoalResult, decode_cancel_response, decode_feedback, decode_result,
-    decode_send_goal_response, decode_status, encode_cancel_request, encode_goal_id, encode_send_goal,
+    GoalId, decode_cancel_response, decode_send_goal_response, decode_status, encode_cancel_request, encode_goal_id,
+};
+use super::nav2_msgs::{
+    DockFeedback, Goal, GoalResult, decode_feedback, decode_reload_response, decode_result, encode_reload_request,
+    encode_send_goal,
 };
 use crate::msgs::ros::Time;
 use std::sync::atomic::{AtomicI64, Ordering};
 use std::time::Duration;
 use thiserror::Error;
 use zenoh::Wait;
-use zenoh::query::QueryTarget;
+use zenoh::query::{QueryTarget, ReplyKeyExpr};
+
+/// One goal of a status message: its id, when it was accepted, its
+/// `action_msgs/msg/GoalStatus` code.
+pub type GoalStatus = (GoalId, Time, i8);
 
 /// Why a call did not get its answer.
 #[derive(Debug, Error)]
@@ -37,7 +45,8 @@ pub enum ClientError {
     Rejected,
 }
 
-/// A client of the node's `dock_robot` and `undock_robot` actions.
+/// A client of the node's `dock_robot` and `undock_robot` actions and its
+/// `reload_database` service.
 pub struct ActionClient {
     session: zenoh::Session,
     node: NodeName,
@@ -47,7 +56,7 @@ pub struct ActionClient {
 
 impl ActionClient {
     /// A client on `session` for the node whose names `node` gives (its domain and
-    /// namespace; the node's own name is not part of action keys).
+    /// namespace; the node's own name is only in `reload_database`'s key).
     pub fn new(session: &zenoh::Session, node: NodeName) -> Self {
         let gid = gid(&format!("client/{}/{}", session.zid(), now_ns()));
         Self {
@@ -60,9 +69,9 @@ impl ActionClient {
 
     fn names(goal_is_dock: bool) -> (&'static str, ActionInterfaces) {
         if goal_is_dock {
-            ("dock_robot", interfaces::action("marsupial_msgs/action/Dock"))
+            ("dock_robot", interfaces::action(interfaces::DOCK_ROBOT))
         } else {
-            ("undock_robot", interfaces::action("marsupial_msgs/action/Undock"))
+            ("undock_robot", interfaces::action(interfaces::UNDOCK_ROBOT))
         }
     }
 
@@ -148,17 +157,31 @@ impl ActionClient {
         })
     }
 
-    /// Calls `f` with each feedback message of the action (`dock`: docking) until the
-    /// returned subscriber is dropped.
+    /// Calls `ReloadDockDatabase` with `filepath`; returns its `success`.
+    ///
+    /// # Errors
+    /// [`ClientError`].
+    pub fn reload_docks(&self, filepath: &str, timeout: Duration) -> Result<bool, ClientError> {
+        let mut buf = Vec::new();
+        encode_reload_request(&mut buf, filepath);
+        let name = format!("{}/reload_database", self.node.name);
+        let answer = self.call(&name, &interfaces::reload_dock_database(), buf, timeout)?;
+        decode_reload_response(&answer).map_err(|e| ClientError::Malformed {
+            service: name,
+            why: e.to_string(),
+        })
+    }
+
+    /// Calls `f` with each `DockRobot` feedback message until the returned subscriber is
+    /// dropped (`UndockRobot`'s feedback is empty and never sent).
     ///
     /// # Errors
     /// [`ClientError::Zenoh`].
     pub fn on_feedback(
         &self,
-        dock: bool,
-        f: impl Fn(GoalId, GoalFeedback) + Send + Sync + 'static,
+        f: impl Fn(GoalId, DockFeedback) + Send + Sync + 'static,
     ) -> Result<zenoh::pubsub::Subscriber<()>, ClientError> {
-        let (action, ty) = Self::names(dock);
+        let (action, ty) = Self::names(true);
         self.session
             .declare_subscriber(self.node.key(&format!("{action}/_action/feedback"), &ty.feedback))
             .callback(move |s| {
@@ -179,7 +202,7 @@ impl ActionClient {
     pub fn on_status(
         &self,
         dock: bool,
-        f: impl Fn(Vec<(GoalId, Time, i8)>) + Send + Sync + 'static,
+        f: impl Fn(Vec<GoalStatus>) + Send + Sync + 'static,
     ) -> Result<zenoh::pubsub::Subscriber<()>, ClientError> {
         let (action, _) = Self::names(dock);
         self.session
@@ -194,5 +217,36 @@ impl ActionClient {
             })
             .wait()
             .map_err(|e| ClientError::Zenoh(e.to_string()))
+    }
+
+    /// The last status message of the action (`dock`: docking), as a transient-local
+    /// subscriber that joins late gets it: a query of `*/<status key>` that accepts
+    /// replies on any key, answered by the node's cache ([`super::latched`]). `None`
+    /// when nothing answered within `timeout`.
+    ///
+    /// # Errors
+    /// [`ClientError::Zenoh`].
+    pub fn latest_status(&self, dock: bool, timeout: Duration) -> Result<Option<Vec<GoalStatus>>, ClientError> {
+        let (action, _) = Self::names(dock);
+        let key = self
+            .node
+            .key(&format!("{action}/_action/status"), &interfaces::goal_status_array());
+        let replies = self
+            .session
+            .get(format!("*/{key}"))
+            .accept_replies(ReplyKeyExpr::Any)
+            .target(QueryTarget::All)
+            .timeout(timeout)
+            .wait()
+            .map_err(|e| ClientError::Zenoh(e.to_string()))?;
+        while let Ok(reply) = replies.recv() {
+            if let Ok(sample) = reply.result()
+                && sample.key_expr().as_str() == key
+                && let Ok(goals) = decode_status(&sample.payload().to_bytes())
+            {
+                return Ok(Some(goals));
+            }
+        }
+        Ok(None)
     }
 }

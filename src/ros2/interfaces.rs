@@ -2,11 +2,22 @@
 //! in `rmw_zenoh`'s key expressions) and their names as DDS spells them.
 //!
 //! Messages: `sensor_msgs/msg/Image`, `sensor_msgs/msg/CompressedImage`,
-//! `nav_msgs/msg/Odometry` (read) and `geometry_msgs/msg/Twist` (written). Requests: the
-//! actions `marsupial_msgs/action/Dock` and `marsupial_msgs/action/Undock`, modelled on
-//! Nav2's `DockRobot` and `UndockRobot` and shipped as a ROS 2 package in
-//! `ros2/marsupial_msgs` (build it in your workspace to call them from `ros2 action`), and
-//! `action_msgs`' cancel service and status topic, which every action has.
+//! `nav_msgs/msg/Odometry` (read) and `geometry_msgs/msg/Twist` (written). Requests:
+//! Nav2's own `nav2_msgs/action/DockRobot` and `nav2_msgs/action/UndockRobot` and the
+//! service `nav2_msgs/srv/ReloadDockDatabase`, so Nav2's behavior-tree nodes,
+//! `nav2_simple_commander` and `ros2 action send_goal` call the node with no package of
+//! ours built, and `action_msgs`' cancel service and status topic, which every action has.
+//!
+//! Which hashes were checked against a published value (the tests below): every Nav2
+//! docking hash (`DockRobot_SendGoal`, `_GetResult`, `_FeedbackMessage`, the three of
+//! `UndockRobot`, `ReloadDockDatabase`, and their goals, results and feedback), compared
+//! with the `hash_string`s `rosidl_generator_type_description` wrote into a public Nav2
+//! build's `share/nav2_msgs/*/*.json`, whose type descriptions carry today's fields; and
+//! the messages those reference (`geometry_msgs/msg/PoseStamped`, `std_msgs/msg/Header`,
+//! `builtin_interfaces/msg/Time` and `Duration`, `unique_identifier_msgs/msg/UUID`,
+//! `service_msgs/msg/ServiceEventInfo`) from the same files. Computed only (no published
+//! value found): `action_msgs/msg/GoalStatusArray` and `action_msgs/srv/CancelGoal`, which
+//! a second implementation of the algorithm, the Python peer's, computes alike.
 
 use super::type_hash::{Field, FieldType, TypeDescription, field, service_hash, time, type_hash};
 
@@ -58,7 +69,6 @@ fn library() -> Vec<TypeDescription> {
         TypeDescription::new("geometry_msgs/msg/Vector3", f64s(&["x", "y", "z"])),
         TypeDescription::new("geometry_msgs/msg/Point", f64s(&["x", "y", "z"])),
         TypeDescription::new("geometry_msgs/msg/Quaternion", f64s(&["x", "y", "z", "w"])),
-        TypeDescription::new("geometry_msgs/msg/Pose2D", f64s(&["x", "y", "theta"])),
         TypeDescription::new(
             "geometry_msgs/msg/Pose",
             vec![
@@ -102,46 +112,63 @@ fn library() -> Vec<TypeDescription> {
                 field("status", FieldType::I8),
             ],
         ),
-        // The two actions' own messages (ros2/marsupial_msgs/action/*.action).
         TypeDescription::new(
-            "marsupial_msgs/action/Dock_Goal",
+            "geometry_msgs/msg/PoseStamped",
             vec![
-                field("use_dock_hint", FieldType::Bool),
-                field("dock_hint", nested("geometry_msgs/msg/Pose2D")),
-                field("max_time", FieldType::F32),
+                field("header", nested("std_msgs/msg/Header")),
+                field("pose", nested("geometry_msgs/msg/Pose")),
             ],
         ),
-        TypeDescription::new("marsupial_msgs/action/Dock_Result", result_fields(true)),
-        TypeDescription::new("marsupial_msgs/action/Dock_Feedback", feedback_fields()),
+        // Nav2's docking actions (nav2_msgs/action/DockRobot.action, UndockRobot.action):
+        // fields in order; constants and default values are not hashed.
         TypeDescription::new(
-            "marsupial_msgs/action/Undock_Goal",
-            vec![field("max_time", FieldType::F32)],
+            "nav2_msgs/action/DockRobot_Goal",
+            vec![
+                field("use_dock_id", FieldType::Bool),
+                field("dock_id", FieldType::String),
+                field("dock_pose", nested("geometry_msgs/msg/PoseStamped")),
+                field("dock_type", FieldType::String),
+                field("max_staging_time", FieldType::F32),
+                field("navigate_to_staging_pose", FieldType::Bool),
+            ],
         ),
-        TypeDescription::new("marsupial_msgs/action/Undock_Result", result_fields(false)),
-        TypeDescription::new("marsupial_msgs/action/Undock_Feedback", feedback_fields()),
-    ]
-}
-
-/// A result: `bool success`, `uint16 error_code`, `string outcome`, and for docking
-/// `uint16 num_retries`.
-fn result_fields(retries: bool) -> Vec<Field> {
-    let mut f = vec![
-        field("success", FieldType::Bool),
-        field("error_code", FieldType::U16),
-        field("outcome", FieldType::String),
-    ];
-    if retries {
-        f.push(field("num_retries", FieldType::U16));
-    }
-    f
-}
-
-/// Feedback: `string phase`, `builtin_interfaces/Duration elapsed`, `uint16 num_retries`.
-fn feedback_fields() -> Vec<Field> {
-    vec![
-        field("phase", FieldType::String),
-        field("elapsed", nested("builtin_interfaces/msg/Duration")),
-        field("num_retries", FieldType::U16),
+        TypeDescription::new(
+            "nav2_msgs/action/DockRobot_Result",
+            vec![
+                field("success", FieldType::Bool),
+                field("error_code", FieldType::U16),
+                field("num_retries", FieldType::U16),
+                field("error_msg", FieldType::String),
+            ],
+        ),
+        TypeDescription::new(
+            "nav2_msgs/action/DockRobot_Feedback",
+            vec![
+                field("state", FieldType::U16),
+                field("docking_time", nested("builtin_interfaces/msg/Duration")),
+                field("num_retries", FieldType::U16),
+            ],
+        ),
+        TypeDescription::new(
+            "nav2_msgs/action/UndockRobot_Goal",
+            vec![
+                field("dock_type", FieldType::String),
+                field("max_undocking_time", FieldType::F32),
+            ],
+        ),
+        TypeDescription::new(
+            "nav2_msgs/action/UndockRobot_Result",
+            vec![
+                field("success", FieldType::Bool),
+                field("error_code", FieldType::U16),
+                field("error_msg", FieldType::String),
+            ],
+        ),
+        // An empty feedback: rosidl gives every empty structure this one member.
+        TypeDescription::new(
+            "nav2_msgs/action/UndockRobot_Feedback",
+            vec![field("structure_needs_at_least_one_member", FieldType::U8)],
+        ),
     ]
 }
 
@@ -238,7 +265,26 @@ pub fn cancel_goal() -> Interface {
     }
 }
 
-/// The interfaces of one action (`marsupial_msgs/action/Dock` or `…/Undock`).
+/// `nav2_msgs/srv/ReloadDockDatabase`: `string filepath` → `bool success`.
+pub fn reload_dock_database() -> Interface {
+    let name = "nav2_msgs/srv/ReloadDockDatabase";
+    Interface {
+        name: name.to_owned(),
+        hash: service_hash(
+            name,
+            vec![field("filepath", FieldType::String)],
+            vec![field("success", FieldType::Bool)],
+            &library(),
+        ),
+    }
+}
+
+/// `nav2_msgs/action/DockRobot`.
+pub const DOCK_ROBOT: &str = "nav2_msgs/action/DockRobot";
+/// `nav2_msgs/action/UndockRobot`.
+pub const UNDOCK_ROBOT: &str = "nav2_msgs/action/UndockRobot";
+
+/// The interfaces of one action (`nav2_msgs/action/DockRobot` or `…/UndockRobot`).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ActionInterfaces {
     /// `<action>_SendGoal`, a service.
@@ -300,109 +346,5 @@ fn with(top: TypeDescription) -> Interface {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn twist_keeps_the_hash_ros_2_prints() {
-        let t = twist();
-        assert_eq!(t.dds_name(), "geometry_msgs::msg::dds_::Twist_");
-        assert_eq!(
-            t.hash,
-            "RIHS01_9c45bf16fe0983d80e3cfe750d6835843d265a9a6c46bd2e609fcddde6fb8d2a"
-        );
-    }
-
-    #[test]
-    fn camera_and_odometry_keep_the_hashes_ros_2_prints() {
-        assert_eq!(
-            image().hash,
-            "RIHS01_d31d41a9a4c4bc8eae9be757b0beed306564f7526c88ea6a4588fb9582527d47"
-        );
-        assert_eq!(
-            odometry().hash,
-            "RIHS01_3cc97dc7fb7502f8714462c526d369e35b603cfc34d946e3f2eda2766dfec6e0"
-        );
-        assert_eq!(
-            message("std_msgs/msg/String").hash,
-            "RIHS01_df668c740482bbd48fb39d76a70dfd4bd59db1288021743503259e948f6b1a18"
-        );
-    }
-
-    #[test]
-    fn action_services_are_named_as_rosidl_names_them() {
-        let a = action("marsupial_msgs/action/Dock");
-        assert_eq!(a.send_goal.dds_name(), "marsupial_msgs::action::dds_::Dock_SendGoal_");
-        assert_eq!(a.get_result.dds_name(), "marsupial_msgs::action::dds_::Dock_GetResult_");
-        assert_eq!(
-            a.feedback.dds_name(),
-            "marsupial_msgs::action::dds_::Dock_FeedbackMessage_"
-        );
-        let u = action("marsupial_msgs/action/Undock");
-        assert_ne!(a.send_goal.hash, u.send_goal.hash);
-        assert_eq!(cancel_goal().dds_name(), "action_msgs::srv::dds_::CancelGoal_");
-    }
-
-    /// The fields of one part (goal, result or feedback) of a shipped `.action` file, as
-    /// `(type, name)`, constants and comments left out.
-    fn action_part(text: &str, part: usize) -> Vec<(String, String)> {
-        let section = text.split("\n---").nth(part).unwrap();
-        section
-            .lines()
-            .map(|l| l.split('#').next().unwrap().trim())
-            .filter(|l| !l.is_empty() && !l.contains('='))
-            .map(|l| {
-                let mut w = l.split_whitespace();
-                (w.next().unwrap().to_owned(), w.next().unwrap().to_owned())
-            })
-            .collect()
-    }
-
-    /// The `.action` spelling of a described field's type.
-    fn spelled(ty: &FieldType) -> String {
-        match ty {
-            FieldType::Bool => "bool".into(),
-            FieldType::F32 => "float32".into(),
-            FieldType::U16 => "uint16".into(),
-            FieldType::String => "string".into(),
-            FieldType::Nested(n) => n.replace("/msg/", "/"),
-            other => format!("{other:?}"),
-        }
-    }
-
-    #[test]
-    fn the_shipped_action_files_match_the_hashed_descriptions() {
-        let lib = library();
-        for (name, text) in [
-            ("Dock", include_str!("../../ros2/marsupial_msgs/action/Dock.action")),
-            ("Undock", include_str!("../../ros2/marsupial_msgs/action/Undock.action")),
-        ] {
-            for (part, suffix) in ["Goal", "Result", "Feedback"].iter().enumerate() {
-                let described = lib
-                    .iter()
-                    .find(|t| t.name == format!("marsupial_msgs/action/{name}_{suffix}"))
-                    .unwrap();
-                let got: Vec<(String, String)> = described
-                    .fields
-                    .iter()
-                    .map(|f| (spelled(&f.ty), f.name.to_owned()))
-                    .collect();
-                assert_eq!(action_part(text, part), got, "{name}_{suffix}");
-            }
-        }
-    }
-
-    #[test]
-    fn every_interface_hashes() {
-        for i in [
-            image(),
-            compressed_image(),
-            odometry(),
-            twist(),
-            goal_status_array(),
-            cancel_goal(),
-        ] {
-            assert!(i.hash.starts_with("RIHS01_") && i.hash.len() == 71, "{i:?}");
-        }
-    }
-}
+#[path = "interfaces_tests.rs"]
+mod tests;

@@ -8,13 +8,18 @@
 //! * A liveliness token is `@ros2_lv/<domain>/<session id>/<node id>/<entity id>/<kind>/
 //!   <enclave>/<namespace>/<node>[/<name>/<type>/<hash>/<qos>]`, each name mangled (`/`
 //!   becomes `%`, an empty one is `%`); kinds `NN` node, `MP` publisher, `MS`
-//!   subscription, `SS` service server.
+//!   subscription, `SS` service server, `SC` service client; the QoS part is
+//!   [`Qos::keyexpr`]. The session id is written as `rmw_zenoh`'s `zid_to_str` writes it
+//!   ([`zid_string`]).
+//! * An entity's GID is XXH3-128 of its liveliness token, the low 64 bits then the high
+//!   64 bits, each little-endian (`liveliness_utils.cpp`, `Entity::Entity`).
 //! * The attachment is 33 bytes: the sequence number (`int64`, little-endian), the source
 //!   timestamp (ns since the UNIX epoch, `int64`, little-endian), the GID's length (one
 //!   byte, 16) and the 16-byte GID. A service reply repeats the request's sequence number
 //!   and client GID.
 
 use super::interfaces::Interface;
+use super::qos::Qos;
 use std::sync::atomic::{AtomicI64, Ordering};
 use zenoh::Wait;
 use zenoh::pubsub::Publisher;
@@ -67,20 +72,38 @@ impl NodeName {
     }
 
     /// The liveliness token of entity number `entity` (1, 2 …) of kind `kind` (`MP`, `MS`,
-    /// `SS`) on `name`, with the default QoS.
-    pub fn entity_token(&self, session: &str, entity: u32, kind: &str, name: &str, ty: &Interface) -> String {
+    /// `SS`, `SC`) on `name`, with its QoS `qos`.
+    pub fn entity_token(
+        &self,
+        session: &str,
+        entity: u32,
+        kind: &str,
+        name: &str,
+        ty: &Interface,
+        qos: &Qos,
+    ) -> String {
         format!(
-            "{}/{}/{}/{}/{DEFAULT_QOS}",
+            "{}/{}/{}/{}/{}",
             self.token_prefix(session, entity, kind),
             mangle(&self.qualify(name)),
             ty.dds_name(),
-            ty.hash
+            ty.hash,
+            qos.keyexpr()
         )
     }
 }
 
-/// The QoS part of a token when every policy is `rmw_zenoh`'s default.
-const DEFAULT_QOS: &str = "::,:,:,:,,";
+/// A Zenoh session id as `rmw_zenoh` writes it in tokens (and as the prefix of a
+/// transient-local publisher's cache): the id's 16 little-endian bytes from the most
+/// significant down, each in lower-case hex *without* padding (`zid_to_str`), so a byte
+/// 0x0a is `a`. `le_bytes` is `ZenohId::to_le_bytes`.
+pub fn zid_string(le_bytes: [u8; 16]) -> String {
+    let mut s = String::with_capacity(32);
+    for b in le_bytes.iter().rev() {
+        s.push_str(&format!("{b:x}"));
+    }
+    s
+}
 
 /// `/` → `%`; the empty name is `%`.
 fn mangle(name: &str) -> String {
@@ -152,11 +175,23 @@ impl RmwPublisher {
     /// # Errors
     /// Zenoh's, as text.
     pub fn put(&self, payload: &[u8]) -> Result<(), String> {
-        let att = Attachment {
+        self.put_with(payload, &self.next_attachment())
+    }
+
+    /// The attachment of the next message: the sequence number counted on, now.
+    pub fn next_attachment(&self) -> Attachment {
+        Attachment {
             sequence_number: self.sequence.fetch_add(1, Ordering::Relaxed) + 1,
             source_timestamp: now_ns(),
             gid: self.gid,
-        };
+        }
+    }
+
+    /// Publishes `payload` with `att` (from [`RmwPublisher::next_attachment`]).
+    ///
+    /// # Errors
+    /// Zenoh's, as text.
+    pub fn put_with(&self, payload: &[u8], att: &Attachment) -> Result<(), String> {
         self.publisher
             .put(payload)
             .attachment(att.encode())
@@ -170,16 +205,12 @@ impl RmwPublisher {
     }
 }
 
-/// A GID for an entity: its liveliness token hashed (FNV-1a, 128 bits). `rmw_zenoh` uses
-/// XXH3 for the same purpose; a GID only has to be unique and stable, not equal to
-/// theirs.
+/// An entity's GID as `rmw_zenoh` makes it: XXH3-128 of its liveliness token, low 64
+/// bits first, each half little-endian, which is the hash's `u128` in little-endian.
+/// So the GID a ROS 2 tool reads for a publisher (`ros2 topic info --verbose`) and the
+/// one in its messages' attachments are the same as a `rmw_zenoh` node's would be.
 pub fn gid(token: &str) -> [u8; 16] {
-    let mut h: u128 = 0x6c62272e07bb014262b821756295c58d;
-    for b in token.bytes() {
-        h ^= u128::from(b);
-        h = h.wrapping_mul(0x0000000001000000000000000000013B);
-    }
-    h.to_le_bytes()
+    xxhash_rust::xxh3::xxh3_128(token.as_bytes()).to_le_bytes()
 }
 
 /// Now, ns since the UNIX epoch.
@@ -215,17 +246,52 @@ mod tests {
                 .starts_with("2/robot1/camera/image_raw/")
         );
         assert!(node("/robot1").key("/cmd_vel", &twist).starts_with("2/cmd_vel/"));
+        // Nav2's action and service, with the hashes a Nav2 build publishes.
+        let dock = interfaces::action(interfaces::DOCK_ROBOT);
+        assert_eq!(
+            node("").key("dock_robot/_action/send_goal", &dock.send_goal),
+            "2/dock_robot/_action/send_goal/nav2_msgs::action::dds_::DockRobot_SendGoal_/\
+             RIHS01_9e60155a1fb741109942c5c7dc21ae0e0db771eaf55d0cfc768bae57a95f3454"
+        );
+        assert_eq!(
+            node("/robot1").key("docking_server/reload_database", &interfaces::reload_dock_database()),
+            "2/robot1/docking_server/reload_database/nav2_msgs::srv::dds_::ReloadDockDatabase_/\
+             RIHS01_3fa9aa056bcc0dfcd10dbd1f61a215f600c82db832dccfdd98e55cf27ad502e6"
+        );
     }
 
     #[test]
     fn tokens_follow_rmw_zenoh() {
         let n = node("");
         assert_eq!(n.node_token("abc"), "@ros2_lv/2/abc/0/0/NN/%/%/marsupial");
-        let t = n.entity_token("abc", 3, "MS", "odom", &interfaces::odometry());
+        let t = n.entity_token("abc", 3, "MS", "odom", &interfaces::odometry(), &Qos::DEFAULT);
         assert!(t.starts_with("@ros2_lv/2/abc/0/3/MS/%/%/marsupial/%odom/nav_msgs::msg::dds_::Odometry_/RIHS01_"));
-        assert!(t.ends_with("/::,:,:,:,,"));
-        let r = node("/robot1").entity_token("abc", 1, "MP", "cmd_vel", &interfaces::twist());
+        assert!(t.ends_with("/:2:,10:,:,:,,"), "{t}");
+        let r = node("/robot1").entity_token("abc", 1, "MP", "cmd_vel", &interfaces::twist(), &Qos::DEFAULT);
         assert!(r.contains("/%robot1/marsupial/%robot1%cmd_vel/"));
+        let s = n.entity_token(
+            "abc",
+            4,
+            "MP",
+            "dock_robot/_action/status",
+            &interfaces::goal_status_array(),
+            &Qos::ACTION_STATUS,
+        );
+        assert!(
+            s.contains("/%dock_robot%_action%status/action_msgs::msg::dds_::GoalStatusArray_/RIHS01_"),
+            "{s}"
+        );
+        assert!(s.ends_with("/::,1:,:,:,,"), "{s}");
+    }
+
+    #[test]
+    fn session_ids_are_written_as_rmw_zenoh_writes_them() {
+        // Most significant byte first, each byte unpadded: 0x0a is `a`, 0x00 is `0`.
+        let mut le = [0u8; 16];
+        le[15] = 0x1f;
+        le[14] = 0x0a;
+        le[0] = 0x03;
+        assert_eq!(zid_string(le), format!("1fa{}3", "0".repeat(13)));
     }
 
     #[test]
@@ -245,9 +311,26 @@ mod tests {
         assert_eq!(Attachment::decode(&bad), None);
     }
 
+    /// The expected values are XXH3-128 of the same bytes by the reference C library
+    /// (xxHash 0.8.4, through PyPI's `xxhash` 4.1.0: `xxh3_128_hexdigest`, which prints the
+    /// high 64 bits first), one of them a status topic's full token (221 bytes:
+    /// XXH3's 129–240-byte path, where most tokens fall).
     #[test]
-    fn gids_differ_per_token() {
-        assert_ne!(gid("a"), gid("b"));
-        assert_eq!(gid("a"), gid("a"));
+    fn gids_are_xxh3_128_of_the_token_as_rmw_zenoh_makes_them() {
+        let le = |hex: &str| u128::from_str_radix(hex, 16).unwrap().to_le_bytes();
+        assert_eq!(gid(""), le("99aa06d3014798d86001c324468d497f"));
+        assert_eq!(gid("a"), le("a96faf705af16834e6c632b61e964e1f"));
+        assert_eq!(
+            gid("@ros2_lv/0/1a2b/0/0/NN/%/%/marsupial"),
+            le("ea394436cfb1cffcc387d67e73a143df")
+        );
+        let status = "@ros2_lv/0/a1b2c3d4e5f60718293a4b5c6d7e8f90/0/5/MP/%/%/docking_server/\
+            %dock_robot%_action%status/action_msgs::msg::dds_::GoalStatusArray_/\
+            RIHS01_6c1684b00f177d37438febe6e709fc4e2b0d4248dca4854946f9ed8b30cda83e/::,1:,:,:,,";
+        assert_eq!(status.len(), 221);
+        assert_eq!(gid(status), le("d959a502211a189294b6fbb87dd9d536"));
+        // Low half first: the first byte is the hash's least significant.
+        assert_eq!(gid("")[0], 0x7f);
+        assert_eq!(gid("")[8], 0xd8);
     }
 }

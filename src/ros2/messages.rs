@@ -1,8 +1,9 @@
 //! CDR payloads of the messages the bridge writes and reads, beyond the camera and
 //! odometry messages [`crate::msgs::cdr`] already decodes: `geometry_msgs/msg/Twist`,
 //! the encoders of `sensor_msgs/msg/Image` and `nav_msgs/msg/Odometry` (for a simulator
-//! or a test publishing to the node), and the action protocol's requests, replies and
-//! messages for `marsupial_msgs/action/Dock` and `…/Undock`.
+//! or a test publishing to the node), and the action protocol's own requests, replies and
+//! messages (`SendGoal`'s response, `GetResult`'s request, `CancelGoal`, the status
+//! topic). Nav2's goals, results and feedback are in [`super::nav2_msgs`].
 //!
 //! Every decoder is total: a short or malformed payload is a [`CdrError`], never a panic.
 
@@ -86,72 +87,6 @@ pub fn encode_odometry(buf: &mut Vec<u8>, t: Time, pose: Pose2, v: f64, omega: f
     }
 }
 
-/// What a docking goal asks (`marsupial_msgs/action/Dock_Goal`).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct DockGoal {
-    /// Where the dock is believed to be, in the odometry frame (`dock_hint` when
-    /// `use_dock_hint`).
-    pub dock_hint: Option<Pose2>,
-    /// Give up after this long, s; 0 for the profile's own limits only.
-    pub max_time: f32,
-}
-
-/// What an undocking goal asks (`marsupial_msgs/action/Undock_Goal`).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct UndockGoal {
-    /// Give up after this long, s; 0 for the profile's own limits only.
-    pub max_time: f32,
-}
-
-/// Either goal.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Goal {
-    /// Dock.
-    Dock(DockGoal),
-    /// Undock (the departure).
-    Undock(UndockGoal),
-}
-
-/// Reads a `SendGoal` request: the goal id, then the goal of the action `dock` says.
-///
-/// # Errors
-/// [`CdrError`] naming the field.
-pub fn decode_send_goal(buf: &[u8], dock: bool) -> Result<(GoalId, Goal), CdrError> {
-    let mut r = CdrReader::new(buf)?;
-    let id = r.fixed_bytes::<16>("goal_id")?;
-    let goal = if dock {
-        let use_hint = r.u8("goal.use_dock_hint")? != 0;
-        let [x, y, theta] = r.f64s::<3>("goal.dock_hint")?;
-        let max_time = r.f32("goal.max_time")?;
-        Goal::Dock(DockGoal {
-            dock_hint: use_hint.then_some(Pose2 { x, y, theta }),
-            max_time,
-        })
-    } else {
-        Goal::Undock(UndockGoal {
-            max_time: r.f32("goal.max_time")?,
-        })
-    };
-    Ok((id, goal))
-}
-
-/// Writes a `SendGoal` request (what a client sends).
-pub fn encode_send_goal(buf: &mut Vec<u8>, id: &GoalId, goal: &Goal) {
-    let mut w = CdrWriter::new(buf);
-    w.fixed_bytes(id);
-    match goal {
-        Goal::Dock(g) => {
-            w.u8(u8::from(g.dock_hint.is_some()));
-            let p = g.dock_hint.unwrap_or_default();
-            for v in [p.x, p.y, p.theta] {
-                w.f64(v);
-            }
-            w.f32(g.max_time);
-        }
-        Goal::Undock(g) => w.f32(g.max_time),
-    }
-}
-
 /// Writes a `SendGoal` response.
 pub fn encode_send_goal_response(buf: &mut Vec<u8>, accepted: bool, t: Time) {
     let mut w = CdrWriter::new(buf);
@@ -180,98 +115,6 @@ pub fn decode_goal_id(buf: &[u8]) -> Result<GoalId, CdrError> {
 /// Writes a request that is a goal id alone (`GetResult`).
 pub fn encode_goal_id(buf: &mut Vec<u8>, id: &GoalId) {
     CdrWriter::new(buf).fixed_bytes(id);
-}
-
-/// How a goal ended, as its result says it.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct GoalResult {
-    /// `action_msgs/msg/GoalStatus` code: 4 succeeded, 5 canceled, 6 aborted.
-    pub status: i8,
-    /// Docked, or undocked.
-    pub success: bool,
-    /// Nav2's `DockRobot` error code (0 on success).
-    pub error_code: u16,
-    /// The typed outcome: `docked`, `completed`, a failure reason (`target_lost` …), or
-    /// the runtime's (`aborted: camera 0 driver panicked …`, `canceled`, `timeout`).
-    pub outcome: String,
-    /// Retries used (docking only).
-    pub num_retries: u16,
-}
-
-/// Writes a `GetResult` response for the action `dock` says.
-pub fn encode_result(buf: &mut Vec<u8>, r: &GoalResult, dock: bool) {
-    let mut w = CdrWriter::new(buf);
-    w.u8(r.status as u8);
-    w.u8(u8::from(r.success));
-    w.u16(r.error_code);
-    w.string(&r.outcome);
-    if dock {
-        w.u16(r.num_retries);
-    }
-}
-
-/// Reads a `GetResult` response.
-///
-/// # Errors
-/// [`CdrError`] naming the field.
-pub fn decode_result(buf: &[u8], dock: bool) -> Result<GoalResult, CdrError> {
-    let mut r = CdrReader::new(buf)?;
-    let status = r.u8("status")? as i8;
-    let success = r.u8("result.success")? != 0;
-    let error_code = r.u16("result.error_code")?;
-    let outcome = r.string("result.outcome")?.to_owned();
-    let num_retries = if dock { r.u16("result.num_retries")? } else { 0 };
-    Ok(GoalResult {
-        status,
-        success,
-        error_code,
-        outcome,
-        num_retries,
-    })
-}
-
-/// A goal's progress (`<action>_Feedback`).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct GoalFeedback {
-    /// The active phase (`search`, `approach`, `back_in` …).
-    pub phase: String,
-    /// Since the goal started, ns.
-    pub elapsed_ns: i64,
-    /// Retries used so far.
-    pub num_retries: u16,
-}
-
-/// Writes a `FeedbackMessage`: the goal id and the feedback's phase, elapsed time (ns)
-/// and retries, borrowed, so the loop's feedback allocates nothing.
-pub fn encode_feedback(buf: &mut Vec<u8>, id: &GoalId, phase: &str, elapsed_ns: i64, num_retries: u16) {
-    let mut w = CdrWriter::new(buf);
-    w.fixed_bytes(id);
-    w.string(phase);
-    let d = stamp(elapsed_ns);
-    w.i32(d.sec);
-    w.u32(d.nanosec);
-    w.u16(num_retries);
-}
-
-/// Reads a `FeedbackMessage`.
-///
-/// # Errors
-/// [`CdrError`] naming the field.
-pub fn decode_feedback(buf: &[u8]) -> Result<(GoalId, GoalFeedback), CdrError> {
-    let mut r = CdrReader::new(buf)?;
-    let id = r.fixed_bytes::<16>("goal_id")?;
-    let phase = r.string("feedback.phase")?.to_owned();
-    let sec = r.i32("feedback.elapsed.sec")?;
-    let nanosec = r.u32("feedback.elapsed.nanosec")?;
-    let num_retries = r.u16("feedback.num_retries")?;
-    Ok((
-        id,
-        GoalFeedback {
-            phase,
-            elapsed_ns: i64::from(sec) * 1_000_000_000 + i64::from(nanosec),
-            num_retries,
-        },
-    ))
 }
 
 /// Writes an `action_msgs/msg/GoalStatusArray` of `(id, accepted at, status)`.
@@ -402,48 +245,18 @@ mod tests {
     }
 
     #[test]
-    fn goals_results_and_feedback_round_trip() {
+    fn the_action_protocols_own_messages_round_trip() {
         let id = [9u8; 16];
         let mut b = Vec::new();
-        let dock = Goal::Dock(DockGoal {
-            dock_hint: Some(Pose2 {
-                x: 1.0,
-                y: 2.0,
-                theta: 3.0,
-            }),
-            max_time: 60.0,
-        });
-        encode_send_goal(&mut b, &id, &dock);
-        assert_eq!(decode_send_goal(&b, true).unwrap(), (id, dock));
-        let undock = Goal::Undock(UndockGoal { max_time: 5.0 });
-        encode_send_goal(&mut b, &id, &undock);
-        assert_eq!(decode_send_goal(&b, false).unwrap(), (id, undock));
-        assert!(decode_send_goal(&b[..10], false).is_err());
-
-        let r = GoalResult {
-            status: 6,
-            success: false,
-            error_code: 904,
-            outcome: "target_lost".into(),
-            num_retries: 2,
-        };
-        encode_result(&mut b, &r, true);
-        assert_eq!(decode_result(&b, true).unwrap(), r);
-
-        let f = GoalFeedback {
-            phase: "approach".into(),
-            elapsed_ns: 12_300_000_000,
-            num_retries: 1,
-        };
-        encode_feedback(&mut b, &id, &f.phase, f.elapsed_ns, f.num_retries);
-        assert_eq!(decode_feedback(&b).unwrap(), (id, f));
-
         encode_send_goal_response(&mut b, true, stamp(5));
         assert!(decode_send_goal_response(&b).unwrap());
+        encode_goal_id(&mut b, &id);
+        assert_eq!(decode_goal_id(&b).unwrap(), id);
         encode_cancel_request(&mut b, &id);
         assert_eq!(decode_goal_id(&b).unwrap(), id);
         encode_cancel_response(&mut b, 0, &[(id, stamp(0))]);
         assert_eq!(decode_cancel_response(&b).unwrap(), 0);
+        assert!(decode_goal_id(&b[..8]).is_err());
     }
 
     #[test]

@@ -3,27 +3,39 @@
 //!
 //! [`Ros2Node::start`] opens a Zenoh session with explicit endpoints and multicast
 //! scouting off, subscribes to the camera image(s), odometry and the dock switch,
-//! publishes `cmd_vel`, and serves docking and undocking as ROS 2 actions
-//! (`marsupial_msgs/action/Dock` and `…/Undock`, modelled on Nav2's `DockRobot` and
-//! `UndockRobot`; see [`node`]). `marsupial ros2 --profile P` runs it from the command
-//! line, and [`client::ActionClient`] calls its actions from Rust.
+//! publishes `cmd_vel`, and serves Nav2's docking interface exactly:
+//! `nav2_msgs/action/DockRobot` on `dock_robot`, `nav2_msgs/action/UndockRobot` on
+//! `undock_robot` and `nav2_msgs/srv/ReloadDockDatabase` on `<node>/reload_database`
+//! (see [`node`], [`goals`], [`nav2`]). A ROS 2 client needs no package of ours.
+//! `marsupial ros2 --profile P` runs it from the command line, and
+//! [`client::ActionClient`] calls its actions from Rust.
 //!
-//! What was checked here and what was not: the key expressions, liveliness tokens,
-//! attachments and type hashes follow `rmw_zenoh`'s design document and REP-2016, and
-//! the hashes are tested against those ROS 2 prints for `std_msgs/msg/String`,
-//! `geometry_msgs/msg/Twist`, `sensor_msgs/msg/Image`, `nav_msgs/msg/Odometry` and the
-//! service `example_interfaces/srv/AddTwoInts`; the CDR layouts against the XCDR1 rules
-//! ([`crate::msgs::cdr`]). `tests/ros2_bridge.rs` docks the simulated Bujold through
-//! the bridge, with the simulator as a second Zenoh participant. No live ROS 2
-//! installation was run against it.
+//! What was checked here and what was not: the key expressions, liveliness tokens (with
+//! each entity's QoS), GIDs, attachments and type hashes follow `rmw_zenoh`'s design
+//! document and sources and REP-2011's hashing; the hashes are tested against published
+//! values (`std_msgs/msg/String`, `geometry_msgs/msg/Twist`, `sensor_msgs/msg/Image`,
+//! `nav_msgs/msg/Odometry`, `example_interfaces/srv/AddTwoInts`, and every Nav2 docking
+//! interface: see [`interfaces`]); the CDR layouts against the XCDR1 rules
+//! ([`crate::msgs::cdr`]). `tests/ros2_bridge.rs` docks the simulated Bujold through the
+//! bridge, with the simulator as a second Zenoh participant. No live ROS 2 installation
+//! was run against it.
 
 pub mod aux_devices;
 pub mod client;
+pub mod config;
 pub mod devices;
+pub mod dock_db;
+pub mod goals;
 pub mod interfaces;
 pub mod keys;
+pub mod latched;
 pub mod messages;
+pub mod nav2;
+pub mod nav2_msgs;
 pub mod node;
+pub mod plan;
+pub mod progress;
+pub mod qos;
 pub mod type_hash;
 
 pub use devices::ImageKind;

@@ -1,4 +1,5 @@
-//! ROS 2 type hashes (REP-2016, `RIHS01_…`), computed from type descriptions.
+//! ROS 2 type hashes (RIHS01, REP-2011, as `rosidl_generator_type_description` computes
+//! them), from type descriptions.
 //!
 //! `rmw_zenoh` puts each topic's and service's type hash in its key expression, so a
 //! publisher and a subscriber meet only when their hashes agree. The hash is the SHA-256
