@@ -171,14 +171,14 @@ fn approach_signals_the_dock_a_lost_target_and_an_off_axis_view() {
     }
     let step = tick(&mut a, &mut mem, 2.0, at(0.8), Some(view(0.8, 12.0, 1500)));
     assert_eq!(step.status, Status::Event("off_axis"));
-    assert_eq!(mem.retries, 1);
+    assert_eq!(mem.retries.used(), 1);
     assert!(mem.plan.is_some());
 }
 
 #[test]
 fn decide_backs_in_aligned_retries_misaligned_and_gives_up_when_out_of_retries() {
     let mut mem = memory();
-    let new = || decide::Decide::new(DecideParams::default(), 0.02, 5f64.to_radians(), 1);
+    let new = || decide::Decide::new(DecideParams::default(), 0.02, 5f64.to_radians());
     let mut d = new();
     enter(&mut d, &mut mem, 0.0, at(0.4));
     for k in 1..5 {
@@ -190,7 +190,7 @@ fn decide_backs_in_aligned_retries_misaligned_and_gives_up_when_out_of_retries()
     assert_eq!(s.output.aux.get::<Posture>(), Some(Posture::Lowered));
     // 5° off at 0.38 m: reposition (a retry), then out of retries: give up.
     for (retries_before, expected) in [(0, "misaligned"), (1, "retries_exhausted")] {
-        mem.retries = retries_before;
+        mem.retries = common::retries(1, retries_before);
         enter(&mut d, &mut mem, 1.0, at(0.4));
         let mut last = None;
         for k in 1..=5 {

@@ -392,7 +392,8 @@ fn final_runs_the_state_1_law_once_then_creeps_and_retries() {
     let g = marsupial::behaviors::catalog::tuning::<marsupial::behaviors::raposa::Raposa>(&profile())
         .unwrap()
         .seven_state;
-    let mut f = final_approach::FinalApproach::new(3);
+    mem.retries = common::retries(3, 0);
+    let mut f = final_approach::FinalApproach::new(Default::default());
     let near = seen(0.28, Some(3.0), [4.0, 10.0], true);
     enter(&mut f, &mut mem, 5.0, at(0.5), near);
     let aux = mem.aux;
@@ -409,9 +410,9 @@ fn final_runs_the_state_1_law_once_then_creeps_and_retries() {
     assert_eq!(end.status, Status::Event("retry"));
     assert_eq!(end.output.drive, DriveCommand::Stop);
     assert_eq!(end.output.aux.get::<Lights>(), Some(Lights(false)));
-    assert_eq!(mem.retries, 1);
+    assert_eq!(mem.retries.used(), 1);
     // The last retry used: retries exhausted.
-    mem.retries = 3;
+    mem.retries = common::retries(3, 3);
     enter(&mut f, &mut mem, 20.0, at(0.5), near);
     tick(&mut f, &mut mem, 20.0, at(0.5), near);
     assert_eq!(

@@ -348,3 +348,12 @@ impl marsupial::schemas::Agent for Backer {
 pub fn backer(_: &Profile) -> Result<Box<dyn marsupial::schemas::Agent>, marsupial::behaviors::BuildError> {
     Ok(Box::new(Backer { started: None }))
 }
+
+/// A docking's retries: `used` of `max` spent.
+pub fn retries(max: u32, used: u32) -> marsupial::behaviors::common::retries::Retries {
+    let mut r = marsupial::behaviors::common::retries::Retries::new(max);
+    for _ in 0..used {
+        r.spend();
+    }
+    r
+}

@@ -178,8 +178,7 @@ fn decide(m: &mut Memory, p: &AlignParams, s: Sighting) -> Decision {
         }
         None => {
             // Reverse and realign (seed 000 §II, §V-B), a bounded number of times.
-            m.retries += 1;
-            if m.retries > g.max_retries {
+            if !m.retries.spend() {
                 return Decision::Done(Outcome::Failed(FailureReason::RetriesExhausted));
             }
             Decision::Arc {
@@ -205,8 +204,7 @@ fn past_unseen(m: &mut Memory, p: &AlignParams, s: Sighting) -> Option<Decision>
     if s.pose.x >= look_x - p.arrive_m {
         return None;
     }
-    m.retries += 1;
-    if m.retries > m.geometry.max_retries {
+    if !m.retries.spend() {
         return Some(Decision::Done(Outcome::Failed(FailureReason::RetriesExhausted)));
     }
     Some(Decision::Arc {
@@ -309,7 +307,7 @@ mod tests {
                 }
             }
             assert!(committed, "{start:?} ended at {pose:?}");
-            assert_eq!(m.retries, 0);
+            assert_eq!(m.retries.used(), 0);
         }
         // With the budget spent, a misaligned arrival reverses and spends a retry.
         let start = Pose2::new(look_x + 0.05, 0.0, PI + 7f64.to_radians());
@@ -318,7 +316,7 @@ mod tests {
             Decision::Arc { arc, .. } => assert_eq!((arc.curvature, arc.length), (0.0, -p.reverse_m)),
             d => panic!("expected a reverse, got {d:?}"),
         }
-        assert_eq!(m.retries, 1);
+        assert_eq!(m.retries.used(), 1);
         // Leaving the arrival circle starts the count over.
         let _ = decide(&mut m, &p, stereo(Pose2::new(look_x + 0.4, 0.0, PI)));
         assert_eq!(m.looks.steps, 0);
@@ -339,15 +337,17 @@ mod tests {
         };
         // At or before the look pose: look again (None), no retry spent.
         assert!(past_unseen(&mut m, &p, sighting(look_x)).is_none());
-        assert_eq!(m.retries, 0);
+        assert_eq!(m.retries.used(), 0);
         // 12 cm past it (axel-field run 22): reverse `reverse_m`, one retry.
         match past_unseen(&mut m, &p, sighting(look_x - 0.12)) {
             Some(Decision::Arc { arc, .. }) => assert_eq!((arc.curvature, arc.length), (0.0, -p.reverse_m)),
             _ => panic!("expected a reverse"),
         }
-        assert_eq!(m.retries, 1);
+        assert_eq!(m.retries.used(), 1);
         // Retries are bounded as for any realignment.
-        m.retries = m.geometry.max_retries;
+        while m.retries.left() {
+            m.retries.spend();
+        }
         assert!(matches!(
             past_unseen(&mut m, &p, sighting(look_x - 0.12)),
             Some(Decision::Done(Outcome::Failed(FailureReason::RetriesExhausted)))

@@ -34,8 +34,6 @@ pub struct Geometry {
     /// The commitment gate before mating: the arm's largest angle to the cone's axis, rad
     /// (`success.heading_tolerance_deg`).
     pub gate_heading: f64,
-    /// Retries allowed (`behavior.max_retries`, our choice).
-    pub max_retries: u32,
 }
 
 impl Geometry {
@@ -69,7 +67,6 @@ impl Geometry {
             reel_in: gains.reel_in_m,
             gate_lateral: profile.success.lateral_tolerance_m,
             gate_heading: profile.success.heading_tolerance_deg.to_radians(),
-            max_retries: profile.behavior.max_retries,
         })
     }
 

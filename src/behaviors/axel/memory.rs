@@ -13,6 +13,7 @@ use super::legs::Motion;
 use super::look::Looks;
 use super::stereo::Perception;
 use super::tuning::AxelRobot;
+use crate::behaviors::common::retries::Retries;
 use crate::behaviors::composed::SharedMemory;
 use crate::geometry::Pose2;
 use crate::kinematics::two_arc::PlanParams;
@@ -148,8 +149,8 @@ pub struct Memory {
     pub odo: Pose2,
     /// The reel's reading this tick.
     pub reel: Option<TetherReading>,
-    /// Realignments (reverse and retry) used this docking.
-    pub retries: u32,
+    /// Realignments (reverse and retry) this docking, of `behavior.max_retries`.
+    pub retries: Retries,
     /// Arcs driven this docking.
     pub arcs: u32,
     /// The sign of the acquisition's turn (+1 counter-clockwise): toward the side the
@@ -194,7 +195,7 @@ impl Memory {
             run_start: None,
             odo: Pose2::default(),
             reel: None,
-            retries: 0,
+            retries: Retries::new(profile.behavior.max_retries),
             arcs: 0,
             search_sign: 1.0,
             seen: false,
@@ -296,7 +297,7 @@ impl Memory {
         Feedback {
             phase,
             elapsed: self.now - self.run_start.unwrap_or(self.now),
-            retries: self.retries,
+            retries: self.retries.used(),
         }
     }
 }
@@ -329,7 +330,7 @@ impl SharedMemory for Memory {
         self.run_start = None;
         self.looking = false;
         self.sighting = None;
-        self.retries = 0;
+        self.retries.reset();
         self.arcs = 0;
         self.search_sign = 1.0;
         self.seen = false;

@@ -25,28 +25,23 @@ use crate::schemas::{Behavior, DriveCommand, Inputs, MotionVector, MotorOutput, 
 pub struct Approach {
     params: ApproachParams,
     dock_total_px: f64,
-    max_retries: u32,
 }
 
 impl Approach {
     /// The leaf of a tree over `mem` (read here for its approach); at the dock
-    /// at `dock_total_px`, repositioning at most `max_retries` times per docking.
+    /// at `dock_total_px`, repositioning while the docking has retries left.
     ///
     /// # Errors
     /// A message when `output = "vector"` but the memory's approach has no potential
     /// field.
-    pub fn new(mem: &Memory, params: ApproachParams, dock_total_px: f64, max_retries: u32) -> Result<Self, String> {
+    pub fn new(mem: &Memory, params: ApproachParams, dock_total_px: f64) -> Result<Self, String> {
         if params.output == ApproachOutput::Vector && mem.approach.field.is_none() {
             return Err(
                 "params.output: `vector` needs robot.approach = \"potential_field\" (ratio steering has no vector)"
                     .into(),
             );
         }
-        Ok(Self {
-            params,
-            dock_total_px,
-            max_retries,
-        })
+        Ok(Self { params, dock_total_px })
     }
 
     /// This tick's proposal for a view.
@@ -82,13 +77,13 @@ impl Behavior<Memory> for Approach {
         m.observe_change(inputs);
         // Repositioning is decided on the median viewing angle, not the filtered one.
         let off_axis = match &m.planning {
-            Some(p) if m.retries < self.max_retries => self.off_axis(m, p),
+            Some(p) if m.retries.left() => self.off_axis(m, p),
             _ => None,
         };
         let step = match (m.view, off_axis) {
             (Some(v), _) if v.total_px as f64 >= self.dock_total_px => m.hold("approach").with_event("at_dock"),
             (Some(_), Some(off)) => {
-                m.retries += 1;
+                m.retries.spend();
                 m.plan = Some(m.plan_reposition(&off));
                 m.hold("approach").with_event("off_axis")
             }

@@ -60,11 +60,11 @@ pub fn at_dock_decision(
     }
 }
 
-/// The heading margin for a decision after `retries` of `max_retries`: the margin is
-/// insurance for a robot that can still retry, so the last decision (a "no" would end
-/// the mission in a certain failure) backs in within the tolerance fraction alone.
-fn heading_margin(margin: f64, retries: u32, max_retries: u32) -> f64 {
-    if retries >= max_retries { 0.0 } else { margin }
+/// The heading margin for a decision: the margin is insurance for a robot that can
+/// still retry, so the last decision (`last`: a "no" would end the mission in a certain
+/// failure) backs in within the tolerance fraction alone.
+fn heading_margin(margin: f64, last: bool) -> f64 {
+    if last { 0.0 } else { margin }
 }
 
 /// See the module docs.
@@ -72,20 +72,18 @@ pub struct Decide {
     params: DecideParams,
     tol_lateral: f64,
     tol_heading: f64,
-    max_retries: u32,
     started: f64,
     samples: Vec<FiducialView>,
 }
 
 impl Decide {
     /// The leaf, with the profile's success tolerances (m, rad).
-    pub fn new(params: DecideParams, tol_lateral: f64, tol_heading: f64, max_retries: u32) -> Self {
+    pub fn new(params: DecideParams, tol_lateral: f64, tol_heading: f64) -> Self {
         Self {
             samples: Vec::with_capacity(params.frames.max(1)),
             params,
             tol_lateral,
             tol_heading,
-            max_retries,
             started: 0.0,
         }
     }
@@ -103,8 +101,9 @@ impl Behavior<Memory> for Decide {
         }
         if self.samples.len() < self.params.frames {
             if m.now - self.started > self.params.lost_after_s {
-                // Lost at the gate: back off and look again.
-                m.retries += 1;
+                // Lost at the gate: back off and look again, the retry counted (the
+                // next decision judges the allowance).
+                m.retries.spend();
                 return Some(m.hold("decide").with_event("lost"));
             }
             return Some(m.hold("decide"));
@@ -115,7 +114,7 @@ impl Behavior<Memory> for Decide {
             self.tol_lateral,
             self.tol_heading,
             self.params.tolerance_fraction,
-            heading_margin(self.params.heading_margin_deg.to_radians(), m.retries, self.max_retries),
+            heading_margin(self.params.heading_margin_deg.to_radians(), !m.retries.left()),
         );
         tracing::debug!(target: "marsupial::behavior", now = m.now, back_in = d.back_in, alpha_deg = d.alpha.to_degrees(), heading_deg = d.heading.to_degrees(), distance = d.distance, lateral_m = d.lateral_at_entrance, "at-dock decision");
         if d.back_in {
@@ -126,8 +125,7 @@ impl Behavior<Memory> for Decide {
                 m.feedback("decide"),
             ));
         }
-        m.retries += 1;
-        if m.retries > self.max_retries {
+        if !m.retries.spend() {
             m.failing = Some(FailureReason::RetriesExhausted);
             return Some(Step::event(
                 "retries_exhausted",

@@ -10,6 +10,7 @@
 pub use super::motor::{ApproachMotor, lowered, raised};
 use super::tuning::{Approach, BujoldRobot, BujoldTuning};
 use crate::behaviors::common::median::MedianWindow;
+use crate::behaviors::common::retries::Retries;
 use crate::behaviors::composed::SharedMemory;
 use crate::geometry::Pose2;
 use crate::perception::TwoBlockPercept;
@@ -78,8 +79,8 @@ pub struct Memory {
     pub last_side: f64,
     /// When this run began, s.
     pub run_start: Option<f64>,
-    /// Retries used this docking.
-    pub retries: u32,
+    /// This docking's retries, of `behavior.max_retries`.
+    pub retries: Retries,
     /// Unjamming manoeuvres this docking.
     pub unjams: u32,
     /// Odometry heading the close dock began facing along (front away from the dock), rad:
@@ -178,7 +179,7 @@ impl Memory {
             dock_in_odometry: None,
             last_side: 1.0,
             run_start: None,
-            retries: 0,
+            retries: Retries::new(profile.behavior.max_retries),
             unjams: 0,
             start_heading: None,
             dock_hint: None,
@@ -299,7 +300,7 @@ impl Memory {
         Feedback {
             phase,
             elapsed: self.now - self.run_start.unwrap_or(self.now),
-            retries: self.retries,
+            retries: self.retries.used(),
         }
     }
 
@@ -330,7 +331,7 @@ impl SharedMemory for Memory {
                 self.alpha_filtered = None;
                 self.alpha_window.clear();
                 self.ratio_gate.reset();
-                self.retries = 0;
+                self.retries.reset();
                 self.unjams = 0;
                 self.ever_seen = false;
                 self.last_seen = None;

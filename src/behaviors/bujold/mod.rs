@@ -99,8 +99,7 @@ pub fn register(registry: &mut Registry<Memory>) {
         })
         .register("bujold.approach", |m: &Memory, a: &LeafArgs<'_>| {
             let dock_total = m.approach.steering.dock_total_px;
-            let retries = a.profile.behavior.max_retries;
-            Ok(Box::new(approach::Approach::new(m, a.params()?, dock_total, retries)?))
+            Ok(Box::new(approach::Approach::new(m, a.params()?, dock_total)?))
         })
         .register("bujold.decide", |_: &Memory, a: &LeafArgs<'_>| {
             let s = &a.profile.success;
@@ -108,7 +107,6 @@ pub fn register(registry: &mut Registry<Memory>) {
                 a.params()?,
                 s.lateral_tolerance_m,
                 s.heading_tolerance_deg.to_radians(),
-                a.profile.behavior.max_retries,
             )))
         })
         .register("bujold.back_in", move |_: &Memory, a: &LeafArgs<'_>| {

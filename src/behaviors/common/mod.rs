@@ -9,12 +9,14 @@
 //! * [`search`]: the search turn until the target is acquired, over
 //!   [`search::Searching`].
 //!
-//! [`median`] is the median window both robots smooth their viewing-angle estimates with.
+//! [`retries`] counts a docking's retries against `behavior.max_retries`, the same way
+//! for every robot; [`median`] is the median window both robots smooth their viewing-angle estimates with.
 
 pub mod avoid;
 pub mod docking;
 pub mod median;
 pub mod motion;
+pub mod retries;
 pub mod search;
 
 use super::registry::{LeafArgs, Registry};

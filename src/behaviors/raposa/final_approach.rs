@@ -14,28 +14,20 @@ use crate::schemas::{ArmPosition, Behavior, FailureReason, Inputs, Lights, Outco
 
 /// See the module docs.
 pub struct FinalApproach {
-    max_retries: u32,
     params: FinalParams,
     start: f64,
     first: bool,
 }
 
 impl FinalApproach {
-    /// The leaf, failing after `max_retries` retries, with the default params.
-    pub fn new(max_retries: u32) -> Self {
+    /// The leaf with the node's params; it fails once the docking's retries
+    /// ([`Memory::retries`]) are spent.
+    pub fn new(params: FinalParams) -> Self {
         Self {
-            max_retries,
-            params: FinalParams::default(),
+            params,
             start: 0.0,
             first: true,
         }
-    }
-}
-
-impl FinalApproach {
-    /// The same leaf with the node's params.
-    pub fn with_params(self, params: FinalParams) -> Self {
-        Self { params, ..self }
     }
 }
 
@@ -65,8 +57,7 @@ impl Behavior<Memory> for FinalApproach {
         if self.params.posture.is_some() {
             m.aux.set(Posture::Raised);
         }
-        m.retries += 1;
-        if m.retries > self.max_retries {
+        if !m.retries.spend() {
             return Some(
                 m.hold("state_6")
                     .finishing(Outcome::Failed(FailureReason::RetriesExhausted)),

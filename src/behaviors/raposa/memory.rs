@@ -16,6 +16,7 @@
 use super::region2::Region2Plan;
 use super::source::Source;
 use super::tuning::{RaposaRobot, SevenStateGains};
+use crate::behaviors::common::retries::Retries;
 use crate::behaviors::composed::SharedMemory;
 use crate::geometry::{Pose2, Twist, wrap_angle};
 use crate::perception::PyramidPercept;
@@ -60,8 +61,8 @@ pub struct Memory {
     pub run_start: Option<f64>,
     /// Arm, lights and guides: attached to every output.
     pub aux: Auxiliary,
-    /// Final approaches retried this docking.
-    pub retries: u32,
+    /// Final approaches retried this docking, of `behavior.max_retries`.
+    pub retries: Retries,
     /// Consecutive frames with neither the ellipse nor the blue edges.
     pub unseen: u32,
     /// Consecutive frames with the ellipse and no pair (no α): inside the dead zone, a
@@ -154,7 +155,7 @@ impl Memory {
             percept: PyramidPercept::not_found(0.0, size),
             run_start: None,
             aux: Auxiliary::default(),
-            retries: 0,
+            retries: Retries::new(profile.behavior.max_retries),
             unseen: 0,
             lone: 0,
             probes: 0,
@@ -201,7 +202,7 @@ impl Memory {
         Feedback {
             phase,
             elapsed: self.now - self.run_start.unwrap_or(self.now),
-            retries: self.retries,
+            retries: self.retries.used(),
         }
     }
 
@@ -298,7 +299,7 @@ impl SharedMemory for Memory {
             }
             Mission::Docking { .. } => {
                 self.run_start = None;
-                self.retries = 0;
+                self.retries.reset();
                 self.unseen = 0;
                 self.lone = 0;
                 self.probes = 0;

@@ -116,9 +116,7 @@ pub fn register(registry: &mut Registry<Memory>) {
             Ok(Box::new(Search::new("state_5", search, ())))
         })
         .register("raposa.final", |_: &Ctx, a: &LeafArgs<'_>| {
-            Ok(Box::new(
-                final_approach::FinalApproach::new(a.profile.behavior.max_retries).with_params(a.params()?),
-            ))
+            Ok(Box::new(final_approach::FinalApproach::new(a.params()?)))
         })
         // The back-aways (latched): body forward for the backward camera at the far
         // speed, keeping the ellipse centred; then event `cleared` with the detector's
