@@ -82,6 +82,9 @@ pub struct Stream<'a> {
     scratch: Vec<u8>,
     zstd: ruzstd::decoding::FrameDecoder,
     channels: mcap::read::ChannelAccumulator<'static>,
+    /// After the data end record: the summary repeats schemas and channels, which are
+    /// not linked again (as `mcap`'s reader does not).
+    past_data_end: bool,
     done: bool,
 }
 
@@ -95,6 +98,7 @@ impl<'a> Stream<'a> {
             scratch: Vec::new(),
             zstd: ruzstd::decoding::FrameDecoder::new(),
             channels: Default::default(),
+            past_data_end: false,
             done: false,
         }
     }
@@ -132,7 +136,7 @@ impl<'a> Stream<'a> {
                 return Err(McapError::UnexpectedEof.into());
             };
             let body_end = body_at.checked_add(len).filter(|&e| e <= bytes.len());
-            if opcode == op::CHUNK {
+            if opcode == op::CHUNK && !self.past_data_end {
                 self.open_chunk(body_at, body_end)?;
                 self.at = body_end.unwrap_or(bytes.len());
                 continue;
@@ -151,6 +155,12 @@ impl<'a> Stream<'a> {
                 };
             }
             self.at = body_end;
+            if opcode == op::DATA_END {
+                self.past_data_end = true;
+            }
+            if self.past_data_end {
+                continue;
+            }
             if let Some((channel, log_time, data)) = link(&mut self.channels, opcode, &bytes[body_at..body_end])? {
                 return Ok(Some(RawMessage {
                     channel,
