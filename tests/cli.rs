@@ -17,6 +17,7 @@ mod lighting_random;
 mod odometry_calibration;
 mod profile_errors;
 mod replay;
+mod replay_bags;
 mod scenario_errors;
 mod shard_merge;
 mod trials_determinism;

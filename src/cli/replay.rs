@@ -21,8 +21,9 @@ use thiserror::Error;
 /// Options of `marsupial replay` (also its command-line arguments).
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 pub struct ReplayOptions {
-    /// The log: a ROS 2 bag in MCAP, or a Foxglove-schema MCAP file.
-    #[arg(value_name = "LOG.mcap")]
+    /// The log: a ROS 2 bag in MCAP (a file, or a rosbag2 directory with its
+    /// metadata.yaml), or a Foxglove-schema MCAP file.
+    #[arg(value_name = "LOG.mcap|BAG_DIR")]
     pub log: PathBuf,
     /// Profile whose camera 0 took the frames (e.g. profiles/bujold.toml).
     #[arg(long, value_name = "PROFILE")]

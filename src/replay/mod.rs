@@ -1,5 +1,8 @@
 //! Replaying real logs (`marsupial replay`): a robot's camera frames and odometry read from
-//! an MCAP file, run through a profile's perceptual schema or its whole behavior.
+//! an MCAP file or a rosbag2 directory of them ([`bag_dir`]), run through a profile's
+//! perceptual schema or its whole behavior. Chunks stored uncompressed, or compressed with
+//! zstd (libmcap's and so rosbag2's default, and Foxglove's) or lz4, are read in the
+//! default build, by pure-Rust decoders ([`stream`]).
 //!
 //! Two kinds of log are read:
 //!
@@ -14,8 +17,8 @@
 //! frames, become RGB ([`crate::msgs::pixels`]); Bayer mosaics and 16-bit depth are
 //! refused by name.
 //!
-//! Errors come in two sizes. A fault of the file (not MCAP, truncated, compressed with a
-//! codec this build lacks: [`log::LogFault`]) or of the topics asked for
+//! Errors come in two sizes. A fault of the file (not MCAP, truncated, compressed with an
+//! unknown codec: [`log::LogFault`]) or of a bag directory ([`ReplayError::Bag`]) or of the topics asked for
 //! ([`topics::TopicError`]) stops the replay with [`ReplayError`]. A message that does not
 //! decode (bad CDR, unsupported encoding: [`decode::DecodeError`]) is skipped and counted by
 //! topic and reason, so a half-readable topic still replays; only a topic with no usable
@@ -24,11 +27,13 @@
 //! The decoders ([`crate::msgs::cdr::decode_image`], [`foxglove::decode_raw_image`] …)
 //! are pure functions over `&[u8]` that never panic, for fuzzing.
 
+pub mod bag_dir;
 pub mod decode;
 pub mod foxglove;
 pub mod log;
 pub mod preflight;
 pub mod session;
+pub mod stream;
 pub mod topics;
 
 use std::path::PathBuf;
@@ -44,6 +49,15 @@ pub enum ReplayError {
         path: PathBuf,
         /// Why.
         source: std::io::Error,
+    },
+    /// A rosbag2 directory that cannot be replayed: its `metadata.yaml` is missing or
+    /// malformed, its storage is not MCAP, or a file it names is not there.
+    #[error("{}: {why}", path.display())]
+    Bag {
+        /// The directory's `metadata.yaml`.
+        path: PathBuf,
+        /// What is wrong, naming the field.
+        why: String,
     },
     /// The file is not a readable MCAP file, or stops being one part-way.
     #[error("{}: {fault}", path.display())]

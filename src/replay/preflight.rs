@@ -19,10 +19,11 @@
 //!
 //! What is walked, as the reader walks it: the records of the data section from the
 //! start magic, the records inside uncompressed chunks, and the summary section the
-//! footer points to. Records inside compressed chunks (builds with `compressed-logs`)
-//! are left to the reader. The walk stops quietly at anything it cannot follow (a record
-//! that runs past the end of the file, a footer that points nowhere): those are the
-//! reader's to report, with the message they come after.
+//! footer points to. Records inside compressed chunks are walked when the replay has
+//! decompressed them ([`chunk_flaw`], from [`super::stream`]), before they are parsed. The
+//! walk stops quietly at anything it cannot follow (a record that runs past the end of the
+//! file, a footer that points nowhere): those are the reader's to report, with the
+//! message they come after.
 
 /// MCAP record opcodes (the specification's "Records" section).
 mod op {
@@ -140,6 +141,12 @@ fn record_name(opcode: u8) -> &'static str {
 /// The first flaw in the data section (chunks included), else in the summary section.
 pub fn first_flaw(bytes: &[u8]) -> Option<Flaw> {
     walk(bytes, MAGIC_LEN, bytes.len(), None).or_else(|| walk(bytes, summary_start(bytes)?, bytes.len(), None))
+}
+
+/// The first flaw among the records of a decompressed chunk (`records`, the whole of
+/// it): offsets are within `records`.
+pub fn chunk_flaw(records: &[u8]) -> Option<Flaw> {
+    walk(records, 0, records.len(), Some(0))
 }
 
 /// Where the footer says the summary section starts, as the reader takes it: the last
