@@ -6,18 +6,19 @@
 //! schema asks to look ([`Memory::looking`]), which the schemas do only with the rover
 //! stopped and settled, so a pose is never measured from a moving rover's frames. Each
 //! look yields a [`Sighting`]: the rover's pose in the module frame with the pose's
-//! quality figures. A schema trusts a sighting only by its quality ([`Trust`]).
+//! quality figures. A schema trusts a sighting only by its quality ([`Trust`]); both are
+//! in `sighting.rs`, re-exported here.
 
 pub use super::geometry::Geometry;
 use super::legs::Motion;
 use super::look::Looks;
+pub use super::sighting::{Sighting, Trust};
 use super::stereo::Perception;
 use super::tuning::AxelRobot;
 use crate::behaviors::common::retries::Retries;
 use crate::behaviors::composed::SharedMemory;
 use crate::geometry::Pose2;
 use crate::kinematics::two_arc::PlanParams;
-use crate::perception::circles::PoseSource;
 use crate::profile::Profile;
 use crate::schemas::{
     AgentStats, DriveCommand, FailureReason, Feedback, Inputs, Mission, MissionError, MotorOutput, Outcome, Step,
@@ -35,61 +36,6 @@ pub const TAUT_CURRENT_A: f64 = 1.0;
 /// reel's top rate and reads the current once a tick: a tick's overshoot then stays
 /// within the 0.5–1.0 A the paper's reel drew (seed 000 §V-C).
 pub const SLACK_CURRENT_A: f64 = 0.7;
-
-/// One pose measurement: where the rover is in the module frame, and how good it is.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Sighting {
-    /// Loop time of the frames, s.
-    pub t: f64,
-    /// The rover's pose in the module frame (mouth at the origin, face looking +x).
-    pub pose: Pose2,
-    /// Stereo or mono.
-    pub source: PoseSource,
-    /// Marks the pose came from.
-    pub marks: usize,
-    /// RMS reprojection of the posed model against the detections, px.
-    pub reprojection_px: f64,
-    /// RMS metric residual of the fit, m.
-    pub residual_m: f64,
-}
-
-/// The quality a sighting must have to be planned on (node params `trust`, ours: the
-/// paper accepted any pose its correspondence produced, and its monocular poses, with no
-/// distortion model, misled it, §V-E).
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Trust {
-    /// Largest RMS reprojection error, px.
-    pub reprojection_px: f64,
-    /// Largest RMS metric residual, m.
-    pub residual_m: f64,
-    /// Fewest marks.
-    pub marks: usize,
-    /// Accept a monocular pose (one camera saw the module).
-    pub mono: bool,
-}
-
-impl Default for Trust {
-    fn default() -> Self {
-        Self {
-            reprojection_px: 3.0,
-            residual_m: 0.05,
-            marks: 5,
-            mono: true,
-        }
-    }
-}
-
-impl Trust {
-    /// True when `s` is good enough to plan on.
-    pub fn accepts(&self, s: &Sighting) -> bool {
-        s.marks >= self.marks
-            && s.reprojection_px <= self.reprojection_px
-            && s.residual_m <= self.residual_m
-            && (self.mono || s.source == PoseSource::Stereo)
-            && s.pose.is_finite()
-    }
-}
 
 /// Where the planner must keep the module (node params `view`, ours): the paper asked
 /// only that the module stay in the field of view "as much as possible" (§IV-A-1).

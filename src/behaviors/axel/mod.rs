@@ -32,6 +32,7 @@ pub mod look;
 pub mod mate;
 pub mod memory;
 pub mod reel;
+pub mod sighting;
 pub mod stall;
 mod stereo;
 pub mod tuning;
