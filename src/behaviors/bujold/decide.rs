@@ -208,14 +208,22 @@ mod tests {
     #[test]
     fn the_last_decision_drops_the_margin() {
         let margin = 2f64.to_radians();
-        assert_eq!(heading_margin(margin, 0, 2), margin);
-        assert_eq!(heading_margin(margin, 1, 2), margin);
-        assert_eq!(heading_margin(margin, 2, 2), 0.0);
+        // Whether the decision after `used` of 2 retries is the last.
+        let last = |used: u32| {
+            let mut r = crate::behaviors::common::retries::Retries::new(2);
+            (0..used).for_each(|_| {
+                r.spend();
+            });
+            !r.left()
+        };
+        assert_eq!(heading_margin(margin, last(0)), margin);
+        assert_eq!(heading_margin(margin, last(1)), margin);
+        assert_eq!(heading_margin(margin, last(2)), 0.0);
         // A heading of 3.4° is refused with the margin and taken without it.
         let s = [view(3.4, 3.4)];
         let tol = 5f64.to_radians();
-        assert!(!at_dock_decision(&s, 0.2, 0.02, tol, 0.8, heading_margin(margin, 1, 2)).back_in);
-        assert!(at_dock_decision(&s, 0.2, 0.02, tol, 0.8, heading_margin(margin, 2, 2)).back_in);
+        assert!(!at_dock_decision(&s, 0.2, 0.02, tol, 0.8, heading_margin(margin, last(1))).back_in);
+        assert!(at_dock_decision(&s, 0.2, 0.02, tol, 0.8, heading_margin(margin, last(2))).back_in);
     }
 
     #[test]
