@@ -154,7 +154,7 @@ fn search_is_jammed_when_turning_does_not_change_the_view() {
 fn approach_signals_the_dock_a_lost_target_and_an_off_axis_view() {
     let mut mem = memory();
     let total = mem.approach.steering.dock_total_px;
-    let mut a = approach::Approach::new(&mem, ApproachParams::default(), total, 4).unwrap();
+    let mut a = approach::Approach::new(&mem, ApproachParams::default(), total).unwrap();
     enter(&mut a, &mut mem, 0.0, at(1.0));
     assert_eq!(
         tick(&mut a, &mut mem, 0.1, at(1.0), Some(view(1.0, 0.0, 900))).status,
