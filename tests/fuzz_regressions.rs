@@ -269,3 +269,29 @@ fn records_the_mcap_reader_would_overflow_or_slice_past_are_refused() {
     let flaw = refused_log("replay-mcap-attachment-without-crc.mcap");
     assert!(matches!(flaw, Flaw::ShortRecord { opcode: 0x09, .. }), "{flaw:?}");
 }
+
+#[test]
+fn a_record_the_preflight_walk_does_not_reach_is_still_checked_before_the_reader_parses_it() {
+    use marsupial::replay::ReplayError;
+    use marsupial::replay::log::{Log, LogFault};
+    use marsupial::replay::preflight::Flaw;
+    // Found by the replay target in CI (30 s run) after the replay's own message stream
+    // came in: a schema record declaring a 1.95 GB string that the stream handed to
+    // `mcap::parse_record` (which reserves the declared length) though the file's
+    // preflight walk had not descended to it. The stream now checks every record it
+    // parses (`preflight::record_flaw`).
+    let name = "replay-mcap-string-in-stream-record.mcap";
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/fuzz")
+        .join(name);
+    let bytes = std::fs::read(&path).unwrap();
+    let flaw = match Log::from_bytes(&path, bytes) {
+        Err(ReplayError::Log {
+            fault: LogFault::Malformed(flaw) | LogFault::MalformedChunk { flaw, .. },
+            ..
+        }) => flaw,
+        Err(e) => panic!("{name}: {e}"),
+        Ok(_) => panic!("{name}: read as a log"),
+    };
+    assert!(matches!(flaw, Flaw::LongString { opcode: 0x03, .. }), "{flaw:?}");
+}

@@ -88,6 +88,7 @@ fn fault(e: Fault, after: Option<(String, u64)>) -> LogFault {
     let e = match e {
         Fault::Mcap(e) => e,
         Fault::Flaw { chunk, flaw } => return LogFault::MalformedChunk { chunk, flaw },
+        Fault::Record(flaw) => return LogFault::Malformed(flaw),
     };
     match e {
         mcap::McapError::UnexpectedEof | mcap::McapError::BadFooter => LogFault::Truncated { after },

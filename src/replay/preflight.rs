@@ -149,6 +149,14 @@ pub fn chunk_flaw(records: &[u8]) -> Option<Flaw> {
     walk(records, 0, records.len(), Some(0))
 }
 
+/// The flaw of the one record `opcode`, `body` at byte `offset`, as [`first_flaw`] finds
+/// them (a string declared longer than its record, a record too short for its tail). The
+/// replay's stream checks every record with it just before `mcap::parse_record` sees it,
+/// whatever the walks above decided to descend into.
+pub fn record_flaw(opcode: u8, body: &[u8], offset: usize) -> Option<Flaw> {
+    check(opcode, body).err().map(|f| f.at(offset, opcode))
+}
+
 /// Where the footer says the summary section starts, as the reader takes it: the last
 /// 37 bytes are a footer record (its length field is not read) and the end magic, and a
 /// summary start of 0 means none. The reader reads records from there to a footer or

@@ -38,6 +38,9 @@ pub enum Fault {
         /// The flaw; its offset is within the decompressed records.
         flaw: Flaw,
     },
+    /// A record, outside a decompressed chunk, the reader must not see (its offset is in
+    /// the file).
+    Record(Flaw),
 }
 
 impl From<McapError> for Fault {
@@ -68,6 +71,8 @@ enum Source {
 /// The chunk being read: its records are `at..end` of its source.
 struct Chunk {
     source: Source,
+    /// The chunk record's offset in the file, bytes.
+    chunk: usize,
     at: usize,
     end: usize,
     /// The file ends inside it (`end` is the end of the file).
@@ -161,7 +166,11 @@ impl<'a> Stream<'a> {
             if self.past_data_end {
                 continue;
             }
-            if let Some((channel, log_time, data)) = link(&mut self.channels, opcode, &bytes[body_at..body_end])? {
+            let body = &bytes[body_at..body_end];
+            if let Some(flaw) = preflight::record_flaw(opcode, body, body_at - RECORD_HEADER) {
+                return Err(Fault::Record(flaw));
+            }
+            if let Some((channel, log_time, data)) = link(&mut self.channels, opcode, body)? {
                 return Ok(Some(RawMessage {
                     channel,
                     log_time,
@@ -210,6 +219,7 @@ impl<'a> Stream<'a> {
             let at = body_at + data_at.min(body.len());
             self.chunk = Some(Chunk {
                 source: Source::File,
+                chunk: chunk_at,
                 at,
                 end: at + data.len(),
                 cut,
@@ -229,6 +239,7 @@ impl<'a> Stream<'a> {
         }
         self.chunk = Some(Chunk {
             source: Source::Scratch,
+            chunk: chunk_at,
             at: 0,
             end: self.scratch.len(),
             cut,
@@ -287,7 +298,14 @@ fn next_in_chunk<'b>(
         .into());
     };
     c.at = end;
-    Ok(link(channels, opcode, &records[body_at..end])?)
+    let body = &records[body_at..end];
+    if let Some(flaw) = preflight::record_flaw(opcode, body, body_at - RECORD_HEADER) {
+        return Err(match c.source {
+            Source::File => Fault::Record(flaw),
+            Source::Scratch => Fault::Flaw { chunk: c.chunk, flaw },
+        });
+    }
+    Ok(link(channels, opcode, body)?)
 }
 
 /// Records a schema or channel; gives a message linked to its channel.
