@@ -11,9 +11,7 @@ use marsupial::behaviors::registry::Registry;
 use marsupial::geometry::Pose2;
 use marsupial::perception::circles::PoseSource;
 use marsupial::profile::Profile;
-use marsupial::schemas::{
-    Behavior, DriveCommand, FailureReason, Inputs, OdometryReading, Outcome, Stamped, Status, Step,
-};
+use marsupial::schemas::{Behavior, DriveCommand, FailureReason, Inputs, Outcome, Status, Step};
 use std::f64::consts::PI;
 
 const DT: f64 = 0.2;
@@ -33,15 +31,7 @@ fn phase(p: &Profile, name: &str) -> (Box<dyn Behavior<Memory>>, Memory) {
 }
 
 fn inputs(now: f64, odo: Pose2) -> Inputs<'static> {
-    let mut i = Inputs::empty(now);
-    i.odometry = Some(Stamped::new(
-        now,
-        OdometryReading {
-            pose: odo,
-            ..Default::default()
-        },
-    ));
-    i
+    common::odometry_inputs(now, odo)
 }
 
 /// Sets this tick's time and pose in memory (what the root's perception does), then
@@ -54,6 +44,21 @@ fn tick(node: &mut dyn Behavior<Memory>, m: &mut Memory, now: f64, odo: Pose2) -
 
 fn stopped(s: &Step) -> bool {
     matches!(s.output.drive, DriveCommand::Stop)
+}
+
+/// Ticks `node` standing at `odo` from t = 0 until it ends the docking (stopped), before
+/// `deadline` s: the outcome and when.
+fn until_done(node: &mut dyn Behavior<Memory>, m: &mut Memory, odo: Pose2, deadline: f64) -> (Outcome, f64) {
+    let mut t = 0.0;
+    loop {
+        t += DT;
+        let s = tick(node, m, t, odo);
+        if let Status::Done(o) = s.status {
+            assert!(stopped(&s), "{s:?}");
+            return (o, t);
+        }
+        assert!(t < deadline, "{s:?} at {t}");
+    }
 }
 
 /// A trusted stereo sighting at `t` of the rover at module-frame `pose`.
@@ -156,16 +161,7 @@ fn the_search_gives_up_on_its_clock_in_whichever_leg_is_running() {
         let (mut node, mut m) = phase(&p, "acquire");
         let odo = Pose2::default();
         node.enter(&mut m, &inputs(0.0, odo));
-        let mut t = 0.0;
-        let end = loop {
-            t += DT;
-            let s = tick(node.as_mut(), &mut m, t, odo);
-            if let Status::Done(o) = s.status {
-                assert!(stopped(&s));
-                break (o, t);
-            }
-            assert!(t < limit + 1.0, "{s:?} at {t}");
-        };
+        let end = until_done(node.as_mut(), &mut m, odo, limit + 1.0);
         assert_eq!(end.0, Outcome::Failed(FailureReason::TargetNeverDetected));
         assert!(
             end.1 > limit && end.1 <= limit + DT + 1e-9,
@@ -182,13 +178,6 @@ fn a_fix_seen_before_makes_the_searchs_failure_target_lost() {
     let odo = Pose2::default();
     node.enter(&mut m, &inputs(0.0, odo));
     m.fix(&sighting(0.0, Pose2::new(3.0, 0.0, PI)));
-    let mut t = 0.0;
-    let outcome = loop {
-        t += DT;
-        if let Status::Done(o) = tick(node.as_mut(), &mut m, t, odo).status {
-            break o;
-        }
-        assert!(t < 5.0);
-    };
+    let (outcome, _) = until_done(node.as_mut(), &mut m, odo, 5.0);
     assert_eq!(outcome, Outcome::Failed(FailureReason::TargetLost));
 }

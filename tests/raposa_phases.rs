@@ -20,7 +20,7 @@ use marsupial::profile::tree::NodeSpec;
 use marsupial::profile::{Profile, SegmentationMode};
 use marsupial::schemas::{
     ArmPosition, Behavior, DOCK_CONTACT_KIND, DriveCommand, FailureReason, Guides, Inputs, Lights, Mission,
-    MissionError, OdometryReading, Outcome, SensorInput, Stamped, Status, Step,
+    MissionError, Outcome, SensorInput, Status, Step,
 };
 
 fn profile() -> Profile {
@@ -95,15 +95,7 @@ fn nothing() -> PyramidPercept {
 }
 
 fn inputs(now: f64, odo: Pose2) -> Inputs<'static> {
-    let mut i = Inputs::empty(now);
-    i.odometry = Some(Stamped::new(
-        now,
-        OdometryReading {
-            pose: odo,
-            ..Default::default()
-        },
-    ));
-    i
+    common::odometry_inputs(now, odo)
 }
 
 /// Sets this tick's time, pose and percept in memory (what the root's perception does),

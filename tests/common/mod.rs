@@ -357,3 +357,17 @@ pub fn retries(max: u32, used: u32) -> marsupial::behaviors::common::retries::Re
     }
     r
 }
+
+/// A tick's inputs at `now` holding only an odometry reading of `odo` (the phase tests
+/// that drive leaves without the renderer).
+pub fn odometry_inputs(now: f64, odo: marsupial::geometry::Pose2) -> marsupial::schemas::Inputs<'static> {
+    let mut i = marsupial::schemas::Inputs::empty(now);
+    i.odometry = Some(marsupial::schemas::Stamped::new(
+        now,
+        marsupial::schemas::OdometryReading {
+            pose: odo,
+            ..Default::default()
+        },
+    ));
+    i
+}
