@@ -1,5 +1,5 @@
 //! One tick of the composed Bujold behavior (`profiles/bujold.toml`'s `[behavior.tree]`
-//! built by `behaviors::bujold::agent`), perception excluded. Target (issue: the
+//! built by `Catalog::compose`), perception excluded. Target (issue: the
 //! composition redesign): under 20 µs.
 //!
 //! The percepts are computed beforehand, by Bujold's two-block schema on a sequence of
@@ -48,7 +48,9 @@ fn bench_tick(c: &mut Criterion) {
         "the bench's frames must show the flap"
     );
 
-    let mut agent = bujold::agent(&profile).expect("agent");
+    let mut agent = marsupial::behaviors::catalog::shipped()
+        .compose(&bujold::Bujold, &profile)
+        .expect("agent");
     agent.begin(&Mission::docking()).expect("docking");
     let (mut k, mut now, mut ticks) = (0usize, 0.0f64, 0u64);
     c.bench_function("bujold_composed_tick_without_perception", |b| {

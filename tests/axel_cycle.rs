@@ -6,7 +6,9 @@
 
 use crate::common;
 
+use marsupial::behaviors::axel::Axel;
 use marsupial::behaviors::axel::memory::{Memory, Sighting};
+use marsupial::behaviors::catalog;
 use marsupial::behaviors::registry::Registry;
 use marsupial::geometry::Pose2;
 use marsupial::perception::circles::PoseSource;
@@ -26,7 +28,7 @@ fn profile(search_timeout_s: f64) -> Profile {
 fn phase(p: &Profile, name: &str) -> (Box<dyn Behavior<Memory>>, Memory) {
     let mut registry = Registry::new();
     marsupial::behaviors::axel::register(&mut registry);
-    let m = Memory::from_profile(p).unwrap();
+    let m = catalog::memory(&Axel, p).unwrap();
     (registry.build_node(p, name, &m).unwrap(), m)
 }
 

@@ -8,8 +8,7 @@
 use crate::common;
 
 use marsupial::behaviors::BuildError;
-use marsupial::behaviors::bujold::{self, Memory};
-use marsupial::behaviors::registry::Registry;
+use marsupial::behaviors::bujold;
 use marsupial::geometry::Pose2;
 use marsupial::profile::{Profile, SensorSpec};
 use marsupial::robot::{HardwareError, Sensor};
@@ -54,11 +53,10 @@ impl Sensor for Probe {
 
 /// Bujold's robot, built with a registry that also knows the probe's kind.
 fn bujold_agent(profile: &Profile) -> Result<Box<dyn Agent>, BuildError> {
-    let mut registry: Registry<Memory> = Registry::new();
-    registry.register_sensor_kind(PROBE, |_| Ok(()));
-    marsupial::behaviors::common::register(&mut registry);
-    bujold::register(&mut registry);
-    Ok(Box::new(bujold::agent_with(profile, &registry)?))
+    let robot = marsupial::behaviors::catalog::shipped().compose_with(&bujold::Bujold, profile, |r| {
+        r.register_sensor_kind(PROBE, |_| Ok(()));
+    })?;
+    Ok(Box::new(robot))
 }
 
 /// A campaign's records with what is needed to check them against the ground truth.

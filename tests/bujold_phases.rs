@@ -3,9 +3,11 @@
 
 use crate::common;
 
+use marsupial::behaviors::bujold::Bujold;
 use marsupial::behaviors::bujold::memory::{Memory, RepositionPlan};
 use marsupial::behaviors::bujold::params::*;
 use marsupial::behaviors::bujold::{approach, back_in, decide, departure};
+use marsupial::behaviors::catalog;
 use marsupial::behaviors::common::docking::{DockSwitch, Imprint, ImprintEnd};
 use marsupial::behaviors::registry::Registry;
 use marsupial::geometry::Pose2;
@@ -17,7 +19,7 @@ use marsupial::schemas::{
 };
 
 fn memory() -> Memory {
-    Memory::from_profile(&common::shipped_profile("bujold")).unwrap()
+    catalog::memory(&Bujold, &common::shipped_profile("bujold")).unwrap()
 }
 
 /// The shipped profile's node `name` (a leaf or a whole phase), as the robot builds it.
@@ -29,7 +31,7 @@ fn node(name: &str) -> Box<dyn Behavior<Memory>> {
 }
 
 fn memory_of(profile: &marsupial::profile::Profile) -> Memory {
-    Memory::from_profile(profile).unwrap()
+    catalog::memory(&Bujold, profile).unwrap()
 }
 
 /// The shipped search, turning at 0.4 rad/s and giving up after 40 s.

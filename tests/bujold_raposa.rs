@@ -63,7 +63,9 @@ fn only_the_keys_the_header_lists_differ_from_bujold() {
 fn agent_for_builds_raposa_on_the_two_block_adapter() {
     let p = profile();
     assert!(agent_for(&p).is_ok());
-    let agent = raposa::agent(&p).unwrap();
+    let agent = marsupial::behaviors::catalog::shipped()
+        .compose(&raposa::Raposa, &p)
+        .unwrap();
     let m = agent.memory();
     let Source::TwoBlock(cues) = &m.source else {
         panic!("the two-block flap must select the two-block source");

@@ -5,7 +5,7 @@
 
 use marsupial::behaviors::BuildError;
 use marsupial::behaviors::catalog::shipped;
-use marsupial::behaviors::krawler::{agent, gear_spec};
+use marsupial::behaviors::krawler::{Krawler, gear_spec};
 use marsupial::perception::{GearSpec, RgbImage};
 use marsupial::profile::Profile;
 use marsupial::schemas::{Agent, Behavior, CameraInput, Inputs, Mission};
@@ -86,7 +86,7 @@ fn the_leaves_refuse_bad_params_by_field() {
 #[test]
 fn a_tick_runs_the_estimator_on_the_belly_camera_once_per_frame() {
     let p = profile(&source());
-    let mut robot = agent(&p).unwrap();
+    let mut robot = shipped().compose(&Krawler, &p).unwrap();
     robot.begin(&Mission::docking()).unwrap();
     let cam = &p.cameras[0];
     let frame = RgbImage::new(cam.width_px, cam.height_px);

@@ -11,7 +11,8 @@ use crate::common::krawler::Rig;
 
 use marsupial::arbiter::runtime::{RuntimeConfig, StopHandle, run_missions};
 use marsupial::arbiter::{Lockstep, LoopStatus, ReactiveLoop};
-use marsupial::behaviors::krawler::{agent, gear_spec};
+use marsupial::behaviors::catalog::shipped;
+use marsupial::behaviors::krawler::{Krawler, gear_spec};
 use marsupial::perception::RgbImage;
 use marsupial::perception::krawler::GearGeometry;
 use marsupial::robot::{Camera, Drive, Exposure, HardwareError, Robot};
@@ -135,7 +136,7 @@ fn robot(stall_after_s: f64, step_s: Option<f64>) -> (Robot, Shared) {
 #[test]
 fn in_lockstep_the_estimator_follows_the_wheels_and_the_slip_monitor_stops_a_stall() {
     let p = common::shipped_profile("autokrawler");
-    let mut krawler = agent(&p).unwrap();
+    let mut krawler = shipped().compose(&Krawler, &p).unwrap();
     let seen = Arc::new(Mutex::new(Vec::new()));
     let log = Arc::clone(&seen);
     krawler
@@ -191,7 +192,7 @@ fn in_lockstep_the_estimator_follows_the_wheels_and_the_slip_monitor_stops_a_sta
 #[test]
 fn on_the_threaded_runtime_the_slip_monitor_stops_a_stall() {
     let p = common::shipped_profile("autokrawler");
-    let mut krawler = agent(&p).unwrap();
+    let mut krawler = shipped().compose(&Krawler, &p).unwrap();
     let frames = Arc::new(Mutex::new(0u64));
     let count = Arc::clone(&frames);
     krawler

@@ -761,7 +761,9 @@ fn composed_krawler_ticks_do_not_allocate() {
             im
         })
         .collect();
-    let mut robot = marsupial::behaviors::krawler::agent(&rig.profile).unwrap();
+    let mut robot = marsupial::behaviors::catalog::shipped()
+        .compose(&marsupial::behaviors::krawler::Krawler, &rig.profile)
+        .unwrap();
     robot.begin(&Mission::docking()).unwrap();
     let mut k = 0u32;
     let mut run = |robot: &mut marsupial::behaviors::Composed<marsupial::behaviors::krawler::KrawlerMemory>| {

@@ -7,7 +7,9 @@ use crate::common;
 
 use marsupial::arbiter::Selector;
 use marsupial::behaviors::SharedMemory;
+use marsupial::behaviors::catalog;
 use marsupial::behaviors::common::docking::{DockSwitch, Imprint, ImprintEnd};
+use marsupial::behaviors::raposa::Raposa;
 use marsupial::behaviors::raposa::memory::Memory;
 use marsupial::behaviors::raposa::params::*;
 use marsupial::behaviors::raposa::region2::{plan, robot_in_ball_frame};
@@ -28,7 +30,7 @@ fn profile() -> Profile {
 }
 
 fn memory() -> Memory {
-    Memory::from_profile(&profile()).unwrap()
+    catalog::memory(&Raposa, &profile()).unwrap()
 }
 
 /// The shipped profile's leaf `name` as the robot builds it, with `params` replaced and
@@ -45,7 +47,7 @@ fn node(name: &str, params: &[(&str, toml::Value)]) -> Box<dyn Behavior<Memory>>
     let mut registry = Registry::new();
     marsupial::behaviors::raposa::register(&mut registry);
     registry
-        .build_node(&p, name, &Memory::from_profile(&p).unwrap())
+        .build_node(&p, name, &catalog::memory(&Raposa, &p).unwrap())
         .unwrap()
 }
 
@@ -503,7 +505,7 @@ fn the_dock_switch_closes_the_guides_and_docks() {
 
 #[test]
 fn the_memory_perceives_only_outside_the_departure() {
-    let mut m = Memory::from_profile(&profile()).unwrap();
+    let mut m = catalog::memory(&Raposa, &profile()).unwrap();
     // Fixed bands: nothing to imprint, no departure.
     assert!(matches!(
         m.begin(&Mission::Departure),
@@ -511,7 +513,7 @@ fn the_memory_perceives_only_outside_the_departure() {
     ));
     let mut p = profile();
     p.perception.mode = SegmentationMode::Static;
-    let mut m = Memory::from_profile(&p).unwrap();
+    let mut m = catalog::memory(&Raposa, &p).unwrap();
     m.begin(&Mission::Departure).unwrap();
     m.percept = seen(1.0, None, [0.0, 0.0], false);
     SharedMemory::perceive(&mut m, &inputs(0.5, at(0.2)));

@@ -123,13 +123,26 @@ pub fn memory<K: RobotKind>(kind: &K, profile: &Profile) -> Result<K::Memory, Bu
 
 impl<K: RobotKind> BuildAgent for Kind<K> {
     fn agent(&self, profile: &Profile, devices: &Devices) -> Result<Box<dyn Agent>, BuildError> {
-        let memory = memory(&self.0, profile)?;
-        let mut registry = LeafRegistry::new();
-        devices.install(&mut registry);
-        super::common::register(&mut registry);
-        self.0.leaves(&mut registry);
-        Ok(Box::new(Composed::build(profile, &registry, memory)?))
+        Ok(Box::new(compose(&self.0, profile, devices, |_| {})?))
     }
+}
+
+/// Robot kind `kind`'s robot for `profile`: its memory, and a registry of the device
+/// kinds, the common leaves, the kind's own and then whatever `extend` adds (so a
+/// caller's leaf of a taken name replaces the shipped one).
+fn compose<K: RobotKind>(
+    kind: &K,
+    profile: &Profile,
+    devices: &Devices,
+    extend: impl FnOnce(&mut LeafRegistry<K::Memory>),
+) -> Result<Composed<K::Memory>, BuildError> {
+    let memory = memory(kind, profile)?;
+    let mut registry = LeafRegistry::new();
+    devices.install(&mut registry);
+    super::common::register(&mut registry);
+    kind.leaves(&mut registry);
+    extend(&mut registry);
+    Composed::build(profile, &registry, memory)
 }
 
 /// Runs `check` with a validator over `profile`'s source, returning its problems as
@@ -296,6 +309,30 @@ impl Catalog {
             )])));
         };
         kind.agent(profile, &self.devices)
+    }
+
+    /// Builds robot kind `kind`'s robot for `profile`, typed: as [`Catalog::agent`] does
+    /// for the kind `[robot] kind` names, but with the memory reachable
+    /// ([`Composed::memory`], [`Composed::memory_mut`]), which the boxed agent hides.
+    ///
+    /// # Errors
+    /// As [`Catalog::agent`].
+    pub fn compose<K: RobotKind>(&self, kind: &K, profile: &Profile) -> Result<Composed<K::Memory>, BuildError> {
+        compose(kind, profile, &self.devices, |_| {})
+    }
+
+    /// [`Catalog::compose`] with leaves, selectors or device kinds of the caller's added
+    /// to the registry last (a caller's leaf of a taken name replaces the shipped one).
+    ///
+    /// # Errors
+    /// As [`Catalog::agent`].
+    pub fn compose_with<K: RobotKind>(
+        &self,
+        kind: &K,
+        profile: &Profile,
+        extend: impl FnOnce(&mut LeafRegistry<K::Memory>),
+    ) -> Result<Composed<K::Memory>, BuildError> {
+        compose(kind, profile, &self.devices, extend)
     }
 }
 

@@ -149,7 +149,9 @@ pub fn estimate_runtime(
 ) -> Result<(EstimateRun, SlipFigures), String> {
     let truth = generate(spec, profile, seed)?;
     let p = in_the_loop(profile, params.mount.enabled, true);
-    let mut krawler = crate::behaviors::krawler::agent(&p).map_err(|e| e.to_string())?;
+    let mut krawler = crate::behaviors::catalog::shipped()
+        .compose(&crate::behaviors::krawler::Krawler, &p)
+        .map_err(|e| e.to_string())?;
     let mut ransac = Rng::named(seed, "krawler-ransac");
     let m = krawler.memory_mut();
     m.schema_mut()
@@ -293,7 +295,9 @@ pub fn estimate_threads(
     use crate::arbiter::runtime::{RuntimeConfig, StopHandle, run_missions};
     let truth = generate(spec, profile, seed)?;
     let p = in_the_loop(profile, params.mount.enabled, false);
-    let mut krawler = crate::behaviors::krawler::agent(&p).map_err(|e| e.to_string())?;
+    let mut krawler = crate::behaviors::catalog::shipped()
+        .compose(&crate::behaviors::krawler::Krawler, &p)
+        .map_err(|e| e.to_string())?;
     let mut ransac = Rng::named(seed, "krawler-ransac");
     let m = krawler.memory_mut();
     m.schema_mut()

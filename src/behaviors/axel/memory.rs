@@ -116,15 +116,6 @@ pub struct Memory {
 }
 
 impl Memory {
-    /// The memory of the robot `profile` describes, with the tuning of its `[robot]`
-    /// table read as Axel's ([`AxelRobot`]).
-    ///
-    /// # Errors
-    /// As [`crate::behaviors::catalog::memory`].
-    pub fn from_profile(profile: &Profile) -> Result<Self, crate::behaviors::BuildError> {
-        crate::behaviors::catalog::memory(&super::Axel, profile)
-    }
-
     /// The memory for an Axel profile.
     ///
     /// # Errors
@@ -298,7 +289,7 @@ impl Memory {
     pub(super) fn shipped_axel() -> Self {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/profiles/axel.toml");
         let profile = Profile::load(std::path::Path::new(path)).expect("axel profile");
-        Self::from_profile(&profile).expect("memory")
+        crate::behaviors::catalog::memory(&super::Axel, &profile).expect("memory")
     }
 }
 

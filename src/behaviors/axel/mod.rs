@@ -37,8 +37,6 @@ pub mod stall;
 mod stereo;
 pub mod tuning;
 
-use super::agent::BuildError;
-use super::composed::Composed;
 use super::registry::{LeafArgs, Registry};
 use crate::profile::Profile;
 pub use memory::Memory;
@@ -82,31 +80,6 @@ pub fn register(registry: &mut Registry<Memory>) {
             a.no_params()?;
             Ok(Box::new(reel::Reel))
         });
-}
-
-/// Axel's robot: the circle perception in the shared [`Memory`] and the tree of
-/// `[behavior.tree]`.
-pub type AxelAgent = Composed<Memory>;
-
-/// Builds Axel's robot from a profile with `circles` fiducial, two cameras, `[dock]`,
-/// `[tether]`, `[robot.two_arc]` and a `[behavior.tree]` of Axel's schemas (or the
-/// user's, registered in `registry`).
-///
-/// # Errors
-/// [`BuildError`] when something it needs is missing or the tree does not build.
-pub fn agent_with(profile: &Profile, registry: &Registry<Memory>) -> Result<AxelAgent, BuildError> {
-    Composed::build(profile, registry, Memory::from_profile(profile)?)
-}
-
-/// Builds Axel's robot with Axel's own schemas (see [`agent_with`]).
-///
-/// # Errors
-/// As [`agent_with`].
-pub fn agent(profile: &Profile) -> Result<AxelAgent, BuildError> {
-    let mut registry = Registry::new();
-    super::common::register(&mut registry);
-    register(&mut registry);
-    agent_with(profile, &registry)
 }
 
 /// Axel's robot kind, `[robot] kind = "axel"`: its tuning is [`AxelRobot`](tuning::AxelRobot), its

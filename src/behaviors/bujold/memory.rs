@@ -108,15 +108,6 @@ pub struct Memory {
 }
 
 impl Memory {
-    /// The memory of the robot `profile` describes, with the tuning of its `[robot]`
-    /// table read as Bujold's ([`BujoldRobot`]).
-    ///
-    /// # Errors
-    /// As [`crate::behaviors::catalog::memory`].
-    pub fn from_profile(profile: &Profile) -> Result<Self, crate::behaviors::BuildError> {
-        crate::behaviors::catalog::memory(&super::Bujold, profile)
-    }
-
     /// The memory of a robot just switched on, built from a profile with a two-block
     /// fiducial, a camera and a `[dock]`, with Bujold's `[robot]` tuning.
     ///
@@ -378,7 +369,7 @@ mod tests {
     #[test]
     fn a_flashed_block_moves_neither_the_angle_nor_the_plan() {
         let profile = Profile::load("profiles/bujold.toml".as_ref()).unwrap();
-        let mut m = Memory::from_profile(&profile).unwrap();
+        let mut m = crate::behaviors::catalog::memory(&crate::behaviors::bujold::Bujold, &profile).unwrap();
         m.digest(&Inputs::empty(0.0), &pair(0.0, 2250, 2250));
         assert!(m.planning.is_some());
         let alpha = m.alpha_filtered.unwrap();

@@ -11,9 +11,10 @@
 //!   ⇄ `unjam` → `approach` → `decide` → `back_in`, with `reposition`, `move_away` and
 //!   `give_up` as the retry loops, and per-state timeouts.
 //!
-//! The robot, [`BujoldAgent`] (a [`Composed`] behavior), runs the two-block perceptual
-//! schema once per tick into the shared [`Memory`] and then ticks the tree; [`register`]
-//! puts the phase schemas in a [`Registry`] under `bujold.*` names.
+//! The robot (a [`Composed`](super::Composed) behavior the catalog builds for
+//! [`Bujold`]) runs the two-block perceptual schema once per tick into the shared
+//! [`Memory`] and then ticks the tree; [`register`] puts the phase schemas in a
+//! [`Registry`] under `bujold.*` names.
 
 pub mod approach;
 pub mod back_in;
@@ -29,11 +30,9 @@ pub mod tuning;
 
 pub use decide::{Decision, at_dock_decision};
 
-use super::agent::BuildError;
 use super::common::docking::{DockSwitch, Imprint, ImprintEnd};
 use super::common::motion::{Aim, AimFn, BackOff, BackOffParams, Distance, End, Hooks, TurnParams, TurnTo};
 use super::common::search::{Search, SearchParams};
-use super::composed::Composed;
 use super::registry::{LeafArgs, Registry};
 use crate::perception::two_block_pose::TwoBlockGeometry;
 use crate::profile::Profile;
@@ -162,31 +161,6 @@ fn imprint_distance(profile: &Profile) -> Option<f64> {
     let cam = profile.cameras.first()?;
     let g = TwoBlockGeometry::new(cam, &fid);
     Some(profile.perception.imprint.at_distance_m + profile.dock?.depth_m - rear_behind_camera(profile, &g)?)
-}
-
-/// Bujold's robot: the two-block perceptual schema in the shared [`Memory`] and the tree
-/// of `[behavior.tree]`.
-pub type BujoldAgent = Composed<Memory>;
-
-/// Builds Bujold's robot from a profile with a `two_block` fiducial,
-/// `[robot.ratio_steering]` (and `[robot.potential_field]` when selected) and a
-/// `[behavior.tree]` of Bujold's schemas (or the user's, registered in `registry`).
-///
-/// # Errors
-/// [`BuildError`] when something it needs is missing or the tree does not build.
-pub fn agent_with(profile: &Profile, registry: &Registry<Memory>) -> Result<BujoldAgent, BuildError> {
-    Composed::build(profile, registry, Memory::from_profile(profile)?)
-}
-
-/// Builds Bujold's robot with Bujold's own schemas (see [`agent_with`]).
-///
-/// # Errors
-/// As [`agent_with`].
-pub fn agent(profile: &Profile) -> Result<BujoldAgent, BuildError> {
-    let mut registry = Registry::new();
-    super::common::register(&mut registry);
-    register(&mut registry);
-    agent_with(profile, &registry)
 }
 
 /// Bujold's robot kind, `[robot] kind = "bujold"`: its tuning is [`BujoldRobot`](tuning::BujoldRobot), its

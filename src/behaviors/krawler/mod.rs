@@ -21,7 +21,6 @@ pub use slip::SlipReading;
 
 use super::agent::BuildError;
 use super::catalog::{LeafRegistry, RobotKind};
-use super::composed::Composed;
 use super::registry::LeafArgs;
 use crate::config::{Validate, Validator};
 use crate::perception::{GearSpec, KrawlerParams};
@@ -111,20 +110,6 @@ pub fn schema(profile: &Profile) -> Result<KrawlerSchema, BuildError> {
         profile: profile.name.clone(),
         what,
     })
-}
-
-/// The AutoKrawler's robot, typed: its memory stays reachable
-/// ([`Composed::memory_mut`], to watch each estimate), which the catalog's boxed agent
-/// hides.
-///
-/// # Errors
-/// As [`Catalog::agent`](super::Catalog::agent).
-pub fn agent(profile: &Profile) -> Result<Composed<KrawlerMemory>, BuildError> {
-    let memory = super::catalog::memory(&Krawler, profile)?;
-    let mut registry = LeafRegistry::new();
-    super::common::register(&mut registry);
-    Krawler.leaves(&mut registry);
-    Composed::build(profile, &registry, memory)
 }
 
 /// The AutoKrawler's robot kind (see the module docs).

@@ -96,15 +96,6 @@ pub struct Memory {
 }
 
 impl Memory {
-    /// The memory of the robot `profile` describes, with the tuning of its `[robot]`
-    /// table read as Raposa's ([`RaposaRobot`]).
-    ///
-    /// # Errors
-    /// As [`crate::behaviors::catalog::memory`].
-    pub fn from_profile(profile: &Profile) -> Result<Self, crate::behaviors::BuildError> {
-        crate::behaviors::catalog::memory(&super::Raposa, profile)
-    }
-
     /// The memory of a robot just switched on, built from a profile with a
     /// `pyramid` fiducial or a `two_block` fiducial, a pin-hole back camera and
     /// `[robot.seven_state]`.

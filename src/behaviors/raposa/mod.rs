@@ -62,11 +62,9 @@ pub use region2::Region2Plan;
 pub use source::{Source, TwoBlockCues};
 pub use states::{ServoState, select_state};
 
-use super::agent::BuildError;
 use super::common::docking::{DockSwitch, Imprint, ImprintEnd};
 use super::common::motion::{AimFn, BackOff, Distance, End, Hooks, TurnTo};
 use super::common::search::{Search, SearchParams};
-use super::composed::Composed;
 use super::registry::{LeafArgs, Registry};
 use crate::profile::Profile;
 
@@ -190,10 +188,6 @@ pub fn register(registry: &mut Registry<Memory>) {
         });
 }
 
-/// RAPOSA's robot: the perception source (the pyramid schema, or the two-block adapter)
-/// in the shared [`Memory`] and the tree of `[behavior.tree]`.
-pub type RaposaAgent = Composed<Memory>;
-
 /// RAPOSA's slow search: the doubling sweep at `[robot.seven_state]`'s rate and first
 /// sweep, failing after the profile's `behavior.search_timeout_s`.
 fn slow_search(m: &Memory, a: &LeafArgs<'_>) -> SearchParams {
@@ -215,28 +209,6 @@ fn back_away(phase: &'static str, distance: Distance<Memory>, m: &Memory) -> Bac
         ..Hooks::default()
     };
     BackOff::new(phase, distance, m.gains.far_speed_mps, End::Event("cleared")).hooks(forget)
-}
-
-/// Builds RAPOSA's robot from a profile with a `pyramid` fiducial (or a
-/// `two_block` fiducial, read through [`source::TwoBlockCues`]), a pin-hole back
-/// camera, `[robot.seven_state]` and a `[behavior.tree]` of RAPOSA's schemas (or the
-/// user's, registered in `registry`).
-///
-/// # Errors
-/// [`BuildError`] when something it needs is missing or the tree does not build.
-pub fn agent_with(profile: &Profile, registry: &Registry<Memory>) -> Result<RaposaAgent, BuildError> {
-    Composed::build(profile, registry, Memory::from_profile(profile)?)
-}
-
-/// Builds RAPOSA's robot with RAPOSA's own schemas (see [`agent_with`]).
-///
-/// # Errors
-/// As [`agent_with`].
-pub fn agent(profile: &Profile) -> Result<RaposaAgent, BuildError> {
-    let mut registry = Registry::new();
-    super::common::register(&mut registry);
-    register(&mut registry);
-    agent_with(profile, &registry)
 }
 
 /// Raposa's robot kind, `[robot] kind = "raposa"`: its tuning is [`RaposaRobot`](tuning::RaposaRobot), its
