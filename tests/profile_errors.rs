@@ -350,3 +350,46 @@ fn a_docking_cone_names_the_field_that_cannot_work() {
         "dock.cone.seat_length_m",
     );
 }
+
+#[test]
+fn docks_read_and_bad_ones_name_the_entry_and_line() {
+    let src = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/bujold.toml")).unwrap();
+    let with = |docks: &str| Profile::parse(&format!("{src}\n{docks}"), Path::new("mem.toml"));
+    let p = with("[[docks]]\nid = \"home\"\npose = [1.5, 0.2, 3.0]\n\n[[docks]]\nid = \"shed\"\ntype = \"bujold\"\nframe = \"map\"\n").unwrap();
+    assert_eq!(p.docks.len(), 2);
+    assert_eq!(
+        (p.docks[0].pose, p.docks[1].frame.as_deref()),
+        (Some([1.5, 0.2, 3.0]), Some("map"))
+    );
+    let problem = |docks: &str| {
+        let err = with(docks).unwrap_err();
+        err.problems()
+            .iter()
+            .map(|p| (p.path.clone(), p.message.clone(), p.line))
+            .collect::<Vec<_>>()
+    };
+    let twice = problem("[[docks]]\nid = \"home\"\n[[docks]]\nid = \"home\"\n");
+    assert!(
+        twice
+            .iter()
+            .any(|(path, m, line)| path == "docks[1].id" && m.contains("already docks[0]") && line.is_some()),
+        "{twice:?}"
+    );
+    let nan = problem("[[docks]]\nid = \"home\"\npose = [1.0, nan, 0.0]\n");
+    assert!(
+        nan.iter()
+            .any(|(path, m, _)| path == "docks[0].pose" && m.contains("finite")),
+        "{nan:?}"
+    );
+    let blank = problem("[[docks]]\nid = \" \"\ntype = \"\"\n");
+    let paths: Vec<&str> = blank.iter().map(|(p, ..)| p.as_str()).collect();
+    assert!(
+        paths.contains(&"docks[0].id") && paths.contains(&"docks[0].type"),
+        "{blank:?}"
+    );
+    let unknown = problem("[[docks]]\nid = \"home\"\ncolour = \"red\"\n");
+    assert!(
+        unknown.iter().any(|(_, m, _)| m.contains("unknown field `colour`")),
+        "{unknown:?}"
+    );
+}

@@ -14,6 +14,7 @@ pub mod adapters;
 pub mod behavior;
 pub mod camera;
 pub mod devices;
+pub mod docks;
 pub mod drive;
 pub mod fiducial;
 pub mod geometry;
@@ -26,6 +27,7 @@ pub mod tree;
 pub use behavior::{BehaviorSpec, LoopSpec};
 pub use camera::{CameraModelKind, CameraSpec, FisheyeSpec, Intrinsics, Mount};
 pub use devices::{ActuatorSpec, RANGE_KIND, RangeParams, SensorSpec};
+pub use docks::DockEntry;
 pub use drive::{DriveKind, DriveSpec};
 pub use fiducial::{
     CirclePlacement, CirclesSpec, FiducialKind, FiducialKinds, FiducialSpec, MarkersSpec, NamedColor, PyramidSpec,
@@ -70,6 +72,10 @@ pub struct Profile {
     /// Dock geometry (absent for profiles that do not dock).
     #[serde(default)]
     pub dock: Option<DockSpec>,
+    /// The docks a goal may name, by id, with their poses (`[[docks]]`; none: the one
+    /// dock named after the profile, see [`docks`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub docks: Vec<DockEntry>,
     /// The robot kind that runs this platform, and its tuning (absent: a platform that
     /// runs no behavior, only perception).
     #[serde(default)]
@@ -121,6 +127,7 @@ impl Validate for Profile {
             geometry::validate_dock(d, &self.body, self.fiducial.kind() == PyramidSpec::KIND, v);
             geometry::validate_cone_arm(d, self.tether.as_ref(), &self.body, v);
         }
+        docks::validate_docks(&self.docks, v);
         perception::validate_perception(&self.perception, v);
         if let Some(t) = &self.tether {
             geometry::validate_tether(t, v);

@@ -1,11 +1,12 @@
-//! The node's dock database, until the crate has a full one (issue 44, item 2): the
-//! docks a `DockRobot` goal may name by `dock_id`, and what `ReloadDockDatabase` reads.
+//! The node's dock database: the docks a `DockRobot` goal may name by `dock_id`, and
+//! what `ReloadDockDatabase` reads.
 //!
-//! A profile describes one dock and gives it no id, so the node's first dock is the
-//! profile's, with the profile's name as both its id and its type (`bujold`), in the
-//! odometry frame, its pose unknown (the robot is taken to be within sight of it). A
-//! reload reads a file in the shape of Nav2's dock-database YAML, restricted to what the
-//! node can use:
+//! It starts with the profile's `[[docks]]` ([`crate::profile::docks`]): each with its
+//! id, its type (the profile's name unless given), its frame (the odometry frame unless
+//! given) and its pose when known. A profile without `[[docks]]` has one dock, id and
+//! type its name, in the odometry frame, pose unknown (the robot is taken to be within
+//! sight of it). `--dock-database` at start and `ReloadDockDatabase` while running read
+//! a file in the shape of Nav2's dock-database YAML, restricted to what the node can use:
 //!
 //! ```yaml
 //! docks:
@@ -17,10 +18,12 @@
 //!
 //! Comments (`#` to the end of a line), quotes around values and blank lines are allowed;
 //! any other key, a dock without a pose, a pose that is not three finite numbers, or a
-//! file without `docks:` is an error naming the line and the key. The profile's own dock
-//! stays in the database unless the file defines the same id.
+//! file without `docks:` is an error naming the line and the key. Unlike Nav2's reload,
+//! which replaces the database, the file's docks are added to the profile's (a dock of
+//! the same id replaced), so a file cannot lose the docks the profile declares.
 
 use crate::geometry::Pose2;
+use crate::profile::Profile;
 use std::path::Path;
 use thiserror::Error;
 
@@ -61,21 +64,35 @@ pub enum DockDbError {
 /// The docks the node knows.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DockDatabase {
-    /// In file order, the profile's own dock first unless the file redefines it.
+    /// The profile's docks first, then a file's in its order (a dock of a taken id
+    /// replaced in place).
     pub docks: Vec<Dock>,
 }
 
 impl DockDatabase {
-    /// The profile's one dock: id and type `profile_name`, in `odom_frame`, pose unknown.
-    pub fn for_profile(profile_name: &str, odom_frame: &str) -> Self {
-        Self {
-            docks: vec![Dock {
-                id: profile_name.to_owned(),
-                dock_type: profile_name.to_owned(),
+    /// The docks `profile` declares in `[[docks]]` (or its one dock, see the module
+    /// docs), a frame not given being `odom_frame`.
+    pub fn for_profile(profile: &Profile, odom_frame: &str) -> Self {
+        let docks = if profile.docks.is_empty() {
+            vec![Dock {
+                id: profile.name.clone(),
+                dock_type: profile.name.clone(),
                 frame: odom_frame.to_owned(),
                 pose: None,
-            }],
-        }
+            }]
+        } else {
+            profile
+                .docks
+                .iter()
+                .map(|d| Dock {
+                    id: d.id.clone(),
+                    dock_type: d.dock_type.clone().unwrap_or_else(|| profile.name.clone()),
+                    frame: d.frame.clone().unwrap_or_else(|| odom_frame.to_owned()),
+                    pose: d.pose.map(|[x, y, theta]| Pose2 { x, y, theta }),
+                })
+                .collect()
+        };
+        Self { docks }
     }
 
     /// The dock `id`.
@@ -212,8 +229,49 @@ pub fn parse(text: &str, default_type: &str) -> Result<Vec<Dock>, DockDbError> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// The shipped Bujold profile with `extra` appended.
+    pub(crate) fn bujold(extra: &str) -> Profile {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/profiles/bujold.toml");
+        let src = std::fs::read_to_string(path).unwrap();
+        Profile::parse(&format!("{src}\n{extra}"), Path::new(path)).unwrap()
+    }
+
+    #[test]
+    fn the_profiles_docks_start_the_database() {
+        let own = DockDatabase::for_profile(&bujold(""), "odom");
+        assert_eq!(
+            own.docks,
+            vec![Dock {
+                id: "bujold".into(),
+                dock_type: "bujold".into(),
+                frame: "odom".into(),
+                pose: None,
+            }]
+        );
+        let p = bujold(
+            "[[docks]]\nid = \"home\"\npose = [1.0, 2.0, 0.5]\n[[docks]]\nid = \"shed\"\ntype = \"charger\"\nframe = \"map\"\n",
+        );
+        let db = DockDatabase::for_profile(&p, "odom");
+        assert_eq!(db.ids(), "home, shed");
+        let home = db.get("home").unwrap();
+        assert_eq!((home.dock_type.as_str(), home.frame.as_str()), ("bujold", "odom"));
+        assert_eq!(
+            home.pose,
+            Some(Pose2 {
+                x: 1.0,
+                y: 2.0,
+                theta: 0.5
+            })
+        );
+        let shed = db.get("shed").unwrap();
+        assert_eq!(
+            (shed.dock_type.as_str(), shed.frame.as_str(), shed.pose),
+            ("charger", "map", None)
+        );
+    }
 
     #[test]
     fn a_nav2_shaped_file_reads() {
@@ -253,7 +311,7 @@ mod tests {
 
     #[test]
     fn a_reload_keeps_the_profiles_dock_and_refuses_a_missing_file() {
-        let db = DockDatabase::for_profile("bujold", "odom");
+        let db = DockDatabase::for_profile(&bujold(""), "odom");
         let dir = std::env::temp_dir().join(format!("marsupial-dockdb-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let file = dir.join("docks.yaml");

@@ -87,7 +87,7 @@ impl Ros2Node {
         let session = zenoh::open(zenoh_config(&config.listen, &config.connect)?)
             .wait()
             .map_err(zerr)?;
-        let mut docks = DockDatabase::for_profile(&profile.name, &config.odom_frame);
+        let mut docks = DockDatabase::for_profile(profile, &config.odom_frame);
         if let Some(path) = &config.dock_database {
             docks = docks
                 .reloaded(path, &profile.name)

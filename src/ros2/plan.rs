@@ -158,7 +158,7 @@ mod tests {
     use super::*;
 
     fn db() -> DockDatabase {
-        let mut db = DockDatabase::for_profile("bujold", "odom");
+        let mut db = DockDatabase::for_profile(&super::super::dock_db::tests::bujold(""), "odom");
         db.docks.push(super::super::dock_db::Dock {
             id: "far".into(),
             dock_type: "bujold".into(),
