@@ -100,9 +100,10 @@ pub enum ReplayError {
         /// The topic.
         topic: String,
     },
-    /// A frame's size is not the profile camera's, and what runs needs it to be.
+    /// A frame's size is not the profile camera's, nor of its aspect ratio (which would be
+    /// rescaled to it), and what runs needs it to be.
     #[error(
-        "topic `{topic}` message #{index}: frame {}×{} but the profile's camera is {}×{}; the pyramid schema and the behavior work in that camera's pixels (give a profile for this camera, or replay the two-block schema alone)",
+        "topic `{topic}` message #{index}: frame {}×{} but the profile's camera is {}×{}, of another aspect ratio (frames of the camera's ratio are rescaled to it); the pyramid schema and the behavior work in that camera's pixels (give a profile for this camera, or replay the two-block schema alone)",
         got.0, got.1, expected.0, expected.1
     )]
     FrameSize {
