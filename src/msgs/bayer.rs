@@ -80,7 +80,7 @@ fn window_mean(
             }
         }
     }
-    if n == 0 { 0 } else { ((sum + n / 2) / n) as u8 }
+    (sum + n / 2).checked_div(n).unwrap_or(0) as u8
 }
 
 /// A validated mosaic (`step ≥ width`, `height` rows, both sides ≥ 2) into `out`, which

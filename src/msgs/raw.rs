@@ -68,8 +68,8 @@ impl Encoding {
     /// What the sides must be beyond 1..=16384, or `None` when they are fine.
     fn side_rule(self, w: u32, h: u32) -> Option<&'static str> {
         match self {
-            Encoding::Yuv422(_) if w % 2 != 0 => Some("4:2:2 pairs pixels: the width must be even"),
-            Encoding::Nv(_) if w % 2 != 0 || h % 2 != 0 => {
+            Encoding::Yuv422(_) if !w.is_multiple_of(2) => Some("4:2:2 pairs pixels: the width must be even"),
+            Encoding::Nv(_) if !w.is_multiple_of(2) || !h.is_multiple_of(2) => {
                 Some("4:2:0 shares chroma in 2×2 blocks: width and height must be even")
             }
             Encoding::Bayer(_) if w < 2 || h < 2 => Some("a Bayer mosaic needs at least one 2×2 tile"),

@@ -224,8 +224,8 @@ mod tests {
                     let wy = overlap(oy as f64 * sy, (oy + 1) as f64 * sy, y);
                     for x in 0..fw {
                         let wt = wy * overlap(ox as f64 * sx, (ox + 1) as f64 * sx, x) / (sx * sy);
-                        for c in 0..3 {
-                            acc[c] += wt * f64::from(src.as_bytes()[(y * fw + x) * 3 + c]);
+                        for (c, a) in acc.iter_mut().enumerate() {
+                            *a += wt * f64::from(src.as_bytes()[(y * fw + x) * 3 + c]);
                         }
                     }
                 }
