@@ -13,9 +13,9 @@
 //!   `foxglove.CompressedImage`, `foxglove.PoseInFrame`), as `marsupial dock --record`
 //!   writes them ([`foxglove`]).
 //!
-//! Raw frames in `rgb8`, `bgr8`, `rgba8`, `bgra8` and `mono8`, and JPEG or PNG compressed
-//! frames, become RGB ([`crate::msgs::pixels`]); Bayer mosaics and 16-bit depth are
-//! refused by name.
+//! Raw frames in the encodings cameras deliver (`rgb8`, `bgr8`, `rgba8`, `bgra8`, `mono8`,
+//! YUV 4:2:2 and 4:2:0, 8-bit Bayer), and JPEG or PNG compressed frames, become RGB
+//! ([`crate::msgs::pixels`]); 16-bit depth and other encodings are refused by name.
 //!
 //! Errors come in two sizes. A fault of the file (not MCAP, truncated, compressed with an
 //! unknown codec: [`log::LogFault`]) or of a bag directory ([`ReplayError::Bag`]) or of the topics asked for
