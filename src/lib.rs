@@ -21,7 +21,8 @@
 //!
 //! Above the core, by feature (each layer builds without the ones beside it):
 //!
-//! * `msgs` (feature `ros2` or `sim`): ROS 2 messages in CDR, for the bridge and replay;
+//! * `msgs` (feature `image-io`, so `ros2`, `sim` or `cli`): ROS 2 messages in CDR and
+//!   camera pixels (YUV, Bayer, JPEG …) to frames, for the bridge, replay and `detect`;
 //! * `ros2` (feature `ros2`): the behaviors as a ROS 2 node over Zenoh, no simulator;
 //! * `sim` (feature `sim`): the simulator, scenarios and campaigns writing run records;
 //!   `replay`: a profile's perception or behavior on real logs (ROS 2 bags and Foxglove
@@ -64,7 +65,7 @@ pub mod geometry;
 #[cfg(feature = "image-io")]
 pub mod image_io;
 pub mod kinematics;
-#[cfg(any(feature = "ros2", feature = "sim"))]
+#[cfg(feature = "image-io")]
 pub mod msgs;
 mod panics;
 pub mod perception;

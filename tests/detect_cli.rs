@@ -88,6 +88,67 @@ fn png_and_jpeg_stream_with_json() {
     assert!(v[0]["offset_px"].as_f64().unwrap().abs() < 1.0);
 }
 
+/// The scene as a raw camera frame: a Bayer mosaic (`rggb`) and BT.601 limited-range YUYV
+/// (chroma averaged over each pixel pair), rows packed.
+fn raw_scene() -> (Vec<u8>, Vec<u8>) {
+    let s = scene();
+    let px = |x: usize, y: usize| &s.as_bytes()[(y * 256 + x) * 3..][..3];
+    let bayer = (0..240 * 256)
+        .map(|i| {
+            let (x, y) = (i % 256, i / 256);
+            px(x, y)[[0, 1, 1, 2][(y % 2) * 2 + x % 2]]
+        })
+        .collect();
+    let ycc = |p: &[u8]| {
+        let [r, g, b] = [p[0], p[1], p[2]].map(|c| f64::from(c) / 255.0);
+        let y = 0.299 * r + 0.587 * g + 0.114 * b;
+        [
+            16.0 + 219.0 * y,
+            128.0 + 224.0 * (b - y) / 1.772,
+            128.0 + 224.0 * (r - y) / 1.402,
+        ]
+    };
+    let mut yuyv = Vec::new();
+    for y in 0..240 {
+        for x in (0..256).step_by(2) {
+            let (a, b) = (ycc(px(x, y)), ycc(px(x + 1, y)));
+            let q = |v: f64| v.round().clamp(0.0, 255.0) as u8;
+            yuyv.extend([q(a[0]), q((a[1] + b[1]) / 2.0), q(b[0]), q((a[2] + b[2]) / 2.0)]);
+        }
+    }
+    (bayer, yuyv)
+}
+
+#[test]
+fn raw_camera_frames_are_read_with_raw() {
+    let (bayer, yuyv) = raw_scene();
+    let (b, y) = (tmp("scene.bayer"), tmp("scene.yuyv"));
+    std::fs::write(&b, &bayer).unwrap();
+    std::fs::write(&y, &yuyv).unwrap();
+    for (enc, file) in [("bayer_rggb8", &b), ("yuyv", &y)] {
+        let v = json_lines(&detect(&["--json", "--raw", &format!("{enc}:256x240")], &[file]));
+        assert_eq!(v[0]["found"], true, "{enc}: {v:?}");
+        assert!(
+            (v[0]["left_px"].as_i64().unwrap() - 38 * 46).abs() < 100,
+            "{enc}: {v:?}"
+        );
+    }
+    // A short file, an odd 4:2:2 width and an unknown encoding: the file and encoding named.
+    std::fs::write(&y, &yuyv[..1000]).unwrap();
+    for (raw, want) in [
+        ("yuyv:256x240", "yuyv"),
+        ("yuyv:255x240", "even"),
+        ("nv24:256x240", "nv24"),
+    ] {
+        let out = detect(&["--raw", raw], &[&y]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains("scene.yuyv") && err.contains(want),
+            "{raw}: {err}"
+        );
+    }
+}
+
 #[test]
 fn grey_and_rgba_are_converted() {
     let grey = tmp("grey.png");

@@ -624,9 +624,9 @@ pub(crate) fn replay_err(path: &Path) -> (Vec<serde_json::Value>, ReplayError) {
 }
 
 #[test]
-fn bayer_and_16_bit_frames_are_refused_by_name_and_index() {
+fn sixteen_bit_frames_are_refused_by_name_and_index() {
     let d = tmp("encodings");
-    for (enc, bpp) in [("bayer_rggb8", 1), ("16UC1", 2), ("mono16", 2)] {
+    for (enc, bpp) in [("bayer_rggb16", 2), ("16UC1", 2), ("mono16", 2), ("nv24", 2)] {
         let bag = d.join(format!("{enc}.mcap"));
         let m = image_msg(T0, 32, 24, enc, 32 * bpp, &vec![7; 32 * 24 * bpp as usize]);
         small_bag(&bag, vec![m]);
@@ -640,6 +640,81 @@ fn bayer_and_16_bit_frames_are_refused_by_name_and_index() {
             text.contains(enc) && text.contains("`/cam`") && text.contains("#0"),
             "{text}"
         );
+    }
+}
+
+/// A 32×24 frame of `encoding`, `bytes_per_px` bytes a pixel and `rows_x2 / 2` rows of
+/// data a frame row, every byte `v`.
+fn flat(k: u64, encoding: &str, bytes_per_px: u32, rows_x2: usize, v: u8) -> Vec<u8> {
+    let step = 32 * bytes_per_px;
+    image_msg(
+        T0 + k * DT,
+        32,
+        24,
+        encoding,
+        step,
+        &vec![v; step as usize * 24 * rows_x2 / 2],
+    )
+}
+
+#[test]
+fn camera_encodings_replay_like_rgb() {
+    let d = tmp("camera_encodings");
+    let bag = d.join("cam.mcap");
+    // Y′ = Cb = Cr = 128: grey 130 in BT.601 limited range; a flat mosaic is grey too.
+    let msgs = vec![
+        flat(0, "yuyv", 2, 2, 128),
+        flat(1, "yuv422", 2, 2, 128),
+        flat(2, "nv12", 1, 3, 128),
+        flat(3, "bayer_rggb8", 1, 2, 130),
+        image_msg(T0 + 4 * DT, 32, 24, "rgb8", 96, &[130; 96 * 24]),
+    ];
+    small_bag(&bag, msgs);
+    let (lines, r) = replay(&opts(&bag));
+    r.unwrap();
+    let frames = of_kind(&lines, "frame");
+    assert_eq!(frames.len(), 5, "{lines:?}");
+    assert!(of_kind(&lines, "skipped").is_empty());
+    // The same grey, so the same percept every time (but for its stamp).
+    let percept = |f: &serde_json::Value| {
+        let mut p = f["percept"]["two_block"].clone();
+        p.as_object_mut().unwrap().remove("stamp");
+        p
+    };
+    assert!(frames.iter().all(|f| percept(f) == percept(frames[4])), "{frames:?}");
+}
+
+#[test]
+fn a_truncated_or_corrupt_jpeg_frame_is_skipped_as_missing() {
+    let d = tmp("bad_jpeg");
+    let bag = d.join("jpeg.mcap");
+    let mut im = RgbImage::new(256, 240);
+    im.fill([40, 160, 90]);
+    let good_jpeg = jpeg(&im);
+    let mut corrupt = good_jpeg.clone();
+    corrupt[2..64].fill(0x5A);
+    let msgs: Vec<Msg> = [&good_jpeg[..], &good_jpeg[..20], &good_jpeg[..], &corrupt[..]]
+        .iter()
+        .enumerate()
+        .map(|(k, data)| {
+            let ns = T0 + k as u64 * DT;
+            ("/cam/compressed", ns, compressed_msg(ns, "jpeg", data))
+        })
+        .collect();
+    write_bag(&bag, &[("/cam/compressed", "sensor_msgs/msg/CompressedImage")], &msgs);
+    let (lines, r) = replay(&opts(&bag));
+    r.unwrap();
+    let frames: Vec<u64> = of_kind(&lines, "frame")
+        .iter()
+        .map(|l| l["index"].as_u64().unwrap())
+        .collect();
+    assert_eq!(frames, [0, 2]);
+    let skipped = of_kind(&lines, "skipped");
+    let indices: Vec<u64> = skipped.iter().map(|l| l["index"].as_u64().unwrap()).collect();
+    assert_eq!(indices, [1, 3]);
+    for l in skipped {
+        assert_eq!(l["reason"], "undecodable_image", "{l}");
+        assert_eq!(l["topic"], "/cam/compressed", "{l}");
     }
 }
 
@@ -759,8 +834,8 @@ fn a_half_readable_topic_reports_what_was_skipped_and_goes_on() {
     let bag = d.join("half.mcap");
     let mut xcdr2 = good(3);
     xcdr2[1] = 0x07; // CDR2_LE encapsulation
-    let bayer = image_msg(T0, 32, 24, "bayer_grbg8", 32, &[1; 32 * 24]);
-    small_bag(&bag, vec![good(0), bayer.clone(), good(2), xcdr2, bayer, good(5)]);
+    let nv24 = image_msg(T0, 32, 24, "nv24", 32, &[1; 32 * 24]);
+    small_bag(&bag, vec![good(0), nv24.clone(), good(2), xcdr2, nv24, good(5)]);
     let (lines, r) = replay(&opts(&bag));
     r.unwrap();
     let frames: Vec<u64> = of_kind(&lines, "frame")
@@ -780,7 +855,7 @@ fn a_half_readable_topic_reports_what_was_skipped_and_goes_on() {
         (s[1]["count"].as_u64(), s[1]["first_index"].as_u64()),
         (Some(2), Some(1))
     );
-    assert!(s[1]["first_why"].as_str().unwrap().contains("bayer_grbg8"), "{s}");
+    assert!(s[1]["first_why"].as_str().unwrap().contains("nv24"), "{s}");
 
     // The table says the same in words.
     let mut o = opts(&bag);
@@ -872,7 +947,7 @@ proptest::proptest! {
 }
 
 #[test]
-fn the_pyramid_schema_replays_raposa_frames_and_needs_its_camera_size() {
+fn the_pyramid_schema_replays_raposa_frames_and_needs_its_camera_aspect() {
     let Some(dir) = photos() else { return };
     let d = tmp("raposa");
     let bag = d.join("raposa.mcap");
@@ -914,14 +989,26 @@ fn the_pyramid_schema_replays_raposa_frames_and_needs_its_camera_size() {
     assert_eq!(got, want);
     assert!(got[0]["pyramid"].is_object(), "{}", got[0]);
 
-    // The Bujold-sized frames of another bag are not this camera's.
+    // Frames of another size with the camera's aspect ratio are rescaled to it (32×24
+    // to 160×120, `marsupial::msgs::rescale`) ...
     small_bag(&bag, vec![good(0)]);
+    let (lines, r) = replay(&o);
+    r.unwrap();
+    let frames = of_kind(&lines, "frame");
+    assert_eq!(frames.len(), 1);
+    assert_eq!(
+        (frames[0]["width"].as_u64(), frames[0]["height"].as_u64()),
+        (Some(32), Some(24))
+    );
+    // ... and of another ratio refused, not stretched.
+    small_bag(&bag, vec![image_msg(T0, 32, 20, "rgb8", 96, &[90; 96 * 20])]);
     let (_, e) = replay_err_with(&o);
+    assert!(e.to_string().contains("another aspect ratio"), "{e}");
     assert!(
         matches!(
             &e,
             ReplayError::FrameSize {
-                got: (32, 24),
+                got: (32, 20),
                 expected: (160, 120),
                 ..
             }

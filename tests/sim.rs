@@ -11,6 +11,7 @@ mod axel_reel;
 mod axel_world;
 mod bujold_closed_loop;
 mod bujold_raposa;
+mod camera_encodings;
 mod camera_imperfections;
 mod circles_pose;
 mod circles_render;

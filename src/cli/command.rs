@@ -125,8 +125,8 @@ enum Command {
     /// `nav_msgs/msg/Odometry`) and Foxglove-schema MCAP files (JSON `foxglove.RawImage`,
     /// `foxglove.CompressedImage`, `foxglove.PoseInFrame`, as `dock --record` writes them).
     /// Prints one line per frame (the percept, and with --behavior the command the robot
-    /// would have sent), one per message that could not be used (bad CDR, Bayer or 16-bit
-    /// encodings…), and a summary with the skipped counts by topic and reason.
+    /// would have sent), one per message that could not be used (bad CDR, 16-bit
+    /// encodings, truncated JPEG…), and a summary with the skipped counts by topic and reason.
     #[cfg(feature = "sim")]
     Replay(super::replay::ReplayOptions),
     /// Run a profile's behaviors as a ROS 2 node over Zenoh (built with `--features ros2`).

@@ -8,6 +8,8 @@
 use super::json_line;
 use crate::config::ConfigError;
 use crate::image_io::{ImageFileError, load_rgb, save_png};
+use crate::msgs::pixels::{PixelError, rgb_from_raw};
+use crate::msgs::rescale::ToCamera;
 use crate::perception::circles::{
     CircleDetector, CircleModel, CircleParams, CorrespondenceError, CorrespondenceParams, DetectedMark, LensPlane,
     MarkObservations, ModelFit, ModulePose, PoseBuffers, PoseError, PoseParams, RigCamera, correspond,
@@ -62,9 +64,64 @@ pub struct DetectOptions {
     /// them). Not with `--camera`.
     #[arg(long)]
     pub stereo: bool,
+    /// The images (and imprint images) are raw camera frames, as `v4l2-ctl --stream-to`
+    /// or a driver dumps them: ENCODING (a ROS name: `yuyv`, `uyvy`, `nv12`, `nv21`,
+    /// `bayer_rggb8` …, `rgb8`, `mono8` …), WIDTH×HEIGHT, rows packed without padding.
+    /// Without it, PNG and JPEG files.
+    #[arg(long, value_name = "ENCODING:WxH", value_parser = parse_raw)]
+    pub raw: Option<RawFormat>,
     /// Images, in stream order.
     #[arg(required = true, value_name = "IMAGE")]
     pub images: Vec<PathBuf>,
+}
+
+/// `--raw`: the encoding and size of raw frame files.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RawFormat {
+    /// ROS encoding name.
+    pub encoding: String,
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+}
+
+fn parse_raw(s: &str) -> Result<RawFormat, String> {
+    let bad = || format!("`{s}`: expected ENCODING:WIDTHxHEIGHT, e.g. yuyv:640x480");
+    let (encoding, size) = s.split_once(':').ok_or_else(bad)?;
+    let (w, h) = size.split_once(['x', '×']).ok_or_else(bad)?;
+    let (width, height) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
+    Ok(RawFormat {
+        encoding: encoding.to_string(),
+        width,
+        height,
+    })
+}
+
+/// Reads one image: a PNG or JPEG file, or with `--raw` a raw frame of that encoding.
+fn load(opts: &DetectOptions, path: &Path) -> Result<RgbImage, DetectError> {
+    let Some(raw) = &opts.raw else {
+        return Ok(load_rgb(path)?);
+    };
+    let bytes = std::fs::read(path).map_err(|source| ImageFileError::Read {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    // Rows packed: a row is the frame's size over its rows (4:2:0's chroma rows included).
+    let rows = if matches!(raw.encoding.as_str(), "nv12" | "nv21") {
+        u64::from(raw.height) * 3 / 2
+    } else {
+        u64::from(raw.height)
+    };
+    let step = u32::try_from(bytes.len() as u64 / rows.max(1)).unwrap_or(u32::MAX);
+    rgb_from_raw(raw.width, raw.height, &raw.encoding, step, &bytes).map_err(|why| DetectError::Raw {
+        file: path.to_path_buf(),
+        why,
+    })
+}
+
+fn load_all(opts: &DetectOptions, paths: &[PathBuf]) -> Result<Vec<RgbImage>, DetectError> {
+    paths.iter().map(|p| load(opts, p)).collect()
 }
 
 /// Why `detect` failed.
@@ -84,6 +141,14 @@ pub enum DetectError {
         "imprinting failed: the imprint images have fewer than 10 bright pixels in a profile imprint rectangle ([perception.imprint])"
     )]
     Imprint,
+    /// A `--raw` frame file that is not a frame of that encoding and size.
+    #[error("{}: {why}", file.display())]
+    Raw {
+        /// The file.
+        file: PathBuf,
+        /// Why, naming the encoding.
+        why: PixelError,
+    },
     /// Bad option value.
     #[error("{0}")]
     Usage(String),
@@ -190,8 +255,8 @@ pub fn run(opts: &DetectOptions, out: &mut dyn Write) -> Result<(), DetectError>
         None => 1.0 / profile.cameras[opts.camera].fps,
     };
     // Load everything first so a bad file fails before any output.
-    let imprint: Vec<RgbImage> = opts.imprint.iter().map(|p| load_rgb(p)).collect::<Result<_, _>>()?;
-    let images: Vec<RgbImage> = opts.images.iter().map(|p| load_rgb(p)).collect::<Result<_, _>>()?;
+    let imprint = load_all(opts, &opts.imprint)?;
+    let images = load_all(opts, &opts.images)?;
     if !imprint.is_empty() {
         for im in &imprint {
             schema.imprint_frame(&im.view());
@@ -464,10 +529,13 @@ fn run_circles(opts: &DetectOptions, profile: &Profile, out: &mut dyn Write) -> 
         return run_circles_stereo(opts, profile, out);
     }
     let mut run = CirclesRun::new(profile, opts.camera)?;
-    let images: Vec<RgbImage> = opts.images.iter().map(|p| load_rgb(p)).collect::<Result<_, _>>()?;
+    let images = load_all(opts, &opts.images)?;
     let mut overlay = RgbImage::default();
     let mut times = Vec::with_capacity(opts.repeat);
+    // Another size of the camera's aspect ratio is rescaled, so its lens model holds.
+    let mut to_camera = ToCamera::new(run.cam_size);
     for (k, (path, im)) in opts.images.iter().zip(&images).enumerate() {
+        let im = to_camera.fit(im);
         times.clear();
         let mut outcome = None;
         for _ in 0..opts.repeat {
@@ -509,10 +577,13 @@ fn run_circles_stereo(opts: &DetectOptions, profile: &Profile, out: &mut dyn Wri
         )));
     }
     let mut runs = [CirclesRun::new(profile, 0)?, CirclesRun::new(profile, 1)?];
-    let images: Vec<RgbImage> = opts.images.iter().map(|p| load_rgb(p)).collect::<Result<_, _>>()?;
+    let images = load_all(opts, &opts.images)?;
     let mut overlay = RgbImage::default();
     let (mut times, mut pair_times) = ([Vec::new(), Vec::new()], Vec::new());
+    let mut to_camera = [ToCamera::new(runs[0].cam_size), ToCamera::new(runs[1].cam_size)];
     for (pair, (paths, ims)) in opts.images.chunks(2).zip(images.chunks(2)).enumerate() {
+        let [fit0, fit1] = &mut to_camera;
+        let ims = [fit0.fit(&ims[0]), fit1.fit(&ims[1])];
         let mut last = None;
         times.iter_mut().for_each(Vec::clear);
         pair_times.clear();
@@ -521,21 +592,21 @@ fn run_circles_stereo(opts: &DetectOptions, profile: &Profile, out: &mut dyn Wri
             let mut outcomes = Vec::with_capacity(2);
             for (c, run) in runs.iter_mut().enumerate() {
                 let t = Instant::now();
-                outcomes.push(run.process(&ims[c])?);
+                outcomes.push(run.process(ims[c])?);
                 times[c].push(t.elapsed().as_secs_f64() * 1e6);
             }
-            let stereo = stereo_of(&mut runs, &outcomes, [&ims[0], &ims[1]]);
+            let stereo = stereo_of(&mut runs, &outcomes, ims);
             pair_times.push(started.elapsed().as_secs_f64() * 1e6);
             last = Some((outcomes, stereo));
         }
         let Some((outcomes, stereo)) = last else { continue };
         let names = [paths[0].display().to_string(), paths[1].display().to_string()];
         for c in 0..2 {
-            let rec = circles_record(&names[c], &ims[c], &runs[c], &outcomes[c], median(&mut times[c]));
+            let rec = circles_record(&names[c], ims[c], &runs[c], &outcomes[c], median(&mut times[c]));
             write_circles(out, &rec, opts.json)?;
             if let Some(base) = &opts.overlay {
                 let path = overlay_path(base, 2 * pair + c, opts.images.len());
-                draw_circles(&runs[c], &outcomes[c], &ims[c], &mut overlay, &path)?;
+                draw_circles(&runs[c], &outcomes[c], ims[c], &mut overlay, &path)?;
             }
         }
         let rec = StereoRecord {

@@ -3,6 +3,7 @@
 
 use super::json_line;
 use crate::config::ConfigError;
+use crate::msgs::rescale::Rescaler;
 use crate::perception::RgbImage;
 use crate::profile::CameraSpec;
 use crate::replay::decode::{self, DecodeError};
@@ -255,6 +256,9 @@ pub fn run_with(
     let mut latest_odom: Option<Stamped<OdometryReading>> = None;
     let mut recorder: Option<McapRecorder> = None;
     let mut fault = None;
+    // Frames of another size than the camera's, with its aspect ratio, rescaled to it.
+    let mut rescaler = Rescaler::new();
+    let mut scaled = RgbImage::default();
 
     for msg in log.messages(&wanted) {
         let msg = match msg {
@@ -311,31 +315,38 @@ pub fn run_with(
             }
             Ok(frame) => {
                 let size = (frame.image.width(), frame.image.height());
-                if !session.accepts(size) {
-                    return Err(ReplayError::FrameSize {
-                        topic: image_topic.clone(),
-                        index: msg.index,
-                        got: size,
-                        expected: session.camera_size(),
+                let image = if session.accepts(size) {
+                    &frame.image
+                } else {
+                    let camera = session.camera_size();
+                    scaled.resize(camera.0, camera.1);
+                    if rescaler.fill(&frame.image.view(), &mut scaled).is_err() {
+                        return Err(ReplayError::FrameSize {
+                            topic: image_topic.clone(),
+                            index: msg.index,
+                            got: size,
+                            expected: camera,
+                        }
+                        .into());
                     }
-                    .into());
-                }
+                    &scaled
+                };
                 let ns = frame.stamp_ns.unwrap_or(msg.log_time);
                 let t = clock.t(ns);
-                let res = session.frame(t, &frame.image, latest_odom)?;
+                let res = session.frame(t, image, latest_odom)?;
                 summary.frames += 1;
                 if res.percept.as_ref().is_some_and(found) {
                     summary.found += 1;
                 }
                 if let Some(path) = &opts.record {
                     if recorder.is_none() {
-                        let spec = record_spec(&profile.cameras[0], size);
+                        let spec = record_spec(&profile.cameras[0], (image.width(), image.height()));
                         let mut r = McapRecorder::create(path, &[spec], RecordOptions::default())?;
                         r.begin_mission("replay");
                         recorder = Some(r);
                     }
                     if let Some(r) = recorder.as_mut() {
-                        record_frame(r, t, &frame.image, &res);
+                        record_frame(r, t, image, &res);
                     }
                 }
                 write_frame(out, opts.json, &image_topic, msg.index, t, ns, size, &res)?;

@@ -1,11 +1,15 @@
-//! Logged pixels to the packed RGB8 frames perception takes: raw buffers by their ROS /
-//! Foxglove encoding name, compressed ones (JPEG, PNG) through the `image` crate.
+//! Camera pixels to the packed RGB8 frames perception takes: raw buffers by their ROS /
+//! Foxglove encoding name, compressed ones (JPEG, so MJPEG cameras' frames, and PNG)
+//! through the `image` crate.
 //!
-//! Colour segmentation needs three 8-bit channels, so only encodings that give them
-//! without guessing are read: `rgb8`, `bgr8`, `rgba8`, `bgra8` and `mono8` (grey, copied
-//! to the three channels). Bayer mosaics would need a demosaicing choice, and 16-bit or
-//! float images are depth, not colour: both are refused with the encoding named.
+//! Raw encodings read ([`super::raw`] has the table): `rgb8`, `bgr8`, `rgba8`, `bgra8`,
+//! `mono8` (grey, copied to the three channels), packed 4:2:2 `yuyv` / `yuv422_yuy2` and
+//! `uyvy` / `yuv422`, 4:2:0 `nv12` and `nv21` (BT.601 limited range, [`super::yuv`]),
+//! and 8-bit Bayer mosaics `bayer_rggb8`, `bayer_bggr8`, `bayer_grbg8`, `bayer_gbrg8`
+//! (bilinear demosaic, [`super::bayer`]). 16-bit or float images are depth, not colour:
+//! they are refused with the encoding named, as is any encoding not listed.
 
+use super::raw;
 use crate::perception::RgbImage;
 use thiserror::Error;
 
@@ -13,7 +17,9 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
 pub enum PixelError {
     /// An encoding perception cannot use.
-    #[error("encoding `{encoding}` is not supported ({why}); supported: rgb8, bgr8, rgba8, bgra8, mono8, JPEG, PNG")]
+    #[error(
+        "encoding `{encoding}` is not supported ({why}); supported: rgb8, bgr8, rgba8, bgra8, mono8, yuyv (yuv422_yuy2), uyvy (yuv422), nv12, nv21, bayer_rggb8, bayer_bggr8, bayer_grbg8, bayer_gbrg8, JPEG, PNG"
+    )]
     Unsupported {
         /// The encoding or format.
         encoding: String,
@@ -30,6 +36,19 @@ pub enum PixelError {
         width: u32,
         /// Rows.
         height: u32,
+    },
+    /// Sides the encoding cannot have: an odd width for 4:2:2, an odd side for 4:2:0, less
+    /// than 2×2 for a Bayer mosaic.
+    #[error("a {width}×{height} {encoding} image cannot be: {why}")]
+    Sides {
+        /// Encoding.
+        encoding: String,
+        /// Columns.
+        width: u32,
+        /// Rows.
+        height: u32,
+        /// The rule broken.
+        why: &'static str,
     },
     /// The row stride is shorter than a row, or the buffer shorter than the rows.
     #[error("{width}×{height} {encoding} needs step ≥ {row} and {need} bytes, got step {step} and {got} bytes")]
@@ -61,7 +80,22 @@ pub enum PixelError {
         /// The frame's rows.
         frame_height: usize,
     },
-    /// Compressed bytes that do not decode.
+    /// A frame whose aspect ratio is not the camera's, so it cannot be rescaled to the
+    /// camera's size without distorting it ([`super::rescale`]).
+    #[error(
+        "a {width}×{height} frame has another aspect ratio than the {camera_width}×{camera_height} camera: it is rescaled only when the ratios agree (set the camera to a mode of that ratio, or give the profile this camera's size)"
+    )]
+    Aspect {
+        /// The frame's columns.
+        width: usize,
+        /// The frame's rows.
+        height: usize,
+        /// The camera's columns.
+        camera_width: usize,
+        /// The camera's rows.
+        camera_height: usize,
+    },
+    /// Compressed bytes that do not decode (a truncated or corrupt JPEG frame among them).
     #[error("`{format}` data does not decode: {why}")]
     Decode {
         /// The declared format.
@@ -71,30 +105,15 @@ pub enum PixelError {
     },
 }
 
-/// Largest side accepted, as for profile cameras.
-const MAX_SIDE: u32 = 16384;
-
-/// Why an encoding is refused, or `None` when it is one we do not know at all.
-fn refusal(encoding: &str) -> &'static str {
-    let e = encoding.to_ascii_lowercase();
-    if e.starts_with("bayer_") {
-        "a Bayer mosaic: demosaic it before logging, or log a colour image"
-    } else if e.contains("16") || e == "mono16" {
-        "16-bit data, depth or high-dynamic-range: not a colour image"
-    } else if e.contains("32") || e.contains("64") {
-        "floating-point or 32-bit data: depth, not a colour image"
-    } else if e.starts_with("yuv") || e.starts_with("uyvy") || e.starts_with("yuyv") || e.starts_with("nv") {
-        "packed YUV: convert it to rgb8 or bgr8 before logging"
-    } else {
-        "unknown encoding"
-    }
-}
+const MAX_SIDE: u32 = raw::MAX_SIDE;
 
 /// Packed RGB8 from a raw buffer in `encoding` with `step` bytes per row (ROS's
-/// `sensor_msgs/Image` and Foxglove's `RawImage` fields).
+/// `sensor_msgs/Image` and Foxglove's `RawImage` fields; for `nv12` and `nv21` the
+/// chroma plane's rows follow the `height` luma rows, `step` bytes apart as ROS has it).
 ///
 /// # Errors
-/// [`PixelError`] for an unsupported encoding or sizes that do not add up.
+/// [`PixelError`] for an unsupported encoding, sides it cannot have
+/// ([`PixelError::Sides`]), or sizes that do not add up.
 ///
 /// # Example
 ///
@@ -104,13 +123,13 @@ fn refusal(encoding: &str) -> &'static str {
 /// // 2×1 bgr8 with a 2-byte row pad: blue then red.
 /// let im = rgb_from_raw(2, 1, "bgr8", 8, &[255, 0, 0, 0, 0, 255, 9, 9]).unwrap();
 /// assert_eq!(im.as_bytes(), &[0, 0, 255, 255, 0, 0]);
-/// assert!(rgb_from_raw(2, 1, "bayer_rggb8", 2, &[0, 0]).is_err());
+/// assert!(rgb_from_raw(2, 1, "16UC1", 4, &[0; 4]).is_err());
 /// ```
 pub fn rgb_from_raw(width: u32, height: u32, encoding: &str, step: u32, data: &[u8]) -> Result<RgbImage, PixelError> {
-    let layout = raw_layout(width, height, encoding, step, data)?;
-    // Validated first, so a bad message never sizes an allocation.
+    let checked = raw::check(width, height, encoding, step, data)?;
+    // Checked first, so a bad message never sizes an allocation.
     let mut out = RgbImage::new(width as usize, height as usize);
-    convert_raw(&layout, step, data, &mut out);
+    raw::convert(&checked, data, &mut out);
     Ok(out)
 }
 
@@ -140,7 +159,7 @@ pub fn rgb_into_raw(
     data: &[u8],
     out: &mut RgbImage,
 ) -> Result<(), PixelError> {
-    let layout = raw_layout(width, height, encoding, step, data)?;
+    let checked = raw::check(width, height, encoding, step, data)?;
     if (out.width(), out.height()) != (width as usize, height as usize) {
         return Err(PixelError::Frame {
             width,
@@ -149,63 +168,8 @@ pub fn rgb_into_raw(
             frame_height: out.height(),
         });
     }
-    convert_raw(&layout, step, data, out);
+    raw::convert(&checked, data, out);
     Ok(())
-}
-
-/// A raw buffer's validated layout: bytes per pixel, the index of R, G and B within a
-/// pixel, and the bytes in one row of pixels.
-struct RawLayout {
-    bpp: usize,
-    rgb: [usize; 3],
-    row: usize,
-}
-
-/// Checks the encoding, the sides and the buffer, in that order.
-fn raw_layout(width: u32, height: u32, encoding: &str, step: u32, data: &[u8]) -> Result<RawLayout, PixelError> {
-    let (bpp, rgb) = match encoding {
-        "rgb8" | "RGB8" => (3, [0, 1, 2]),
-        "bgr8" | "BGR8" => (3, [2, 1, 0]),
-        "rgba8" | "RGBA8" => (4, [0, 1, 2]),
-        "bgra8" | "BGRA8" => (4, [2, 1, 0]),
-        "mono8" | "MONO8" | "8UC1" => (1, [0, 0, 0]),
-        other => {
-            return Err(PixelError::Unsupported {
-                encoding: other.to_string(),
-                why: refusal(other),
-            });
-        }
-    };
-    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
-        return Err(PixelError::Size { width, height });
-    }
-    let (w, h) = (width as usize, height as usize);
-    let row = w * bpp;
-    let need = (step as usize) * (h - 1) + row;
-    if (step as usize) < row || data.len() < need {
-        return Err(PixelError::Buffer {
-            width,
-            height,
-            encoding: encoding.to_string(),
-            row,
-            step,
-            need,
-            got: data.len(),
-        });
-    }
-    Ok(RawLayout { bpp, rgb, row })
-}
-
-/// Copies a validated buffer into `out`, which is its size.
-fn convert_raw(layout: &RawLayout, step: u32, data: &[u8], out: &mut RgbImage) {
-    let [r, g, b] = layout.rgb;
-    let dst_row = out.width() * 3;
-    for (y, dst) in out.as_bytes_mut().chunks_exact_mut(dst_row).enumerate() {
-        let src = &data[y * step as usize..y * step as usize + layout.row];
-        for (d, px) in dst.chunks_exact_mut(3).zip(src.chunks_exact(layout.bpp)) {
-            d.copy_from_slice(&[px[r], px[g], px[b]]);
-        }
-    }
 }
 
 /// Packed RGB8 from a compressed image (`format` as logged: `jpeg`, `png`, or
@@ -294,9 +258,97 @@ mod tests {
         }
     }
 
+    proptest::proptest! {
+        /// The camera encodings too: filling a frame gives what allocating one gives, for
+        /// any even size, pad and content.
+        #[test]
+        fn camera_encodings_into_a_frame(hw in 1u32..5, hh in 1u32..5, enc in 0usize..10, pad in 0u32..5, seed in proptest::prelude::any::<u64>()) {
+            let (name, row_bytes_per_px, rows_x2) = [
+                ("yuyv", 2, 2), ("yuv422_yuy2", 2, 2), ("uyvy", 2, 2), ("yuv422", 2, 2), ("nv12", 1, 3), ("nv21", 1, 3),
+                ("bayer_rggb8", 1, 2), ("bayer_bggr8", 1, 2), ("bayer_grbg8", 1, 2), ("bayer_gbrg8", 1, 2),
+            ][enc];
+            let (w, h) = (hw * 2, hh * 2);
+            let step = w * row_bytes_per_px + pad;
+            let mut x = seed | 1;
+            let data: Vec<u8> = (0..step * h * rows_x2 / 2).map(|_| { x ^= x << 13; x ^= x >> 7; x ^= x << 17; x as u8 }).collect();
+            let want = rgb_from_raw(w, h, name, step, &data).unwrap();
+            let mut frame = RgbImage::new(w as usize, h as usize);
+            rgb_into_raw(w, h, name, step, &data, &mut frame).unwrap();
+            proptest::prop_assert_eq!(frame.as_bytes(), want.as_bytes());
+            // One byte short is refused, never read past.
+            let short = rgb_from_raw(w, h, name, step, &data[..data.len() - 1 - pad as usize]);
+            proptest::prop_assert!(matches!(short, Err(PixelError::Buffer { .. })), "{short:?}");
+        }
+    }
+
+    #[test]
+    fn camera_encodings_refuse_sides_they_cannot_have() {
+        for (enc, w, h) in [
+            ("yuyv", 3, 2),
+            ("uyvy", 1, 1),
+            ("nv12", 4, 3),
+            ("nv21", 3, 4),
+            ("bayer_rggb8", 1, 4),
+            ("bayer_gbrg8", 4, 1),
+        ] {
+            let e = rgb_from_raw(w, h, enc, 64, &[0; 4096]).unwrap_err();
+            assert!(matches!(e, PixelError::Sides { .. }), "{enc}: {e:?}");
+            assert!(e.to_string().contains(enc), "{e}");
+        }
+        // A step shorter than a row, zero sides and an empty buffer.
+        assert!(matches!(
+            rgb_from_raw(4, 2, "yuyv", 7, &[0; 64]),
+            Err(PixelError::Buffer { row: 8, .. })
+        ));
+        assert!(matches!(
+            rgb_from_raw(0, 2, "nv12", 0, &[]),
+            Err(PixelError::Size { .. })
+        ));
+        assert!(matches!(
+            rgb_from_raw(4, 2, "nv12", 4, &[0; 11]),
+            Err(PixelError::Buffer { need: 12, .. })
+        ));
+        assert!(matches!(
+            rgb_from_raw(2, 2, "bayer_bggr8", 2, &[]),
+            Err(PixelError::Buffer { .. })
+        ));
+        // A step near u32::MAX does not overflow the size arithmetic.
+        assert!(matches!(
+            rgb_from_raw(2, 16384, "nv12", u32::MAX, &[0; 8]),
+            Err(PixelError::Buffer { .. })
+        ));
+    }
+
+    #[test]
+    fn a_truncated_or_corrupt_jpeg_is_a_decode_error() {
+        let mut im = image::RgbImage::new(32, 24);
+        im.pixels_mut()
+            .enumerate()
+            .for_each(|(i, p)| *p = image::Rgb([i as u8, 80, 200]));
+        let mut jpeg = Vec::new();
+        image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, 90)
+            .encode_image(&im)
+            .unwrap();
+        assert!(rgb_from_compressed("jpeg", &jpeg).is_ok());
+        for cut in [2, 20, jpeg.len() / 2, jpeg.len() - 2] {
+            match rgb_from_compressed("jpeg", &jpeg[..cut]) {
+                Err(PixelError::Decode { format, .. }) => assert_eq!(format, "jpeg"),
+                // A cut in the entropy-coded data may decode, grey below the cut; it must not panic.
+                Ok(rgb) => assert_eq!((rgb.width(), rgb.height()), (32, 24)),
+                Err(e) => panic!("cut at {cut}: {e:?}"),
+            }
+        }
+        let mut corrupt = jpeg.clone();
+        corrupt[2..40].fill(0xFF);
+        assert!(matches!(
+            rgb_from_compressed("jpeg", &corrupt),
+            Err(PixelError::Decode { .. })
+        ));
+    }
+
     #[test]
     fn refusals_name_the_encoding() {
-        for enc in ["bayer_rggb8", "16UC1", "mono16", "32FC1", "yuv422"] {
+        for enc in ["bayer_rggb16", "16UC1", "mono16", "32FC1", "nv24", "yuv420", "hsv8"] {
             let e = rgb_from_raw(2, 2, enc, 4, &[0; 16]).unwrap_err();
             assert!(e.to_string().contains(enc), "{e}");
         }

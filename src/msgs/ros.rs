@@ -56,7 +56,7 @@ impl Image<'_> {
     /// The frame as packed RGB8.
     ///
     /// # Errors
-    /// [`PixelError`] for an encoding perception cannot use (Bayer mosaics, 16-bit depth,
+    /// [`PixelError`] for an encoding perception cannot use (16-bit depth, 16-bit mosaics,
     /// floats …) or sizes that do not add up.
     pub fn to_rgb(&self) -> Result<RgbImage, PixelError> {
         rgb_from_raw(self.width, self.height, self.encoding, self.step, self.data)

@@ -35,7 +35,9 @@ impl DecodeError {
             DecodeError::Cdr(_) => "cdr",
             DecodeError::Foxglove(_) => "json",
             DecodeError::Pixels(P::Unsupported { .. }) => "unsupported_encoding",
-            DecodeError::Pixels(P::Size { .. } | P::Buffer { .. } | P::Frame { .. }) => "bad_size",
+            DecodeError::Pixels(
+                P::Size { .. } | P::Sides { .. } | P::Buffer { .. } | P::Frame { .. } | P::Aspect { .. },
+            ) => "bad_size",
             DecodeError::Pixels(P::Decode { .. }) => "undecodable_image",
             DecodeError::Kind(_) => "kind",
         }

@@ -13,9 +13,9 @@
 //!   `foxglove.CompressedImage`, `foxglove.PoseInFrame`), as `marsupial dock --record`
 //!   writes them ([`foxglove`]).
 //!
-//! Raw frames in `rgb8`, `bgr8`, `rgba8`, `bgra8` and `mono8`, and JPEG or PNG compressed
-//! frames, become RGB ([`crate::msgs::pixels`]); Bayer mosaics and 16-bit depth are
-//! refused by name.
+//! Raw frames in the encodings cameras deliver (`rgb8`, `bgr8`, `rgba8`, `bgra8`, `mono8`,
+//! YUV 4:2:2 and 4:2:0, 8-bit Bayer), and JPEG or PNG compressed frames, become RGB
+//! ([`crate::msgs::pixels`]); 16-bit depth and other encodings are refused by name.
 //!
 //! Errors come in two sizes. A fault of the file (not MCAP, truncated, compressed with an
 //! unknown codec: [`log::LogFault`]) or of a bag directory ([`ReplayError::Bag`]) or of the topics asked for
@@ -100,9 +100,10 @@ pub enum ReplayError {
         /// The topic.
         topic: String,
     },
-    /// A frame's size is not the profile camera's, and what runs needs it to be.
+    /// A frame's size is not the profile camera's, nor of its aspect ratio (which would be
+    /// rescaled to it), and what runs needs it to be.
     #[error(
-        "topic `{topic}` message #{index}: frame {}×{} but the profile's camera is {}×{}; the pyramid schema and the behavior work in that camera's pixels (give a profile for this camera, or replay the two-block schema alone)",
+        "topic `{topic}` message #{index}: frame {}×{} but the profile's camera is {}×{}, of another aspect ratio (frames of the camera's ratio are rescaled to it); the pyramid schema and the behavior work in that camera's pixels (give a profile for this camera, or replay the two-block schema alone)",
         got.0, got.1, expected.0, expected.1
     )]
     FrameSize {

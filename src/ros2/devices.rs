@@ -12,8 +12,8 @@
 
 use super::keys::{RmwPublisher, now_ns};
 use crate::kinematics::DriveCommand;
+use crate::msgs::camera_frame::{CameraBytes, FrameDecoder};
 use crate::msgs::cdr::{decode_compressed_image, decode_image, decode_odometry};
-use crate::msgs::pixels::rgb_into_raw;
 use crate::perception::RgbImage;
 use crate::robot::{Camera, Drive, Exposure, HardwareError, Odometer};
 use crate::schemas::OdometryReading;
@@ -67,9 +67,9 @@ pub(super) fn subscribe(session: &zenoh::Session, key: &str) -> Result<(Arc<Late
 /// Which image message a camera topic carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ImageKind {
-    /// `sensor_msgs/msg/Image` (`rgb8`, `bgr8`, `mono8` …).
+    /// `sensor_msgs/msg/Image` (`rgb8`, `bgr8`, `mono8`, `yuyv`, `uyvy`, `nv12`, Bayer …).
     Raw,
-    /// `sensor_msgs/msg/CompressedImage` (JPEG or PNG).
+    /// `sensor_msgs/msg/CompressedImage` (JPEG, so an MJPEG camera's frames, or PNG).
     Compressed,
 }
 
@@ -81,11 +81,14 @@ pub struct TopicCamera {
     frames: Arc<LatestPayload>,
     wait: Duration,
     trust_stamps: bool,
+    decoder: FrameDecoder,
     _sub: Subscriber<()>,
 }
 
 impl TopicCamera {
-    /// A camera of `size` (the profile's) on `topic`, subscribed with `frames`.
+    /// A camera of `size` (the profile's) on `topic`, subscribed with `frames`. Frames of
+    /// another size with the profile camera's aspect ratio are rescaled to `size`
+    /// ([`crate::msgs::rescale`]: the profile's intrinsics then hold).
     /// `capture` waits up to `wait` for a frame. With `trust_stamps`, a frame's age is
     /// its header stamp's distance from this machine's clock (ROS stamps in wall time, with
     /// clocks kept in sync); without, frames are stamped on arrival.
@@ -104,26 +107,13 @@ impl TopicCamera {
             frames,
             wait,
             trust_stamps,
+            decoder: FrameDecoder::new(),
             _sub: sub,
         }
     }
 
-    /// A frame of another size than the profile's camera is a fault, named.
-    fn check_size(&self, width: usize, height: usize) -> Result<(), HardwareError> {
-        if (width, height) == self.size {
-            return Ok(());
-        }
-        Err(self.fault(format!(
-            "frame is {width}x{height}, the profile's camera is {}x{}",
-            self.size.0, self.size.1
-        )))
-    }
-
     fn fault(&self, detail: String) -> HardwareError {
-        HardwareError::Fault {
-            device: format!("camera on {}", self.topic),
-            detail,
-        }
+        fault(&self.topic, detail)
     }
 }
 
@@ -137,21 +127,35 @@ impl Camera for TopicCamera {
             return Err(HardwareError::NotReady);
         };
         let payload = payload.to_bytes();
-        // A raw frame is converted straight into the loop's frame; a compressed one goes
-        // through its decoder's own buffer (the JPEG and PNG decoders allocate).
+        // Decoded straight into the loop's frame, or rescaled into it from the decoder's
+        // buffer when the camera runs another mode of the profile camera's aspect ratio.
+        // A frame that cannot be used (an encoding not read, a truncated JPEG, another
+        // aspect ratio) is a fault naming the topic: the runtime reports it and the loop
+        // goes on without that frame, as for a missing one.
         let stamp = match self.kind {
             ImageKind::Raw => {
                 let im = decode_image(&payload).map_err(|e| self.fault(e.to_string()))?;
-                self.check_size(im.width as usize, im.height as usize)?;
-                rgb_into_raw(im.width, im.height, im.encoding, im.step, im.data, frame)
-                    .map_err(|e| self.fault(e.to_string()))?;
+                let bytes = CameraBytes::Raw {
+                    width: im.width,
+                    height: im.height,
+                    encoding: im.encoding,
+                    step: im.step,
+                    data: im.data,
+                };
+                self.decoder
+                    .decode_into(bytes, frame)
+                    .map_err(|e| fault(&self.topic, e.to_string()))?;
                 im.header.stamp
             }
             ImageKind::Compressed => {
                 let im = decode_compressed_image(&payload).map_err(|e| self.fault(e.to_string()))?;
-                let rgb = im.to_rgb().map_err(|e| self.fault(e.to_string()))?;
-                self.check_size(rgb.width(), rgb.height())?;
-                frame.as_bytes_mut().copy_from_slice(rgb.as_bytes());
+                let bytes = CameraBytes::Compressed {
+                    format: im.format,
+                    data: im.data,
+                };
+                self.decoder
+                    .decode_into(bytes, frame)
+                    .map_err(|e| fault(&self.topic, e.to_string()))?;
                 im.header.stamp
             }
         };
@@ -163,6 +167,14 @@ impl Camera for TopicCamera {
             _ => Duration::ZERO,
         };
         Ok(Exposure::ago(age))
+    }
+}
+
+/// A fault of the camera on `topic`.
+fn fault(topic: &str, detail: String) -> HardwareError {
+    HardwareError::Fault {
+        device: format!("camera on {topic}"),
+        detail,
     }
 }
 
