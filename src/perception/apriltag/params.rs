@@ -20,8 +20,11 @@ pub struct AprilTagParams {
     /// Quads whose shortest side is shorter than this are not decoded, px (default 10:
     /// 1.25 px per cell for tag36h11, about the least that decodes).
     pub min_side_px: f64,
-    /// Bits a decode may correct (default 2, clamped to the family's
-    /// [`TagFamily::max_correctable`]): more finds more tags and more false ones.
+    /// Bits a decode may correct (clamped to the family's
+    /// [`TagFamily::max_correctable`]): more finds more tags and more false ones. Default
+    /// 2 for tag36h11; [`AprilTagParams::for_family`] gives 0 for tag25h9 and tag16h5,
+    /// whose codes are close enough that an ArUco marker in a real photo decoded as a
+    /// tag25h9 at 2 bits.
     pub max_hamming: u32,
     /// The binarisation that finds black borders.
     pub threshold: TileThreshold,
@@ -132,6 +135,20 @@ pub enum TagRejection {
 }
 
 impl AprilTagParams {
+    /// The defaults for `family`: those of [`Default`] with the family's own
+    /// [`AprilTagParams::max_hamming`] (2 for tag36h11, 0 for the smaller families).
+    pub fn for_family(family: TagFamily) -> Self {
+        let max_hamming = match family {
+            TagFamily::Tag36h11 => 2,
+            TagFamily::Tag25h9 | TagFamily::Tag16h5 => 0,
+        };
+        Self {
+            family,
+            max_hamming,
+            ..Self::default()
+        }
+    }
+
     /// Checks a detection as a schema must before it uses it: the dock's id, large
     /// enough, a finite pose, a covariance within the limits (in that order; the first
     /// failure is returned).
