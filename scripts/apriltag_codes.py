@@ -37,7 +37,8 @@ out = [
     "//! disclaimer, and (2) redistributions in binary form reproduce them in the",
     "//! documentation. THE DATA IS PROVIDED \"AS IS\" WITHOUT WARRANTY OF ANY KIND.",
     "//!",
-    "//! Do not edit by hand; rerun the script.",
+    "//! Do not edit by hand; rerun the script (the tables are kept from rustfmt, four",
+    "//! codes a line).",
     "",
 ]
 for name, const in FAMILIES:
@@ -51,12 +52,14 @@ for name, const in FAMILIES:
     assert len(bx) == len(by) == nbits
     out.append(f"/// {name}: {len(codes)} codes of {nbits} bits, minimum Hamming distance {h},")
     out.append(f"/// {wab} cells across the black border.")
+    out.append("#[rustfmt::skip]")
     out.append(f"pub(super) const {const}_CODES: [u64; {len(codes)}] = [")
     for k in range(0, len(codes), 4):
         out.append("    " + " ".join(f"0x{int(c, 16):011x}," for c in codes[k:k + 4]))
     out.append("];")
     out.append(f"/// {name}: the cell (x right, y down, 0 at the black border's first cell) of")
     out.append("/// each code bit, most significant first.")
+    out.append("#[rustfmt::skip]")
     out.append(f"pub(super) const {const}_BITS: [(u8, u8); {nbits}] = [")
     cells = [f"({bx[i]}, {by[i]})," for i in range(nbits)]
     for k in range(0, nbits, 12):

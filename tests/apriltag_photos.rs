@@ -21,10 +21,13 @@ fn photos() -> Option<PathBuf> {
 fn images(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     for sub in ["backgrounds", "color", "markers", "homography", "sequences"] {
-        let Ok(rd) = std::fs::read_dir(dir.join(sub)) else { continue };
-        out.extend(rd.map(|e| e.unwrap().path()).filter(|p| {
-            matches!(p.extension().and_then(|e| e.to_str()), Some("jpg" | "png"))
-        }));
+        let Ok(rd) = std::fs::read_dir(dir.join(sub)) else {
+            continue;
+        };
+        out.extend(
+            rd.map(|e| e.unwrap().path())
+                .filter(|p| matches!(p.extension().and_then(|e| e.to_str()), Some("jpg" | "png"))),
+        );
     }
     out.sort();
     out
@@ -33,7 +36,14 @@ fn images(dir: &Path) -> Vec<PathBuf> {
 /// A pin-hole for a photo of this size (60° across; only the pose needs it).
 fn camera_for(w: usize, h: usize) -> Pinhole {
     let f = w as f64 / (2.0 * 30f64.to_radians().tan());
-    Pinhole { fx: f, fy: f, cx: (w as f64 - 1.0) / 2.0, cy: (h as f64 - 1.0) / 2.0, k1: 0.0, k2: 0.0 }
+    Pinhole {
+        fx: f,
+        fy: f,
+        cx: (w as f64 - 1.0) / 2.0,
+        cy: (h as f64 - 1.0) / 2.0,
+        k1: 0.0,
+        k2: 0.0,
+    }
 }
 
 #[test]
@@ -48,7 +58,12 @@ fn no_apriltag_in_any_real_photo() {
             let im = load_rgb(&f).unwrap();
             let cam = camera_for(im.width(), im.height());
             let found = det.detect(&im.view(), &cam).unwrap();
-            assert!(found.is_empty(), "{fam:?} false positive in {}: {:?}", f.display(), found[0]);
+            assert!(
+                found.is_empty(),
+                "{fam:?} false positive in {}: {:?}",
+                f.display(),
+                found[0]
+            );
             checked += 1;
         }
     }
@@ -82,9 +97,17 @@ fn a_tag_pasted_into_a_real_scene_is_found_with_its_pose() {
     let r = Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, -1.0))
         * Rotation3::from_axis_angle(&Vector3::y_axis(), 25f64.to_radians()).into_inner();
     let t = Vector3::new(0.1, 0.05, 1.2);
-    let tag = TagSprite { family: TagFamily::Tag36h11, id: 123, size_m: 0.16, supersample: 4 };
+    let tag = TagSprite {
+        family: TagFamily::Tag36h11,
+        id: 123,
+        size_m: 0.16,
+        supersample: 4,
+    };
     assert!(draw_tag(&mut im, &cam, &tag, &r, &t));
-    let params = AprilTagParams { expected_id: Some(123), ..AprilTagParams::default() };
+    let params = AprilTagParams {
+        expected_id: Some(123),
+        ..AprilTagParams::default()
+    };
     let mut det = AprilTagDetector::new(params);
     let found = det.detect(&im.view(), &cam).unwrap();
     assert_eq!(found.len(), 1, "{found:?}");

@@ -118,7 +118,8 @@ pub(super) fn read_cells(
     }
     let (black, white) = (black / nb, white / nw);
     let contrast = white - black;
-    if !(contrast >= lim.min_contrast) {
+    // NaN (no cells read) fails too.
+    if contrast.is_nan() || contrast < lim.min_contrast {
         return None;
     }
     let mid = 0.5 * (black + white);

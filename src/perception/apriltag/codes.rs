@@ -11,10 +11,12 @@
 //! disclaimer, and (2) redistributions in binary form reproduce them in the
 //! documentation. THE DATA IS PROVIDED "AS IS" WITHOUT WARRANTY OF ANY KIND.
 //!
-//! Do not edit by hand; rerun the script.
+//! Do not edit by hand; rerun the script (the tables are kept from rustfmt, four
+//! codes a line).
 
 /// tag16h5: 30 codes of 16 bits, minimum Hamming distance 5,
 /// 6 cells across the black border.
+#[rustfmt::skip]
 pub(super) const TAG16H5_CODES: [u64; 30] = [
     0x000000027c8, 0x000000031b6, 0x00000003859, 0x0000000569c,
     0x00000006c76, 0x00000007ddb, 0x0000000af09, 0x0000000f5a1,
@@ -27,6 +29,7 @@ pub(super) const TAG16H5_CODES: [u64; 30] = [
 ];
 /// tag16h5: the cell (x right, y down, 0 at the black border's first cell) of
 /// each code bit, most significant first.
+#[rustfmt::skip]
 pub(super) const TAG16H5_BITS: [(u8, u8); 16] = [
     (1, 1), (2, 1), (3, 1), (2, 2), (4, 1), (4, 2), (4, 3), (3, 2), (4, 4), (3, 4), (2, 4), (3, 3),
     (1, 4), (1, 3), (1, 2), (2, 3),
@@ -36,6 +39,7 @@ pub(super) const TAG16H5_SHAPE: (u32, u32, u32) = (16, 5, 6);
 
 /// tag25h9: 35 codes of 25 bits, minimum Hamming distance 9,
 /// 7 cells across the black border.
+#[rustfmt::skip]
 pub(super) const TAG25H9_CODES: [u64; 35] = [
     0x0000156f1f4, 0x00001f28cd5, 0x000016ce32c, 0x00001ea379c,
     0x00001390f89, 0x0000034fad0, 0x000007dcdb5, 0x0000119ba95,
@@ -49,6 +53,7 @@ pub(super) const TAG25H9_CODES: [u64; 35] = [
 ];
 /// tag25h9: the cell (x right, y down, 0 at the black border's first cell) of
 /// each code bit, most significant first.
+#[rustfmt::skip]
 pub(super) const TAG25H9_BITS: [(u8, u8); 25] = [
     (1, 1), (2, 1), (3, 1), (4, 1), (2, 2), (3, 2), (5, 1), (5, 2), (5, 3), (5, 4), (4, 2), (4, 3),
     (5, 5), (4, 5), (3, 5), (2, 5), (4, 4), (3, 4), (1, 5), (1, 4), (1, 3), (1, 2), (2, 4), (2, 3),
@@ -59,6 +64,7 @@ pub(super) const TAG25H9_SHAPE: (u32, u32, u32) = (25, 9, 7);
 
 /// tag36h11: 587 codes of 36 bits, minimum Hamming distance 11,
 /// 8 cells across the black border.
+#[rustfmt::skip]
 pub(super) const TAG36H11_CODES: [u64; 587] = [
     0x00d7e00984b, 0x00dda664ca7, 0x00dc4a1c821, 0x00e17b470e9,
     0x00ef91d01b1, 0x00f429cdd73, 0x0005da29225, 0x001106cba43,
@@ -210,6 +216,7 @@ pub(super) const TAG36H11_CODES: [u64; 587] = [
 ];
 /// tag36h11: the cell (x right, y down, 0 at the black border's first cell) of
 /// each code bit, most significant first.
+#[rustfmt::skip]
 pub(super) const TAG36H11_BITS: [(u8, u8); 36] = [
     (1, 1), (2, 1), (3, 1), (4, 1), (5, 1), (2, 2), (3, 2), (4, 2), (3, 3), (6, 1), (6, 2), (6, 3),
     (6, 4), (6, 5), (5, 2), (5, 3), (5, 4), (4, 3), (6, 6), (5, 6), (4, 6), (3, 6), (2, 6), (5, 5),

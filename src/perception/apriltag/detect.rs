@@ -126,7 +126,9 @@ impl AprilTagDetector {
         if self.labeler.size() != (w, h) {
             self.labeler = Labeler::new(w, h);
         }
-        let Ok(count) = self.labeler.label(&self.black).map(|c| c.len()) else { return };
+        let Ok(count) = self.labeler.label(&self.black).map(|c| c.len()) else {
+            return;
+        };
         // Each component's first run (runs are in raster order): its contour's start.
         self.first_run.clear();
         self.first_run.resize(count, u32::MAX);
@@ -159,18 +161,30 @@ impl AprilTagDetector {
                 break;
             }
             traced += 1;
-            let Some(run) = self.first_run.get(label).and_then(|&i| self.labeler.runs().get(i as usize)) else {
+            let Some(run) = self
+                .first_run
+                .get(label)
+                .and_then(|&i| self.labeler.runs().get(i as usize))
+            else {
                 continue;
             };
             let max_len = 4 * (c.width() + c.height()) as usize + 16;
             if !trace_contour(self.black.data(), w, h, (run.x0, run.y), max_len, &mut self.contour) {
                 continue;
             }
-            let Some(rough) = quad_corners(&self.contour, min_side) else { continue };
-            let Some(corners) = refine_corners(grey, w, h, rough) else { continue };
+            let Some(rough) = quad_corners(&self.contour, min_side) else {
+                continue;
+            };
+            let Some(corners) = refine_corners(grey, w, h, rough) else {
+                continue;
+            };
             let Some(map) = SquareMap::new(&corners) else { continue };
-            let Some(cells) = read_cells(grey, w, h, &map, p.family, &limits) else { continue };
-            let Some(code) = p.family.decode(&cells.grid, p.max_hamming) else { continue };
+            let Some(cells) = read_cells(grey, w, h, &map, p.family, &limits) else {
+                continue;
+            };
+            let Some(code) = p.family.decode(&cells.grid, p.max_hamming) else {
+                continue;
+            };
             // The tag's corner j is the quad's corner j + rotation.
             let k = code.rotation as usize;
             let tag_corners = [0, 1, 2, 3].map(|j| corners[(j + k) % 4]);

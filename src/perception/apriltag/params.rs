@@ -161,7 +161,7 @@ impl AprilTagParams {
         {
             return Err(TagRejection::WrongId { found: d.id, expected });
         }
-        if !(d.min_side_px >= self.min_trusted_side_px) {
+        if d.min_side_px.is_nan() || d.min_side_px < self.min_trusted_side_px {
             return Err(TagRejection::TooSmall {
                 side_px: d.min_side_px,
                 min_px: self.min_trusted_side_px,

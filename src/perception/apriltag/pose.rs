@@ -62,7 +62,11 @@ impl TagPose {
 
     /// True when every number of the pose and its covariance is finite.
     pub fn is_finite(&self) -> bool {
-        self.rotation.iter().chain(self.translation.iter()).chain(self.covariance.iter()).all(|v| v.is_finite())
+        self.rotation
+            .iter()
+            .chain(self.translation.iter())
+            .chain(self.covariance.iter())
+            .all(|v| v.is_finite())
             && self.reprojection_px.is_finite()
     }
 }
@@ -122,20 +126,16 @@ fn residuals(
         let (x, y) = (p.x / p.z, p.y / p.z);
         res[2 * k] = f.0 * (x - img[k][0]);
         res[2 * k + 1] = f.1 * (y - img[k][1]);
-        let dp = Matrix2x3::new(
-            f.0 / p.z,
-            0.0,
-            -f.0 * x / p.z,
-            0.0,
-            f.1 / p.z,
-            -f.1 * y / p.z,
-        );
+        let dp = Matrix2x3::new(f.0 / p.z, 0.0, -f.0 * x / p.z, 0.0, f.1 / p.z, -f.1 * y / p.z);
         let dth = dp * (-skew(&rx));
         jac.fixed_view_mut::<2, 3>(2 * k, 0).copy_from(&dth);
         jac.fixed_view_mut::<2, 3>(2 * k, 3).copy_from(&dp);
     }
     Some((res, jac))
 }
+
+/// A refined pose: rotation, translation, RMS reprojection error (px), Jacobian.
+type Refined = (Matrix3<f64>, Vector3<f64>, f64, SMatrix<f64, 8, 6>);
 
 /// Levenberg–Marquardt from (r, t): the refined pose, its residual and Jacobian.
 fn refine(
@@ -144,7 +144,7 @@ fn refine(
     obj: &[Vector3<f64>; 4],
     img: &[[f64; 2]; 4],
     f: (f64, f64),
-) -> Option<(Matrix3<f64>, Vector3<f64>, f64, SMatrix<f64, 8, 6>)> {
+) -> Option<Refined> {
     let (mut res, mut jac) = residuals(&r, &t, obj, img, f)?;
     let mut cost = res.norm_squared();
     let mut lambda = 1e-3;
@@ -200,7 +200,11 @@ pub fn tag_pose(corners: &[[f64; 2]; 4], camera: &Pinhole, size_m: f64, sigma_px
     }
     let src = obj.map(|p| [p.x, p.y]);
     let h = Homography::fit(&src, &img, &[])?.0;
-    let (h1, h2, h3) = (h.column(0).into_owned(), h.column(1).into_owned(), h.column(2).into_owned());
+    let (h1, h2, h3) = (
+        h.column(0).into_owned(),
+        h.column(1).into_owned(),
+        h.column(2).into_owned(),
+    );
     let mut scale = 2.0 / (h1.norm() + h2.norm());
     if h3.z * scale < 0.0 {
         scale = -scale;

@@ -57,7 +57,9 @@ pub(super) fn trace_contour(
     out: &mut Vec<[f64; 2]>,
 ) -> bool {
     out.clear();
-    let set = |x: i32, y: i32| x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h && mask[y as usize * w + x as usize] != 0;
+    let set = |x: i32, y: i32| {
+        x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h && mask[y as usize * w + x as usize] != 0
+    };
     let s = (start.0 as i32, start.1 as i32);
     if !set(s.0, s.1) {
         return false;
@@ -123,7 +125,9 @@ pub(super) fn quad_corners(contour: &[[f64; 2]], min_side_px: f64) -> Option<[[f
     }
     let m = [mx / n as f64, my / n as f64];
     let far = |from: [f64; 2]| {
-        (0..n).max_by(|&a, &b| dist2(contour[a], from).total_cmp(&dist2(contour[b], from))).unwrap_or(0)
+        (0..n)
+            .max_by(|&a, &b| dist2(contour[a], from).total_cmp(&dist2(contour[b], from)))
+            .unwrap_or(0)
     };
     let i0 = far(m);
     let i2 = far(contour[i0]);
@@ -172,7 +176,10 @@ fn intersect(l: Line, m: Line) -> Option<[f64; 2]> {
 /// `None` when a side has too few clear crossings or a corner moves too far (more than
 /// 2 px plus a tenth of the side), which is not a tag's border.
 pub(super) fn refine_corners(grey: &[u8], w: usize, h: usize, c: [[f64; 2]; 4]) -> Option<[[f64; 2]; 4]> {
-    let mut lines = [Line { p: [0.0; 2], d: [0.0; 2] }; 4];
+    let mut lines = [Line {
+        p: [0.0; 2],
+        d: [0.0; 2],
+    }; 4];
     let mut shortest = f64::INFINITY;
     for k in 0..4 {
         let (a, b) = (c[k], c[(k + 1) % 4]);

@@ -42,14 +42,18 @@ pub fn draw_tag(
     translation: &Vector3<f64>,
 ) -> bool {
     let (family, size_m, supersample) = (tag.family, tag.size_m, tag.supersample);
-    let Some(grid) = family.cell_grid(tag.id) else { return false };
+    let Some(grid) = family.cell_grid(tag.id) else {
+        return false;
+    };
     let n = family.cells() as f64;
     let cell = size_m / n;
     // The outer corners of the white ring bound the pixels to visit.
     let ring = tag_corners(size_m + 2.0 * cell);
     let (mut x0, mut y0, mut x1, mut y1) = (f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
     for c in &ring {
-        let Some(p) = camera.project(&(rotation * c + translation)) else { return false };
+        let Some(p) = camera.project(&(rotation * c + translation)) else {
+            return false;
+        };
         x0 = x0.min(p[0]);
         y0 = y0.min(p[1]);
         x1 = x1.max(p[0]);

@@ -103,7 +103,11 @@ fn tags_are_found_from_half_a_metre_to_four_metres() {
         assert_eq!(found[0].id, 300);
         let pose = found[0].pose.unwrap();
         // Relative errors stay within 1 % of the range.
-        assert!((pose.translation - t).norm() < 0.01 * z, "at {z} m: {:?}", pose.translation);
+        assert!(
+            (pose.translation - t).norm() < 0.01 * z,
+            "at {z} m: {:?}",
+            pose.translation
+        );
     }
 }
 
@@ -111,15 +115,33 @@ fn tags_are_found_from_half_a_metre_to_four_metres() {
 fn the_covariance_follows_the_corner_noise_and_the_range() {
     let cam = camera();
     let r = facing(20.0, 0.0, 0.0);
-    let near = tag_pose(&project_corners(&cam, &r, &Vector3::new(0.0, 0.0, 1.0), SIZE).unwrap(), &cam, SIZE, 0.5).unwrap();
-    let far = tag_pose(&project_corners(&cam, &r, &Vector3::new(0.0, 0.0, 3.0), SIZE).unwrap(), &cam, SIZE, 0.5).unwrap();
+    let near = tag_pose(
+        &project_corners(&cam, &r, &Vector3::new(0.0, 0.0, 1.0), SIZE).unwrap(),
+        &cam,
+        SIZE,
+        0.5,
+    )
+    .unwrap();
+    let far = tag_pose(
+        &project_corners(&cam, &r, &Vector3::new(0.0, 0.0, 3.0), SIZE).unwrap(),
+        &cam,
+        SIZE,
+        0.5,
+    )
+    .unwrap();
     assert!(near.reprojection_px < 1e-6);
     assert!((near.rotation - r).norm() < 1e-6 && (near.translation.z - 1.0).abs() < 1e-6);
     // Depth's σ grows as the range squared (z² σ / (f s)): 9× at 3 m.
     let (sz_near, sz_far) = (near.covariance[(5, 5)].sqrt(), far.covariance[(5, 5)].sqrt());
     assert!((sz_far / sz_near - 9.0).abs() < 1.0, "{sz_near} {sz_far}");
     // Twice the pixel noise, twice every σ.
-    let twice = tag_pose(&project_corners(&cam, &r, &Vector3::new(0.0, 0.0, 1.0), SIZE).unwrap(), &cam, SIZE, 1.0).unwrap();
+    let twice = tag_pose(
+        &project_corners(&cam, &r, &Vector3::new(0.0, 0.0, 1.0), SIZE).unwrap(),
+        &cam,
+        SIZE,
+        1.0,
+    )
+    .unwrap();
     assert!((twice.position_sigma_m() / near.position_sigma_m() - 2.0).abs() < 1e-6);
     assert!(near.position_sigma_m() < 0.01 && near.angle_sigma_rad() < 0.05);
 }
@@ -169,7 +191,10 @@ fn the_schema_check_rejects_a_wrong_id_a_small_tag_and_a_bad_pose() {
 fn frames_without_tags_give_nothing_and_never_panic() {
     let cam = camera();
     let mut det = detector();
-    assert_eq!(det.detect(&RgbImage::new(0, 0).view(), &cam), Err(crate::perception::VisionError::EmptyImage));
+    assert_eq!(
+        det.detect(&RgbImage::new(0, 0).view(), &cam),
+        Err(crate::perception::VisionError::EmptyImage)
+    );
     assert!(det.detect_grey(&[0; 5], 2, 2, &cam).is_err());
     for (w, h) in [(1, 1), (3, 2), (640, 480)] {
         for level in [0u8, 255] {
@@ -191,7 +216,10 @@ fn frames_without_tags_give_nothing_and_never_panic() {
             }
         }
         s = s.rotate_left(7);
-        assert!(det.detect(&im.view(), &cam).unwrap().is_empty(), "noise in blocks of {block}");
+        assert!(
+            det.detect(&im.view(), &cam).unwrap().is_empty(),
+            "noise in blocks of {block}"
+        );
     }
 }
 

@@ -40,7 +40,11 @@ impl Default for TileThreshold {
 /// Writes the grey image of `rgb` into `grey` (resized to the frame, row-major).
 pub fn grey_into(rgb: &RgbView<'_>, grey: &mut Vec<u8>) {
     grey.clear();
-    grey.extend(rgb.as_bytes().chunks_exact(3).map(|p| grey_from_rgb([p[0], p[1], p[2]])));
+    grey.extend(
+        rgb.as_bytes()
+            .chunks_exact(3)
+            .map(|p| grey_from_rgb([p[0], p[1], p[2]])),
+    );
 }
 
 /// The threshold's reusable tile buffers.
