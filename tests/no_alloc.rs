@@ -11,7 +11,8 @@
 //!   and the fallback choice);
 //! * the AutoKrawler's marker step: segmentation, opening, labelling, identity; and its
 //!   whole ten-DOF estimate (markers, roll, drop, steering, and the wheels' pyramids,
-//!   corners, Lucas–Kanade, RANSAC and correction).
+//!   corners, Lucas–Kanade, RANSAC and correction);
+//! * the AprilTag detector: threshold, labelling, quads, decoding, pose and its check.
 //!
 //! A counting global allocator, gated to the test's own thread, proves it. (The threaded
 //! runtime builds the same per-tick lists as the lockstep; its threads are not counted.)
@@ -788,4 +789,54 @@ fn composed_krawler_ticks_do_not_allocate() {
     COUNTING.with(|c| c.set(false));
     assert_eq!(allocs(), 0, "allocations in steady state");
     assert_eq!(robot.memory().percept.frames, 12);
+}
+
+#[test]
+fn apriltag_detection_and_pose_do_not_allocate() {
+    use marsupial::perception::Pinhole;
+    use marsupial::perception::apriltag::{AprilTagDetector, AprilTagParams, TagFamily, TagSprite, draw_tag};
+    use nalgebra::{Matrix3, Vector3};
+    let cam = Pinhole {
+        fx: 600.0,
+        fy: 600.0,
+        cx: 319.5,
+        cy: 239.5,
+        k1: 0.0,
+        k2: 0.0,
+    };
+    let facing = Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, -1.0));
+    let frames: Vec<RgbImage> = [0.8, 1.0, 1.3]
+        .iter()
+        .map(|&z| {
+            let mut im = RgbImage::new(640, 480);
+            im.fill([128; 3]);
+            let tag = TagSprite {
+                family: TagFamily::Tag36h11,
+                id: 11,
+                size_m: 0.16,
+                supersample: 2,
+            };
+            draw_tag(&mut im, &cam, &tag, &facing, &Vector3::new(0.05, 0.02, z));
+            im
+        })
+        .collect();
+    let params = AprilTagParams {
+        expected_id: Some(11),
+        ..AprilTagParams::default()
+    };
+    let mut det = AprilTagDetector::new(params);
+    for f in &frames {
+        det.detect(&f.view(), &cam).unwrap(); // buffers grow to the frame
+    }
+    reset();
+    COUNTING.with(|c| c.set(true));
+    let mut accepted = 0;
+    for f in &frames {
+        for d in det.detect(&f.view(), &cam).unwrap() {
+            accepted += params.accept(d).is_ok() as usize;
+        }
+    }
+    COUNTING.with(|c| c.set(false));
+    assert_eq!(accepted, 3);
+    assert_eq!(allocs(), 0, "apriltag detection allocated");
 }

@@ -4,6 +4,7 @@
 
 mod common;
 
+mod apriltag_photos;
 mod autokrawler_world;
 mod avoid_profile;
 mod axel_closed_loop;

@@ -26,8 +26,11 @@
 //!   geometry, and its tracker with fixed, imprinted or adapted HSV bands.
 //! * [`circles`]: Axel's circle fiducials: detection, correspondence to the module's
 //!   model by homography, and pose.
+//! * [`apriltag`]: AprilTag fiducials (tag36h11 and kin): detection, id, pose and its
+//!   covariance, and the check that rejects a wrong id, a small tag or an uncertain pose.
 //! * [`overlay`]: drawing a detection over its frame.
 
+pub mod apriltag;
 pub mod camera_model;
 pub mod cast;
 pub mod circles;
