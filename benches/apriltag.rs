@@ -18,14 +18,7 @@ use std::hint::black_box;
 use std::path::Path;
 
 fn camera() -> Pinhole {
-    Pinhole {
-        fx: 600.0,
-        fy: 600.0,
-        cx: 319.5,
-        cy: 239.5,
-        k1: 0.0,
-        k2: 0.0,
-    }
+    Pinhole::ideal(600.0, 640, 480)
 }
 
 fn with_tag(mut im: RgbImage) -> RgbImage {

@@ -8,15 +8,7 @@ use marsupial::perception::{Pinhole, RgbImage};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use std::path::{Path, PathBuf};
 
-fn photos() -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/photos");
-    if p.is_dir() {
-        Some(p)
-    } else {
-        eprintln!("skipping: {} not found", p.display());
-        None
-    }
-}
+use crate::common::photos;
 
 fn images(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();

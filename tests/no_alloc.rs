@@ -796,14 +796,7 @@ fn apriltag_detection_and_pose_do_not_allocate() {
     use marsupial::perception::Pinhole;
     use marsupial::perception::apriltag::{AprilTagDetector, AprilTagParams, TagFamily, TagSprite, draw_tag};
     use nalgebra::{Matrix3, Vector3};
-    let cam = Pinhole {
-        fx: 600.0,
-        fy: 600.0,
-        cx: 319.5,
-        cy: 239.5,
-        k1: 0.0,
-        k2: 0.0,
-    };
+    let cam = Pinhole::ideal(600.0, 640, 480);
     let facing = Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, -1.0));
     let frames: Vec<RgbImage> = [0.8, 1.0, 1.3]
         .iter()

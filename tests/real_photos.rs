@@ -6,17 +6,9 @@ use marsupial::image_io::load_rgb;
 use marsupial::perception::ColorMode;
 use marsupial::profile::Profile;
 use marsupial::schemas::TwoBlockSchema;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-fn photos() -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/photos");
-    if p.is_dir() {
-        Some(p)
-    } else {
-        eprintln!("skipping: {} not found", p.display());
-        None
-    }
-}
+use crate::common::photos;
 
 fn bujold() -> Profile {
     Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/bujold.toml")).unwrap()

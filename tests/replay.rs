@@ -214,16 +214,6 @@ pub(crate) fn write_bag(path: &Path, topics: &[(&'static str, &str)], msgs: &[Ms
 
 // ----------------------------------------------------------------------- the frames
 
-pub(crate) fn photos() -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/photos");
-    if p.is_dir() {
-        Some(p)
-    } else {
-        eprintln!("skipping: {} not found", p.display());
-        None
-    }
-}
-
 pub(crate) fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("marsupial-replay-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
@@ -363,7 +353,7 @@ pub(crate) fn expected(frames: &[RgbImage]) -> Vec<serde_json::Value> {
 
 #[test]
 fn a_ros2_bag_of_real_photos_replays_as_the_schema_sees_them() {
-    let Some(dir) = photos() else { return };
+    let Some(dir) = common::photos() else { return };
     let d = tmp("photos");
     let bag = d.join("photos.mcap");
     let (frames, jpegs) = photo_bag(&bag, &dir);
@@ -426,7 +416,7 @@ fn a_ros2_bag_of_real_photos_replays_as_the_schema_sees_them() {
 
 #[test]
 fn the_behavior_runs_open_loop_and_the_record_replays_the_same() {
-    let Some(dir) = photos() else { return };
+    let Some(dir) = common::photos() else { return };
     let d = tmp("behavior");
     let bag = d.join("photos.mcap");
     let (frames, _) = photo_bag(&bag, &dir);
@@ -948,7 +938,7 @@ proptest::proptest! {
 
 #[test]
 fn the_pyramid_schema_replays_raposa_frames_and_needs_its_camera_aspect() {
-    let Some(dir) = photos() else { return };
+    let Some(dir) = common::photos() else { return };
     let d = tmp("raposa");
     let bag = d.join("raposa.mcap");
     // 160×120 crops of real fruit (orange among them), as bgr8.

@@ -10,7 +10,8 @@
 //! per-frame output of a replay are the same, value for value, from each compressed copy
 //! as from the uncompressed bag.
 
-use crate::replay::{DT, Msg, T0, expected, of_kind, opts, photo_bag, photos, replay, replay_err, tmp, write_bag};
+use crate::common::photos;
+use crate::replay::{DT, Msg, T0, expected, of_kind, opts, photo_bag, replay, replay_err, tmp, write_bag};
 use marsupial::replay::ReplayError;
 use marsupial::replay::log::LogFault;
 use std::io::Write;

@@ -55,6 +55,19 @@ pub struct Pinhole {
 }
 
 impl Pinhole {
+    /// A camera without distortion, focal length `f` px in both axes, its principal
+    /// point the centre of a `width` × `height` image (pixel centres at integers).
+    pub fn ideal(f: f64, width: usize, height: usize) -> Self {
+        Self {
+            fx: f,
+            fy: f,
+            cx: (width as f64 - 1.0) / 2.0,
+            cy: (height as f64 - 1.0) / 2.0,
+            k1: 0.0,
+            k2: 0.0,
+        }
+    }
+
     /// Pixel of a camera-frame point, or `None` behind the camera.
     pub fn project(&self, p: &Vector3<f64>) -> Option<[f64; 2]> {
         if p.z <= 1e-9 {

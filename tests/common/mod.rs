@@ -15,6 +15,18 @@ use marsupial::profile::Profile;
 use marsupial::sim::render::{Renderer, SensorParams};
 use std::path::{Path, PathBuf};
 
+/// The real photographs (`../shared/data/photos`), or `None` (saying so) on a checkout
+/// without them, so a test that needs them skips.
+pub fn photos() -> Option<PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/photos");
+    if p.is_dir() {
+        Some(p)
+    } else {
+        eprintln!("skipping: {} not found", p.display());
+        None
+    }
+}
+
 /// A profile shipped in `profiles/`, by name.
 pub fn shipped_profile(name: &str) -> Profile {
     Profile::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("profiles/{name}.toml"))).unwrap()

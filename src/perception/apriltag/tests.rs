@@ -9,14 +9,7 @@ use nalgebra::{Matrix3, Rotation3, Vector3};
 const SIZE: f64 = 0.16;
 
 fn camera() -> Pinhole {
-    Pinhole {
-        fx: 600.0,
-        fy: 600.0,
-        cx: 319.5,
-        cy: 239.5,
-        k1: 0.0,
-        k2: 0.0,
-    }
+    Pinhole::ideal(600.0, 640, 480)
 }
 
 /// camera_from_tag for a tag facing the camera, then turned by yaw (about the tag's
