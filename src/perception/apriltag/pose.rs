@@ -20,7 +20,7 @@
 //! [`TagPose::alternative_px`] keeps the other's error when it is a distinct pose.
 //!
 //! **Covariance.** With J the 8 × 6 Jacobian of the pixel residuals at the optimum, for
-//! the perturbation R ← exp([δθ]×)·R, t ← t + δt (δθ in radians about the camera's axes,
+//! the perturbation R ← exp(\[δθ\]×)·R, t ← t + δt (δθ in radians about the camera's axes,
 //! δt in metres in the camera frame), Σ = σ²·(JᵀJ)⁻¹ for independent corner noise σ px
 //! on each coordinate: the first-order covariance of the least-squares pose. Order
 //! [δθx, δθy, δθz, δtx, δty, δtz].
