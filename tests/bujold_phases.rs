@@ -14,8 +14,8 @@ use marsupial::geometry::Pose2;
 use marsupial::perception::RgbImage;
 use marsupial::perception::two_block_pose::FiducialView;
 use marsupial::schemas::{
-    Behavior, CameraInput, DOCK_CONTACT_KIND, DriveCommand, FailureReason, Inputs, OdometryReading, Outcome, Posture,
-    SensorInput, Stamped, Status, Step,
+    Agent, Behavior, CameraInput, DOCK_CONTACT_KIND, DriveCommand, FailureReason, Inputs, Mission, OdometryReading,
+    Outcome, Posture, SensorInput, Stamped, Status, Step,
 };
 
 fn memory() -> Memory {
@@ -354,4 +354,30 @@ fn the_dock_switch_is_released_only_by_contact() {
     let s = c.tick(&mut mem, &inputs).unwrap();
     assert_eq!(s.status, Status::Done(Outcome::Docked));
     assert_eq!(s.output.aux.get::<Posture>(), Some(Posture::Lowered));
+}
+
+/// A dock hint drives to the approach zone first (the ballistic states) unless the
+/// mission says the robot is already staged (Nav2's `navigate_to_staging_pose = false`).
+#[test]
+fn a_staged_docking_skips_the_ballistic_leg() {
+    let p = common::shipped_profile("bujold");
+    let hint = Pose2::new(-3.0, 0.5, 0.2);
+    let first_phase = |mission: Mission| {
+        let mut robot = catalog::shipped().compose(&Bujold, &p).unwrap();
+        robot.begin(&mission).unwrap();
+        let mut inputs = Inputs::empty(0.0);
+        inputs.odometry = Some(Stamped::new(0.0, OdometryReading::default()));
+        robot
+            .tick_perceived(&inputs, |m| m.perceive(&inputs))
+            .unwrap()
+            .feedback
+            .phase
+    };
+    assert!(first_phase(Mission::docking_at(hint)).starts_with("ballistic"));
+    let staged = Mission::Docking {
+        dock_hint: Some(hint),
+        stage: false,
+    };
+    assert_eq!(first_phase(staged), "search");
+    assert_eq!(first_phase(Mission::docking()), "search");
 }

@@ -154,8 +154,8 @@ impl<M: SharedMemory> Agent for Composed<M> {
                     mission: mission.name(),
                     why: "its [behavior.tree] declares no `departure` state".into(),
                 })?,
-            Mission::Docking { dock_hint } => match (dock_hint, &self.entries.ballistic) {
-                (Some(_), Some(b)) => b.clone(),
+            Mission::Docking { dock_hint, stage } => match (dock_hint, &self.entries.ballistic) {
+                (Some(_), Some(b)) if *stage => b.clone(),
                 _ => self.entries.docking.clone(),
             },
         };

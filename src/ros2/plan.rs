@@ -74,8 +74,9 @@ impl Resolver<'_> {
 
     /// A `DockRobot` goal's plan: by `dock_id` from the database (its pose, when known,
     /// becomes the mission's dock hint), or at `dock_pose` (the hint), of `dock_type`.
-    /// `navigate_to_staging_pose` changes nothing: the robot's own phases drive to the
-    /// staging pose when they have one.
+    /// With `navigate_to_staging_pose` and a hint, the robot's own ballistic phase drives
+    /// to the approach zone first (it has no `NavigateToPose` client); without, it starts
+    /// where it is, as staged.
     ///
     /// # Errors
     /// [`GoalError`]: `DOCK_NOT_IN_DB` for an unknown `dock_id`; `DOCK_NOT_VALID` for a
@@ -111,7 +112,10 @@ impl Resolver<'_> {
             Some(planar(&g.dock_pose)?)
         };
         Ok(Plan {
-            mission: Mission::Docking { dock_hint: hint },
+            mission: Mission::Docking {
+                dock_hint: hint,
+                stage: g.navigate_to_staging_pose,
+            },
             max_duration: None,
             max_staging_s: Some(f64::from(g.max_staging_time)),
         })
@@ -185,7 +189,7 @@ mod tests {
             ..DockRobotGoal::default()
         };
         let p = r.docking(&by_id).unwrap();
-        assert_eq!(p.mission, Mission::Docking { dock_hint: None });
+        assert_eq!(p.mission, Mission::docking());
         assert_eq!(p.max_staging_s, Some(1000.0));
         let half = std::f64::consts::FRAC_PI_4;
         let by_pose = DockRobotGoal {
@@ -198,11 +202,22 @@ mod tests {
             },
             ..DockRobotGoal::default()
         };
-        let Mission::Docking { dock_hint: Some(h) } = r.docking(&by_pose).unwrap().mission else {
+        let Mission::Docking {
+            dock_hint: Some(h),
+            stage: true,
+        } = r.docking(&by_pose).unwrap().mission
+        else {
             panic!("a hint")
         };
         assert!((h.x - 1.0).abs() < 1e-12 && (h.y - 2.0).abs() < 1e-12);
         assert!((h.theta - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        let staged = DockRobotGoal {
+            navigate_to_staging_pose: false,
+            ..by_pose
+        };
+        let Mission::Docking { stage: false, .. } = r.docking(&staged).unwrap().mission else {
+            panic!("navigate_to_staging_pose = false: already staged")
+        };
     }
 
     #[test]

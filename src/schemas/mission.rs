@@ -27,13 +27,30 @@ pub enum Mission {
         /// approach zone by odometry first; without, the robot is taken to be within
         /// sight of the dock.
         dock_hint: Option<Pose2>,
+        /// Drive to the approach zone first when there is a hint and the tree declares a
+        /// ballistic entry (Nav2's `navigate_to_staging_pose`); `false`: the robot is
+        /// already staged and starts at the tree's docking entry, the hint kept for the
+        /// phases that use it (a repositioning toward the dock).
+        stage: bool,
     },
 }
 
 impl Mission {
     /// Docking from within sight of the dock (no a-priori pose).
     pub fn docking() -> Self {
-        Mission::Docking { dock_hint: None }
+        Mission::Docking {
+            dock_hint: None,
+            stage: true,
+        }
+    }
+
+    /// Docking at the dock `hint` says, driving to its approach zone first (where the
+    /// robot's tree declares a ballistic entry).
+    pub fn docking_at(hint: Pose2) -> Self {
+        Mission::Docking {
+            dock_hint: Some(hint),
+            stage: true,
+        }
     }
 
     /// Short name, as in logs: `departure` or `docking`.

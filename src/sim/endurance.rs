@@ -391,7 +391,7 @@ fn cycle(
                 sim.set_fault(None);
             });
             rig.lp
-                .begin(&Mission::Docking { dock_hint: None })
+                .begin(&Mission::docking())
                 .map_err(|e| SimError::Unsupported(e.to_string()))?;
             let end = rig.run("docking", sc.timeout_s, rec, mcap);
             let manoeuvres = rig.lp.root().stats().manoeuvres;

@@ -408,7 +408,7 @@ pub fn run_one(
         )
     });
     rig.lp
-        .begin(&Mission::Docking { dock_hint })
+        .begin(&Mission::Docking { dock_hint, stage: true })
         .map_err(|e| SimError::Unsupported(e.to_string()))?;
     let end = rig.run("docking", sc.timeout_s, rec, &mut mcap);
     let manoeuvres = rig.lp.root().stats().manoeuvres;

@@ -318,7 +318,7 @@ impl SharedMemory for Memory {
         self.run_start = None;
         match mission {
             Mission::Departure => self.imprinted = false,
-            Mission::Docking { dock_hint } => {
+            Mission::Docking { dock_hint, .. } => {
                 self.alpha_filtered = None;
                 self.alpha_window.clear();
                 self.ratio_gate.reset();
