@@ -833,3 +833,54 @@ fn apriltag_detection_and_pose_do_not_allocate() {
     assert_eq!(accepted, 3);
     assert_eq!(allocs(), 0, "apriltag detection allocated");
 }
+
+/// A camera's raw frames decode without allocating once the decoder has seen their size:
+/// at the camera's size (straight into the loop's frame) and at twice it (decoded into the
+/// decoder's own buffer, then area-rescaled), for 4:2:2, 4:2:0 and Bayer. (A JPEG frame
+/// is decoded by the `image` crate into a new image each time: not counted here.)
+#[cfg(feature = "image-io")]
+#[test]
+fn camera_frames_decode_without_allocating() {
+    use marsupial::msgs::camera_frame::{CameraBytes, FrameDecoder};
+    let (w, h) = (64u32, 48u32);
+    let mut frame = RgbImage::new(w as usize, h as usize);
+    let mut decoder = FrameDecoder::new();
+    // (encoding, width, height, bytes) at the camera's size and at twice it.
+    let messages: Vec<(&str, u32, u32, Vec<u8>)> = [1u32, 2]
+        .into_iter()
+        .flat_map(|scale| {
+            let (mw, mh) = (w * scale, h * scale);
+            let ramp = |n: usize| (0..n).map(|i| (i * 7 % 251) as u8).collect::<Vec<u8>>();
+            [
+                ("yuyv", mw, mh, ramp((2 * mw * mh) as usize)),
+                ("uyvy", mw, mh, ramp((2 * mw * mh) as usize)),
+                ("nv12", mw, mh, ramp((mw * mh * 3 / 2) as usize)),
+                ("bayer_grbg8", mw, mh, ramp((mw * mh) as usize)),
+            ]
+        })
+        .collect();
+    let decode = |decoder: &mut FrameDecoder, frame: &mut RgbImage| {
+        for (encoding, mw, mh, data) in &messages {
+            let step = match *encoding {
+                "yuyv" | "uyvy" => 2 * mw,
+                _ => *mw,
+            };
+            let bytes = CameraBytes::Raw {
+                width: *mw,
+                height: *mh,
+                encoding,
+                step,
+                data,
+            };
+            assert_eq!(decoder.decode_into(bytes, frame).unwrap(), (*mw as usize, *mh as usize));
+        }
+    };
+    decode(&mut decoder, &mut frame); // the decoder's buffers grow to the sizes
+    reset();
+    COUNTING.with(|c| c.set(true));
+    for _ in 0..3 {
+        decode(&mut decoder, &mut frame);
+    }
+    COUNTING.with(|c| c.set(false));
+    assert_eq!(allocs(), 0, "decoding camera frames allocated");
+}
