@@ -27,15 +27,7 @@ fn images(dir: &Path) -> Vec<PathBuf> {
 
 /// A pin-hole for a photo of this size (60° across; only the pose needs it).
 fn camera_for(w: usize, h: usize) -> Pinhole {
-    let f = w as f64 / (2.0 * 30f64.to_radians().tan());
-    Pinhole {
-        fx: f,
-        fy: f,
-        cx: (w as f64 - 1.0) / 2.0,
-        cy: (h as f64 - 1.0) / 2.0,
-        k1: 0.0,
-        k2: 0.0,
-    }
+    Pinhole::ideal(w as f64 / (2.0 * 30f64.to_radians().tan()), w, h)
 }
 
 #[test]

@@ -334,6 +334,11 @@ pub(crate) fn of_kind<'a>(lines: &'a [serde_json::Value], kind: &str) -> Vec<&'a
     lines.iter().filter(|l| l["kind"] == kind).collect()
 }
 
+/// The `index` of each line (the message each frame or skip names).
+fn indices(lines: &[&serde_json::Value]) -> Vec<u64> {
+    lines.iter().map(|l| l["index"].as_u64().unwrap()).collect()
+}
+
 /// The percepts the schema gives on `frames` at 0, 0.1, 0.2 … s, as JSON.
 pub(crate) fn expected(frames: &[RgbImage]) -> Vec<serde_json::Value> {
     let p = common::shipped_profile("bujold");
@@ -694,13 +699,10 @@ fn a_truncated_or_corrupt_jpeg_frame_is_skipped_as_missing() {
     write_bag(&bag, &[("/cam/compressed", "sensor_msgs/msg/CompressedImage")], &msgs);
     let (lines, r) = replay(&opts(&bag));
     r.unwrap();
-    let frames: Vec<u64> = of_kind(&lines, "frame")
-        .iter()
-        .map(|l| l["index"].as_u64().unwrap())
-        .collect();
+    let frames = indices(&of_kind(&lines, "frame"));
     assert_eq!(frames, [0, 2]);
     let skipped = of_kind(&lines, "skipped");
-    let indices: Vec<u64> = skipped.iter().map(|l| l["index"].as_u64().unwrap()).collect();
+    let indices = indices(&skipped);
     assert_eq!(indices, [1, 3]);
     for l in skipped {
         assert_eq!(l["reason"], "undecodable_image", "{l}");
@@ -828,10 +830,7 @@ fn a_half_readable_topic_reports_what_was_skipped_and_goes_on() {
     small_bag(&bag, vec![good(0), nv24.clone(), good(2), xcdr2, nv24, good(5)]);
     let (lines, r) = replay(&opts(&bag));
     r.unwrap();
-    let frames: Vec<u64> = of_kind(&lines, "frame")
-        .iter()
-        .map(|l| l["index"].as_u64().unwrap())
-        .collect();
+    let frames = indices(&of_kind(&lines, "frame"));
     assert_eq!(frames, [0, 2, 5]);
     let s = &of_kind(&lines, "summary")[0]["skipped"];
     assert_eq!(s[0]["reason"], "cdr");
